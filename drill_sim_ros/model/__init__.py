@@ -1,0 +1,1 @@
+"""Pure numerical core (numpy/numba). Never imports rclpy, mcap or rerun."""

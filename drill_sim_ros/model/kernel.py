@@ -1,0 +1,383 @@
+"""Compiled stepping of the RGD07 delay model (eqs. 25-33), in absolute variables.
+
+Richard, Germay & Detournay (2007), J. Sound Vib. 305, 432-456. Everything here is
+dimensionless (time unit t*, length unit L*, weight unit zeta*eps*a*L*, torque unit C).
+
+Absolute variables (so the surface inputs may change at any step):
+
+* ``U``  bit depth (down positive), ``V = dU/dtau`` (rate of penetration);
+* ``PHI`` bit angle, ``OMEGA = dPHI/dtau`` (never negative);
+* ``PHI_S`` top-drive angle, driven at ``OMEGA_S``; pipe torque = ``PHI_S - PHI``
+  (eq. 25 right: ``phi'' + phi = T0 - T`` with ``phi = PHI - PHI_0`` is
+  ``PHI'' = (PHI_S - PHI) - T``);
+* ``W_APP`` the applied weight (eq. 25 left: ``U'' = psi (W_APP - W)``).
+
+The depth of cut (eqs. 6-8, 26-28) is read from the bottom-hole profile: the height
+each angle of one blade sector (2 pi / n) was last cut to, stored on ``n_nodes`` nodes.
+A passing blade lowers the surface to the bit depth when the bit is deeper (max rule), so
+the rock is re-cut correctly after the bit has bounced off bottom. :func:`advance_exact`
+is the reference path: it keeps the exact time history of (PHI, U) and solves eq. (7) for
+the delay by interpolation, as in RGD07 Appendix C.
+
+Integration is symplectic Euler (RGD07 eq. C.1 with the position update using the new
+velocity). The wearflat contact (eq. 31) is solved implicitly in the new axial velocity,
+which yields the set-valued force ``0 <= W_f <= lam`` at ``V = 0`` (eq. 31, last line)
+with no chattering. Stick (eq. 32) freezes the bit; slip happens when the pipe torque
+reaches the cutting + friction torque (eqs. 14, 33), checked at every step so the
+top-drive speed may vary.
+
+Kernels never raise: they return a status code (``STATUS_*``).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+# ---- parameter vector (float64) -------------------------------------------------------
+P_N = 0             # number of blades n
+P_BETA = 1          # beta = mu gamma zeta (eq. 10)
+P_LAM = 2           # bluntness lambda (eq. 24)
+P_PSI = 3           # system number psi (eq. 24)
+P_DT = 4            # time step dtau
+P_NODES = 5         # profile nodes per blade sector
+P_OMEGA_RATE = 6    # max |d OMEGA_S / dtau| (inf = instantaneous)
+P_W_RATE = 7        # max |d W_APP / dtau| (inf = instantaneous)
+P_TAU_AVG = 8       # statistics accumulate for tau >= P_TAU_AVG
+N_PARAMS = 9
+
+# ---- surface targets (float64) ----------------------------------------------------------
+I_OMEGA_S = 0       # commanded top-drive speed
+I_W_APP = 1         # commanded applied weight
+N_INPUTS = 2
+
+# ---- state vector (float64) -------------------------------------------------------------
+S_TAU = 0
+S_U = 1
+S_V = 2
+S_PHI = 3
+S_OMEGA = 4
+S_PHI_S = 5
+S_OMEGA_S = 6
+S_W_APP = 7
+S_STUCK = 8         # 1.0 while the bit sticks (eq. 32)
+S_NODE = 9          # index of the profile node most recently passed
+S_FRAC = 10         # bit position past that node, in node spacings [0, 1)
+S_H_OLD = 11        # that node's height before the current blade re-cut it
+S_STEP = 12         # step counter
+N_STATE = 13
+
+# ---- sample columns ---------------------------------------------------------------------
+C_TAU = 0
+C_U = 1             # bit depth
+C_V = 2             # rate of penetration
+C_PHI = 3           # bit angle
+C_OMEGA = 4         # bit angular speed
+C_PHI_S = 5         # top-drive angle
+C_OMEGA_S = 6       # top-drive speed
+C_W_APP = 7         # applied weight
+C_WOB = 8           # weight on bit W
+C_TOB = 9           # torque on bit T
+C_DOC = 10          # depth of cut delta (negative: clearance above the rock)
+C_WF = 11           # wearflat contact weight W_f
+C_T_PIPE = 12       # pipe (surface) torque PHI_S - PHI
+C_MODE = 13
+N_COLS = 14
+
+# ---- interaction modes ------------------------------------------------------------------
+MODE_CUTTING = 0    # cutting with full wearflat contact
+MODE_LOST_CONTACT = 1  # cutting, wearflat contact partly or fully lost (V <= 0)
+MODE_STUCK = 2      # OMEGA = 0 (eq. 32)
+MODE_OFF_BOTTOM = 3  # delta < 0: bit above the rock, T = W = 0
+MODE_NAMES = ("cutting", "lost_contact", "stuck", "off_bottom")
+
+# ---- statistics accumulators --------------------------------------------------------------
+A_COUNT = 0         # steps accumulated (tau >= P_TAU_AVG)
+A_WF = 1
+A_TOB = 2
+A_DOC = 3
+A_WOB = 4
+A_OMEGA = 5
+A_T_PIPE = 6
+A_V = 7
+A_OMEGA_MIN = 8
+A_OMEGA_MAX = 9
+A_STUCK = 10        # steps stuck within the window
+A_FIRST_STICK = 11  # tau of the first stick (nan if none), whole run
+A_FIRST_BOUNCE = 12  # tau of the first off-bottom step (nan if none), whole run
+A_DOC_OMEGA = 13    # sum of delta * OMEGA (for the mean penetration per revolution)
+N_ACC = 14
+
+STATUS_OK = 0
+STATUS_NONFINITE = 1
+STATUS_HISTORY_FULL = 2
+
+
+def new_accumulators() -> np.ndarray:
+    """Zeroed statistics with the extremes and first-event times unset."""
+    acc = np.zeros(N_ACC)
+    acc[A_OMEGA_MIN] = np.inf
+    acc[A_OMEGA_MAX] = -np.inf
+    acc[A_FIRST_STICK] = np.nan
+    acc[A_FIRST_BOUNCE] = np.nan
+    return acc
+
+
+@njit(cache=True, inline="always")
+def _ramp(current: float, target: float, max_rate: float, dt: float) -> float:
+    """Move ``current`` toward ``target`` by at most ``max_rate * dt``."""
+    step = max_rate * dt
+    if target > current + step:
+        return current + step
+    if target < current - step:
+        return current - step
+    return target
+
+
+@njit(cache=True, inline="always")
+def _wearflat_contact(v: float, w_app: float, doc: float, lam: float,
+                      kick: float) -> tuple[float, float]:
+    """Axial update with the contact law of eq. (31), implicit in the new velocity.
+
+    ``kick = psi * dtau``. Returns ``(v_new, w_f)`` with ``w_f = lam`` if ``v_new > 0``,
+    ``0`` if ``v_new < 0`` and ``v_new = 0, 0 <= w_f <= lam`` from the balance of linear
+    momentum otherwise (eq. 31, last line; eq. 25 left with W = delta + W_f, eq. 29).
+    """
+    v_free = v + kick * (w_app - doc)        # no wearflat force
+    if v_free < 0.0:
+        return v_free, 0.0                   # moving up: contact lost
+    v_full = v_free - kick * lam             # full wearflat force
+    if v_full > 0.0:
+        return v_full, lam                   # moving down: full contact
+    return 0.0, v_free / kick                # V = 0: set-valued contact force
+
+
+@njit(cache=True, inline="always")
+def _step(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, surface: float,
+          row: np.ndarray) -> None:
+    """One symplectic-Euler step of eqs. (25)-(33) given the rock height under the bit.
+
+    Fills ``row`` with the sample at the start of the step (state and bit forces at tau)
+    and leaves the new state in ``st`` (angle bookkeeping is the caller's).
+    """
+    n, beta, lam, psi, dt = prm[P_N], prm[P_BETA], prm[P_LAM], prm[P_PSI], prm[P_DT]
+    u, v, phi, omega = st[S_U], st[S_V], st[S_PHI], st[S_OMEGA]
+    t_pipe = st[S_PHI_S] - phi
+    w_app = st[S_W_APP]
+    doc = n * (u - surface)                  # eqs. (8), (26)-(27): delta = n (U - U(tau - tau_n))
+    stuck = st[S_STUCK] != 0.0
+    if stuck and doc >= 0.0 and t_pipe <= doc + beta * lam:
+        # Stick phase: the bit is immobile, the rock reacts the pipe torque and the weight
+        # (eq. 14 generalised to a varying top-drive speed; full wearflat contact).
+        w_f, wob, tob, mode = lam, w_app, t_pipe, MODE_STUCK
+        v_new, omega_new = 0.0, 0.0
+    else:
+        stuck = False
+        if doc >= 0.0:
+            v_new, w_f = _wearflat_contact(v, w_app, doc, lam, psi * dt)
+            wob = doc + w_f                   # eq. (29): W = delta + W_f
+            tob = doc + beta * w_f            # eq. (30): T = delta + beta W_f
+            mode = MODE_CUTTING if w_f >= lam else MODE_LOST_CONTACT
+        else:
+            w_f, wob, tob, mode = 0.0, 0.0, 0.0, MODE_OFF_BOTTOM
+            v_new = v + psi * dt * w_app      # free fall: no force from the rock
+        omega_new = omega + (t_pipe - tob) * dt   # eq. (25) right
+        if omega_new <= 0.0:
+            omega_new = 0.0                   # no backward rotation
+            if doc >= 0.0:                    # eq. (32): the bit sticks on the rock
+                stuck = True
+                v_new = 0.0
+    row[C_TAU] = st[S_TAU]
+    row[C_U] = u
+    row[C_V] = v
+    row[C_PHI] = phi
+    row[C_OMEGA] = omega
+    row[C_PHI_S] = st[S_PHI_S]
+    row[C_OMEGA_S] = st[S_OMEGA_S]
+    row[C_W_APP] = w_app
+    row[C_WOB] = wob
+    row[C_TOB] = tob
+    row[C_DOC] = doc
+    row[C_WF] = w_f
+    row[C_T_PIPE] = t_pipe
+    row[C_MODE] = mode
+    st[S_V] = v_new
+    st[S_U] = u + v_new * dt
+    st[S_OMEGA] = omega_new
+    st[S_PHI] = phi + omega_new * dt
+    st[S_PHI_S] += st[S_OMEGA_S] * dt
+    st[S_OMEGA_S] = _ramp(st[S_OMEGA_S], tgt[I_OMEGA_S], prm[P_OMEGA_RATE], dt)
+    st[S_W_APP] = _ramp(w_app, tgt[I_W_APP], prm[P_W_RATE], dt)
+    st[S_STUCK] = 1.0 if stuck else 0.0
+    st[S_TAU] += dt
+    st[S_STEP] += 1.0
+
+
+@njit(cache=True, inline="always")
+def _accumulate(acc: np.ndarray, row: np.ndarray, tau_avg: float) -> None:
+    """Add one step's sample to the running statistics."""
+    mode = row[C_MODE]
+    if mode == MODE_STUCK and math.isnan(acc[A_FIRST_STICK]):
+        acc[A_FIRST_STICK] = row[C_TAU]
+    if mode == MODE_OFF_BOTTOM and math.isnan(acc[A_FIRST_BOUNCE]):
+        acc[A_FIRST_BOUNCE] = row[C_TAU]
+    if row[C_TAU] < tau_avg:
+        return
+    omega = row[C_OMEGA]
+    acc[A_COUNT] += 1.0
+    acc[A_WF] += row[C_WF]
+    acc[A_TOB] += row[C_TOB]
+    acc[A_DOC] += row[C_DOC]
+    acc[A_WOB] += row[C_WOB]
+    acc[A_OMEGA] += omega
+    acc[A_T_PIPE] += row[C_T_PIPE]
+    acc[A_V] += row[C_V]
+    acc[A_DOC_OMEGA] += row[C_DOC] * omega
+    acc[A_OMEGA_MIN] = min(acc[A_OMEGA_MIN], omega)
+    acc[A_OMEGA_MAX] = max(acc[A_OMEGA_MAX], omega)
+    if mode == MODE_STUCK:
+        acc[A_STUCK] += 1.0
+
+
+@njit(cache=True)
+def _first_countdown(step: float, every: int) -> int:
+    """Steps until the next global step that is a multiple of ``every`` (-1: never)."""
+    if every <= 0:
+        return -1
+    return (every - int(step) % every) % every
+
+
+@njit(cache=True, inline="always")
+def _emit(row: np.ndarray, out: np.ndarray, n_rows: int, countdown: int,
+          every: int) -> tuple[int, int]:
+    """Copy ``row`` into ``out`` when ``countdown`` hits zero; returns (rows, countdown)."""
+    if countdown == 0:
+        if n_rows < out.shape[0]:
+            out[n_rows, :] = row
+            n_rows += 1
+        return n_rows, every - 1
+    return n_rows, countdown - 1
+
+
+@njit(cache=True)
+def advance_profile(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarray,
+                    acc: np.ndarray, out: np.ndarray, n_steps: int,
+                    every: int) -> tuple[int, int]:
+    """Advance ``n_steps`` with the bottom-hole-profile delay (the production path).
+
+    profile: shape (n_nodes,), rock height per node of one blade sector (2 pi / n). The
+    bit reads the height left by the previous blade (eq. 6: U(t - t_n) where eq. 7 holds)
+    by linear interpolation in angle, and re-cuts every node it passes to
+    ``max(old, U_crossing)``.
+    out: shape (rows, N_COLS); a row is written when the global step % every == 0.
+    Returns ``(status, rows_written)``.
+    """
+    n_nodes = profile.shape[0]
+    spacing = 2.0 * math.pi / prm[P_N] / n_nodes
+    inv_spacing = 1.0 / spacing
+    tau_avg = prm[P_TAU_AVG]
+    row = np.empty(N_COLS)
+    node = int(st[S_NODE])
+    frac = st[S_FRAC]
+    h_old = st[S_H_OLD]
+    n_rows = 0
+    countdown = _first_countdown(st[S_STEP], every)
+    for _ in range(n_steps):
+        nxt = node + 1 if node + 1 < n_nodes else 0
+        surface = h_old + frac * (profile[nxt] - h_old)
+        u0 = st[S_U]
+        _step(st, prm, tgt, surface, row)
+        _accumulate(acc, row, tau_avg)
+        n_rows, countdown = _emit(row, out, n_rows, countdown, every)
+        # angle bookkeeping: nodes crossed during the step are re-cut (max rule)
+        dfrac = (st[S_PHI] - row[C_PHI]) * inv_spacing
+        f_start = frac
+        frac += dfrac
+        while frac >= 1.0:
+            frac -= 1.0
+            node = nxt
+            nxt = node + 1 if node + 1 < n_nodes else 0
+            u_cross = u0 + (st[S_U] - u0) * (1.0 - f_start) / dfrac
+            f_start -= 1.0
+            h_old = profile[node]
+            if u_cross > h_old:
+                profile[node] = u_cross
+    st[S_NODE] = node
+    st[S_FRAC] = frac
+    st[S_H_OLD] = h_old
+    if not (math.isfinite(st[S_U]) and math.isfinite(st[S_V]) and math.isfinite(st[S_OMEGA])
+            and math.isfinite(st[S_PHI])):
+        return STATUS_NONFINITE, n_rows
+    return STATUS_OK, n_rows
+
+
+@njit(cache=True)
+def _delayed_depth(hist_phi: np.ndarray, hist_u: np.ndarray, head: int, count: int,
+                   cursor: int, phi_target: float) -> tuple[float, int]:
+    """U at the latest time the bit angle was ``phi_target`` (eq. 7), by interpolation.
+
+    History is a ring buffer (capacity = len(hist_phi)) of ``count`` samples ending at
+    ``head - 1``, with PHI non-decreasing. ``cursor`` (an age-ordered index) only moves
+    forward because ``phi_target`` does. Returns ``(U, cursor)``.
+    """
+    cap = hist_phi.shape[0]
+    start = head - count
+    while cursor + 1 < count and hist_phi[(start + cursor + 1) % cap] <= phi_target:
+        cursor += 1
+    i0 = (start + cursor) % cap
+    if cursor + 1 >= count:
+        return hist_u[i0], cursor
+    i1 = (start + cursor + 1) % cap
+    dphi = hist_phi[i1] - hist_phi[i0]
+    if dphi <= 0.0:
+        return hist_u[i1], cursor
+    w = (phi_target - hist_phi[i0]) / dphi
+    return hist_u[i0] + w * (hist_u[i1] - hist_u[i0]), cursor
+
+
+@njit(cache=True)
+def advance_exact(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, hist: np.ndarray,
+                  meta: np.ndarray, acc: np.ndarray, out: np.ndarray, n_steps: int,
+                  every: int) -> tuple[int, int]:
+    """Reference path: the exact time-history delay of RGD07 Appendix C.
+
+    hist: shape (2, capacity) ring buffer of (PHI, U) samples; meta (int64, 3):
+    head, count, cursor. Solves eq. (7) PHI(t) - PHI(t - t_n) = 2 pi / n by interpolation in
+    the stored history and uses delta = n (U(t) - U(t - t_n)) (eq. 8). Samples are stored
+    only when the angle advances; those older than one sector are forgotten.
+    """
+    sector = 2.0 * math.pi / prm[P_N]
+    cap = hist.shape[1]
+    head, count, cursor = meta[0], meta[1], meta[2]
+    tau_avg = prm[P_TAU_AVG]
+    row = np.empty(N_COLS)
+    n_rows = 0
+    countdown = _first_countdown(st[S_STEP], every)
+    status = STATUS_OK
+    for _ in range(n_steps):
+        surface, cursor = _delayed_depth(hist[0], hist[1], head, count, cursor,
+                                         st[S_PHI] - sector)
+        _step(st, prm, tgt, surface, row)
+        _accumulate(acc, row, tau_avg)
+        n_rows, countdown = _emit(row, out, n_rows, countdown, every)
+        if st[S_PHI] > row[C_PHI]:
+            if count == cap:
+                if cursor == 0:
+                    status = STATUS_HISTORY_FULL
+                    break
+                count -= 1
+                cursor -= 1
+            hist[0, head % cap] = st[S_PHI]
+            hist[1, head % cap] = st[S_U]
+            head = (head + 1) % cap
+            count += 1
+        # forget what is older than the sector behind (keep one sample before it)
+        while cursor > 1:
+            count -= 1
+            cursor -= 1
+    meta[0], meta[1], meta[2] = head, count, cursor
+    if status == STATUS_OK and not (math.isfinite(st[S_U]) and math.isfinite(st[S_OMEGA])):
+        status = STATUS_NONFINITE
+    return status, n_rows

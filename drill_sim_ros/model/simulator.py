@@ -1,0 +1,314 @@
+"""Stateful simulator around the compiled kernels: buffers, inputs, snapshots, samples.
+
+The :class:`Simulator` owns the state vector, the bottom-hole profile (bounded memory:
+``n_nodes`` floats) and the statistics; it validates its inputs once, at the boundary.
+All quantities are dimensionless (RGD07 eqs. 19-24); :mod:`drill_sim_ros.model.params`
+converts to SI.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from drill_sim_ros.model import kernel as k
+from drill_sim_ros.model.analysis import TrivialSolution, trivial_solution
+from drill_sim_ros.model.errors import HistoryOverflow, NumericalFault, ParameterError
+from drill_sim_ros.model.params import DimensionlessParams
+
+METHODS = ("profile", "exact")
+REBASE_DEPTH = 1.0e4     # rebase U and angles beyond this, to keep differences exact
+DEFAULT_NODES = 2048
+
+
+@dataclass(frozen=True)
+class SimConfig:
+    """Numerical settings. dtau: step; n_nodes: profile nodes per blade sector;
+    method: 'profile' (production) or 'exact' (reference time-history delay);
+    omega_rate / w_rate: ramp limits of the surface inputs per unit tau (inf = none);
+    tau_avg: statistics window start; history_capacity: samples kept by 'exact'.
+    """
+
+    dtau: float = 1e-4
+    n_nodes: int = DEFAULT_NODES
+    method: str = "profile"
+    omega_rate: float = math.inf
+    w_rate: float = math.inf
+    tau_avg: float = 0.0
+    history_capacity: int = 1 << 21
+
+    def __post_init__(self) -> None:
+        if not (math.isfinite(self.dtau) and 0.0 < self.dtau <= 0.05):
+            raise ParameterError(f"parameter 'dtau' = {self.dtau!r} must be in (0, 0.05]")
+        if not 16 <= self.n_nodes <= 1 << 22:
+            raise ParameterError(f"parameter 'n_nodes' = {self.n_nodes!r} must be in "
+                                 "[16, 4194304]")
+        if self.method not in METHODS:
+            raise ParameterError(f"parameter 'method' = {self.method!r} must be one of "
+                                 f"{METHODS}")
+        for name in ("omega_rate", "w_rate"):
+            value = getattr(self, name)
+            if math.isnan(value) or value <= 0.0:
+                raise ParameterError(f"parameter '{name}' = {value!r} must be > 0 (inf: none)")
+
+
+@dataclass
+class Snapshot:
+    """Everything needed to resume a run bit-for-bit."""
+
+    state: np.ndarray
+    targets: np.ndarray
+    profile: np.ndarray
+    acc: np.ndarray
+    history: np.ndarray | None
+    meta: np.ndarray | None
+    depth_offset: float
+    angle_offset: float
+
+
+@dataclass
+class Samples:
+    """Rows of kernel samples, shape (rows, N_COLS); columns are ``kernel.C_*``."""
+
+    data: np.ndarray
+    depth_offset: float = 0.0
+    angle_offset: float = 0.0
+    _names: tuple[str, ...] = field(default=(), repr=False)
+
+    def __len__(self) -> int:
+        return self.data.shape[0]
+
+    def column(self, index: int) -> np.ndarray:
+        """One column; depth and angles with the rebasing offsets added back."""
+        col = self.data[:, index]
+        if index == k.C_U:
+            return col + self.depth_offset
+        if index in (k.C_PHI, k.C_PHI_S):
+            return col + self.angle_offset
+        return col
+
+
+def _check_input(name: str, value: float) -> float:
+    value = float(value)
+    if not math.isfinite(value) or value < 0.0:
+        raise ParameterError(f"input '{name}' = {value!r} must be finite and >= 0")
+    return value
+
+
+class Simulator:
+    """The RGD07 bit on a torsional spring, stepped with bounded memory.
+
+    Starts on the trivial solution (eq. 34) of ``params``, with the history before tau = 0
+    being the trivial motion, and the velocity perturbations ``perturb_v`` and
+    ``perturb_omega`` added at tau = 0.
+    """
+
+    def __init__(self, params: DimensionlessParams, config: SimConfig | None = None,
+                 perturb_v: float = 0.0, perturb_omega: float = 0.0) -> None:
+        self.params = params
+        self.config = config or SimConfig()
+        for name, value in (("perturb_v", perturb_v), ("perturb_omega", perturb_omega)):
+            if not math.isfinite(value):
+                raise ParameterError(f"parameter '{name}' = {value!r} must be finite")
+        self._perturb = (float(perturb_v), float(perturb_omega))
+        self._prm = np.zeros(k.N_PARAMS)
+        self._fill_params()
+        self.reset()
+
+    # ---- set-up ---------------------------------------------------------------------
+    def _fill_params(self) -> None:
+        p, c = self.params, self.config
+        self._prm[k.P_N] = p.n
+        self._prm[k.P_BETA] = p.beta
+        self._prm[k.P_LAM] = p.lam
+        self._prm[k.P_PSI] = p.psi
+        self._prm[k.P_DT] = c.dtau
+        self._prm[k.P_NODES] = c.n_nodes
+        self._prm[k.P_OMEGA_RATE] = c.omega_rate
+        self._prm[k.P_W_RATE] = c.w_rate
+        self._prm[k.P_TAU_AVG] = c.tau_avg
+
+    @property
+    def trivial(self) -> TrivialSolution:
+        """Trivial solution (eq. 34) for the parameters the run started with."""
+        return trivial_solution(self.params)
+
+    def reset(self) -> None:
+        """Back to tau = 0 on the trivial solution, perturbations re-applied."""
+        triv = self.trivial
+        p = self.params
+        st = np.zeros(k.N_STATE)
+        st[k.S_V] = triv.v + self._perturb[0]
+        st[k.S_OMEGA] = p.omega0 + self._perturb[1]
+        st[k.S_PHI_S] = triv.torque           # pipe twist carries the trivial torque
+        st[k.S_OMEGA_S] = p.omega0
+        st[k.S_W_APP] = p.w0
+        self._state = st
+        self._targets = np.array([p.omega0, p.w0])
+        self._acc = k.new_accumulators()
+        self._depth_offset = 0.0
+        self._angle_offset = 0.0
+        self._init_profile(triv)
+        self._init_history(triv)
+        self.fault: str | None = None
+
+    def _init_profile(self, triv: TrivialSolution) -> None:
+        """Rock surface left by the trivial motion (eq. 6 with U = v0 tau, PHI = omega0 tau).
+
+        Node j (angle j*h ahead of the bit, j >= 1) was last cut one sector earlier, at
+        depth slope * (j*h - sector) with slope = v0/omega0 = delta0 / (2 pi); node 0 was
+        just cut at U = 0 and held -delta0/n before.
+        """
+        n_nodes = self.config.n_nodes
+        sector = 2.0 * math.pi / self.params.n
+        slope = triv.depth_of_cut / (2.0 * math.pi)
+        angles = np.arange(n_nodes) * (sector / n_nodes)
+        self._profile = slope * (angles - sector)
+        self._profile[0] = 0.0
+        self._state[k.S_NODE] = 0.0
+        self._state[k.S_FRAC] = 0.0
+        self._state[k.S_H_OLD] = -slope * sector
+
+    def _init_history(self, triv: TrivialSolution) -> None:
+        """Trivial (PHI, U) history over one sector and a bit more, for the exact path."""
+        if self.config.method != "exact":
+            self._hist = None
+            self._meta = None
+            return
+        cap = self.config.history_capacity
+        sector = 2.0 * math.pi / self.params.n
+        dphi = self.params.omega0 * self.config.dtau
+        count = min(cap // 2, int(math.ceil(sector / dphi)) + 2)
+        phi = -dphi * np.arange(count - 1, -1, -1)
+        self._hist = np.zeros((2, cap))
+        self._hist[0, :count] = phi
+        self._hist[1, :count] = triv.depth_of_cut / (2.0 * math.pi) * phi
+        self._meta = np.array([count % cap, count, 0], dtype=np.int64)
+
+    # ---- inputs -----------------------------------------------------------------------
+    def set_inputs(self, omega_s: float | None = None, w_app: float | None = None) -> None:
+        """Surface setpoints (dimensionless top-drive speed and applied weight).
+
+        They take effect at the next step, through the ramp limits of the config.
+        """
+        if omega_s is not None:
+            self._targets[k.I_OMEGA_S] = _check_input("omega_s", omega_s)
+        if w_app is not None:
+            self._targets[k.I_W_APP] = _check_input("w_app", w_app)
+
+    @property
+    def targets(self) -> tuple[float, float]:
+        """Commanded (omega_s, w_app)."""
+        return float(self._targets[0]), float(self._targets[1])
+
+    # ---- stepping ---------------------------------------------------------------------
+    @property
+    def tau(self) -> float:
+        return float(self._state[k.S_TAU])
+
+    @property
+    def steps(self) -> int:
+        return int(self._state[k.S_STEP])
+
+    def steps_for(self, duration: float) -> int:
+        """Whole steps covering ``duration`` (rounded to the nearest step)."""
+        if not math.isfinite(duration) or duration < 0.0:
+            raise ParameterError(f"duration {duration!r} must be finite and >= 0")
+        return int(round(duration / self.config.dtau))
+
+    def advance(self, n_steps: int, every: int = 0) -> Samples:
+        """Advance ``n_steps``; return a sample every ``every`` global steps (0: none).
+
+        Raises :class:`NumericalFault` if the state became non-finite (then call reset()).
+        """
+        if self.fault is not None:
+            raise NumericalFault(f"simulator faulted ({self.fault}); call reset()")
+        if n_steps < 0:
+            raise ParameterError(f"n_steps = {n_steps!r} must be >= 0")
+        rows = 0 if every <= 0 else n_steps // every + 1
+        out = np.empty((rows, k.N_COLS))
+        status, written = self._run(n_steps, every, out)
+        samples = Samples(out[:written], self._depth_offset, self._angle_offset)
+        self._check(status)
+        self._rebase()
+        return samples
+
+    def _run(self, n_steps: int, every: int, out: np.ndarray) -> tuple[int, int]:
+        if self.config.method == "profile":
+            return k.advance_profile(self._state, self._prm, self._targets, self._profile,
+                                     self._acc, out, n_steps, every)
+        return k.advance_exact(self._state, self._prm, self._targets, self._hist,
+                               self._meta, self._acc, out, n_steps, every)
+
+    def _check(self, status: int) -> None:
+        if status == k.STATUS_NONFINITE:
+            self.fault = f"non-finite state at tau = {self.tau:.6g}"
+            raise NumericalFault(self.fault)
+        if status == k.STATUS_HISTORY_FULL:
+            self.fault = "exact-delay history full"
+            raise HistoryOverflow(f"{self.fault}: raise SimConfig.history_capacity")
+
+    def _rebase(self) -> None:
+        """Shift depth and angles by whole amounts so differences stay exact (U grows)."""
+        st = self._state
+        if abs(st[k.S_U]) > REBASE_DEPTH:
+            shift = math.floor(st[k.S_U])
+            st[k.S_U] -= shift
+            self._profile -= shift
+            st[k.S_H_OLD] -= shift
+            if self._hist is not None:
+                self._hist[1] -= shift
+            self._depth_offset += shift
+        if abs(st[k.S_PHI]) > REBASE_DEPTH:
+            turns = 2.0 * math.pi * math.floor(st[k.S_PHI] / (2.0 * math.pi))
+            st[k.S_PHI] -= turns
+            st[k.S_PHI_S] -= turns
+            if self._hist is not None:
+                self._hist[0] -= turns
+            self._angle_offset += turns
+
+    # ---- state access -----------------------------------------------------------------
+    def snapshot(self) -> Snapshot:
+        """A deep copy of the whole state; :meth:`restore` resumes it bit-for-bit."""
+        return Snapshot(self._state.copy(), self._targets.copy(), self._profile.copy(),
+                        self._acc.copy(), None if self._hist is None else self._hist.copy(),
+                        None if self._meta is None else self._meta.copy(),
+                        self._depth_offset, self._angle_offset)
+
+    def restore(self, snap: Snapshot) -> None:
+        """Resume from a :meth:`snapshot` of a simulator with the same settings."""
+        if snap.profile.shape != self._profile.shape:
+            raise ParameterError("snapshot profile size differs from this simulator's n_nodes")
+        self._state = snap.state.copy()
+        self._targets = snap.targets.copy()
+        self._profile = snap.profile.copy()
+        self._acc = snap.acc.copy()
+        self._hist = None if snap.history is None else snap.history.copy()
+        self._meta = None if snap.meta is None else snap.meta.copy()
+        self._depth_offset = snap.depth_offset
+        self._angle_offset = snap.angle_offset
+        self.fault = None
+
+    @property
+    def state(self) -> np.ndarray:
+        """Read-only view of the state vector (indices ``kernel.S_*``)."""
+        view = self._state.view()
+        view.flags.writeable = False
+        return view
+
+    @property
+    def profile(self) -> np.ndarray:
+        """Rock height per node of one blade sector (copy, depth offset added)."""
+        return self._profile + self._depth_offset
+
+    @property
+    def accumulators(self) -> np.ndarray:
+        """Raw statistics (indices ``kernel.A_*``); see :func:`analysis.run_statistics`."""
+        return self._acc.copy()
+
+    def reset_statistics(self, tau_avg: float | None = None) -> None:
+        """Start a new statistics window at ``tau_avg`` (default: now)."""
+        self._prm[k.P_TAU_AVG] = self.tau if tau_avg is None else tau_avg
+        self._acc = k.new_accumulators()
