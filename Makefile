@@ -1,0 +1,58 @@
+# drill_sim_ros - set-up, run and test. `make run` and `make test` create .venv on first use.
+SHELL := /bin/bash
+.SHELLFLAGS := -o pipefail -ec
+VENV ?= .venv
+PY := $(VENV)/bin/python
+BIN := $(VENV)/bin
+SYSTEM_PYTHON ?= python3
+
+# Every ROS process we start stays on loopback, in its own DDS domain.
+export ROS_AUTOMATIC_DISCOVERY_RANGE := LOCALHOST
+ROS_DOMAIN_ID ?= $(shell $(SYSTEM_PYTHON) -c 'import random; print(random.randint(1, 101))')
+export ROS_DOMAIN_ID
+# The wheels need this for ament_index lookups (std_msgs share files, type hashes).
+export AMENT_PREFIX_PATH := $(if $(AMENT_PREFIX_PATH),$(AMENT_PREFIX_PATH):$(abspath $(VENV)),$(abspath $(VENV)))
+export NUMBA_CACHE_DIR ?= $(abspath .cache/numba)
+export PYTHONUNBUFFERED := 1
+# rerun: never send usage analytics from anything we start.
+export RERUN_ANALYTICS := 0
+
+RUN_DIR ?= runs/$(shell date -u +%Y%m%dT%H%M%SZ)
+RUN_SECONDS ?= 0
+
+.PHONY: venv run test lint bench clean colcon
+
+venv: $(VENV)/.stamp
+
+# Use a sourced ROS 2 Jazzy when there is one; otherwise rclpy comes from PyPI wheels.
+$(VENV)/.stamp: requirements.txt requirements-ros.txt setup.py
+	@if [ "$${ROS_DISTRO:-}" = "jazzy" ] && $(SYSTEM_PYTHON) -c 'import rclpy' 2>/dev/null; then \
+	  echo "[venv] using the sourced ROS 2 Jazzy"; \
+	  $(SYSTEM_PYTHON) -m venv --system-site-packages $(VENV); ros_req=""; \
+	else \
+	  echo "[venv] no ROS 2 Jazzy sourced: installing rclpy from PyPI wheels"; \
+	  $(SYSTEM_PYTHON) -m venv $(VENV); ros_req="-r requirements-ros.txt"; \
+	fi; \
+	$(PY) -m pip install -q --upgrade pip 2>&1 | grep -v 'is ignored' || true; \
+	$(PY) -m pip install -q $$ros_req -r requirements.txt 2>&1 | grep -v 'is ignored' || true; \
+	$(PY) -m pip install -q --no-build-isolation --no-deps -e . 2>&1 | grep -v 'is ignored' || true; \
+	$(PY) -c 'import rclpy, numba, mcap, rerun, drill_sim_ros' ; \
+	$(PY) -m drill_sim_ros.viz.analytics_off; \
+	touch $@
+
+run: venv
+	@mkdir -p $(RUN_DIR)
+	$(BIN)/sim_node --ros-args --params-file config/sim.yaml -p record.path:=$(RUN_DIR)/run.mcap -p run_seconds:=$(RUN_SECONDS)
+
+test: venv
+	$(BIN)/ruff check drill_sim_ros tests benchmarks
+	$(BIN)/pytest
+
+lint: venv
+	$(BIN)/ruff check drill_sim_ros tests benchmarks
+
+bench: venv
+	$(PY) benchmarks/bench_kernel.py
+
+clean:
+	rm -rf build install log .pytest_cache .ruff_cache .cache

@@ -1,0 +1,116 @@
+"""Named parameter sets (config/presets/*.yaml): the paper's cases and a field case.
+
+A preset file holds ``description``, either ``dimensionless`` (RGD07 groups; the run is
+then in units of t* and L*) or ``physical`` (SI; see :class:`PhysicalParams`), and optional
+``numerics`` (``dtau``, ``n_nodes``).
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from drill_sim_ros.model.errors import ParameterError
+from drill_sim_ros.model.params import (
+    UNIT_SCALES,
+    DimensionlessParams,
+    PhysicalParams,
+    Scales,
+    dimensionless_from_dict,
+    physical_from_dict,
+    scale,
+)
+
+DEFAULT_PRESET = "field_8p5in_shale"
+PACKAGE = "drill_sim_ros"
+
+
+@dataclass(frozen=True)
+class Preset:
+    """A resolved preset: the groups, the scales to SI, and the numerical step."""
+
+    name: str
+    description: str
+    params: DimensionlessParams
+    scales: Scales
+    physical: PhysicalParams | None
+    dtau: float
+    n_nodes: int | None
+
+    @property
+    def is_physical(self) -> bool:
+        return self.physical is not None
+
+
+def config_dirs() -> list[Path]:
+    """Where config/ may live: $DRILL_SIM_CONFIG_DIR, the source tree, install prefixes."""
+    dirs: list[Path] = []
+    if os.environ.get("DRILL_SIM_CONFIG_DIR"):
+        dirs.append(Path(os.environ["DRILL_SIM_CONFIG_DIR"]))
+    dirs.append(Path(__file__).resolve().parents[2] / "config")
+    prefixes = [p for p in os.environ.get("AMENT_PREFIX_PATH", "").split(os.pathsep) if p]
+    prefixes.append(sys.prefix)
+    dirs.extend(Path(p) / "share" / PACKAGE / "config" for p in prefixes)
+    return dirs
+
+
+def preset_path(name_or_path: str) -> Path:
+    """Resolve a preset name (``fig5_8a``) or a YAML path to an existing file."""
+    candidate = Path(name_or_path)
+    if candidate.suffix in (".yaml", ".yml") and candidate.exists():
+        return candidate
+    for base in config_dirs():
+        path = base / "presets" / f"{name_or_path}.yaml"
+        if path.exists():
+            return path
+    raise ParameterError(f"preset '{name_or_path}' not found; known presets: "
+                         f"{', '.join(available_presets()) or 'none'}")
+
+
+def available_presets() -> list[str]:
+    """Names of the presets found in the first config directory that has any."""
+    for base in config_dirs():
+        found = sorted(p.stem for p in (base / "presets").glob("*.yaml"))
+        if found:
+            return found
+    return []
+
+
+def preset_from_dict(name: str, data: dict[str, Any]) -> Preset:
+    """Build a :class:`Preset` from a parsed preset mapping."""
+    if not isinstance(data, dict):
+        raise ParameterError(f"preset '{name}' must be a mapping")
+    numerics = data.get("numerics") or {}
+    has_phys, has_dimless = "physical" in data, "dimensionless" in data
+    if has_phys == has_dimless:
+        raise ParameterError(f"preset '{name}' needs exactly one of 'physical' or "
+                             "'dimensionless'")
+    physical = None
+    if has_phys:
+        physical = physical_from_dict(data["physical"])
+        params, scales = scale(physical)
+    else:
+        params, scales = dimensionless_from_dict(data["dimensionless"]), UNIT_SCALES
+    n_nodes = numerics.get("n_nodes")
+    return Preset(name=name, description=str(data.get("description", "")).strip(),
+                  params=params, scales=scales, physical=physical,
+                  dtau=float(numerics.get("dtau", 1e-4)),
+                  n_nodes=None if n_nodes is None else int(n_nodes))
+
+
+def load_preset(name_or_path: str = DEFAULT_PRESET) -> Preset:
+    """Load a preset by name or path; errors name the file and the bad key."""
+    path = preset_path(name_or_path)
+    try:
+        data = yaml.safe_load(path.read_text())
+    except yaml.YAMLError as exc:
+        raise ParameterError(f"preset file {path} is not valid YAML: {exc}") from exc
+    try:
+        return preset_from_dict(path.stem, data)
+    except ParameterError as exc:
+        raise ParameterError(f"{path}: {exc}") from exc
