@@ -33,9 +33,11 @@ $(VENV)/.stamp: requirements.txt requirements-ros.txt setup.py
 	  echo "[venv] no ROS 2 Jazzy sourced: installing rclpy from PyPI wheels"; \
 	  $(SYSTEM_PYTHON) -m venv $(VENV); ros_req="-r requirements-ros.txt"; \
 	fi; \
-	$(PY) -m pip install -q --upgrade pip 2>&1 | grep -v 'is ignored' || true; \
-	$(PY) -m pip install -q $$ros_req -r requirements.txt 2>&1 | grep -v 'is ignored' || true; \
-	$(PY) -m pip install -q --no-build-isolation --no-deps -e . 2>&1 | grep -v 'is ignored' || true; \
+	pipi() { $(PY) -m pip install --disable-pip-version-check "$$@" > $(VENV)/pip.log 2>&1 \
+	  || { grep -v 'is ignored' $(VENV)/pip.log; echo "[venv] pip install failed"; exit 1; }; }; \
+	echo "[venv] installing dependencies (first run: a few minutes, ~1 GB)"; \
+	pipi $$ros_req -r requirements.txt; \
+	pipi --no-build-isolation --no-deps -e .; \
 	$(PY) -c 'import rclpy, numba, mcap, rerun, drill_sim_ros' ; \
 	$(PY) -m drill_sim_ros.viz.analytics_off; \
 	touch $@
