@@ -155,162 +155,40 @@ def _wearflat_contact(v: float, w_app: float, doc: float, lam: float,
 
 
 @njit(cache=True, inline="always")
-def _step(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, surface: float,
-          row: np.ndarray) -> None:
-    """One symplectic-Euler step of eqs. (25)-(33) given the rock height under the bit.
+def _bit_response(v: float, omega: float, t_pipe: float, w_app: float, doc: float,
+                  stuck: bool, beta: float, lam: float, kick: float,
+                  dt: float) -> tuple[float, float, float, float, float, int, bool]:
+    """Bit-rock forces and the new velocities (eqs. 25, 29-33).
 
-    Fills ``row`` with the sample at the start of the step (state and bit forces at tau)
-    and leaves the new state in ``st`` (angle bookkeeping is the caller's).
+    Returns ``(v_new, omega_new, w_f, wob, tob, mode, stuck_new)``.
     """
-    n, beta, lam, psi, dt = prm[P_N], prm[P_BETA], prm[P_LAM], prm[P_PSI], prm[P_DT]
-    u, v, phi, omega = st[S_U], st[S_V], st[S_PHI], st[S_OMEGA]
-    t_pipe = st[S_PHI_S] - phi
-    w_app = st[S_W_APP]
-    doc = n * (u - surface)                  # eqs. (8), (26)-(27): delta = n (U - U(tau - tau_n))
-    stuck = st[S_STUCK] != 0.0
     if stuck and doc >= 0.0 and t_pipe <= doc + beta * lam:
-        # Stick phase: the bit is immobile, the rock reacts the pipe torque and the weight
-        # (eq. 14 generalised to a varying top-drive speed; full wearflat contact).
-        w_f, wob, tob, mode = lam, w_app, t_pipe, MODE_STUCK
-        v_new, omega_new = 0.0, 0.0
+        # Stick (eq. 32): the bit is immobile and the rock reacts the pipe torque and the
+        # applied weight, until the pipe torque exceeds the cutting + friction torque
+        # delta_k + beta lam (eqs. 14, 33 in the form valid for any top-drive speed).
+        return 0.0, 0.0, lam, w_app, t_pipe, MODE_STUCK, True
+    if doc >= 0.0:
+        v_new, w_f = _wearflat_contact(v, w_app, doc, lam, kick)
+        wob = doc + w_f                       # eq. (29): W = delta + W_f
+        tob = doc + beta * w_f                # eq. (30): T = delta + beta W_f
+        mode = MODE_CUTTING if w_f >= lam else MODE_LOST_CONTACT
     else:
-        stuck = False
-        if doc >= 0.0:
-            v_new, w_f = _wearflat_contact(v, w_app, doc, lam, psi * dt)
-            wob = doc + w_f                   # eq. (29): W = delta + W_f
-            tob = doc + beta * w_f            # eq. (30): T = delta + beta W_f
-            mode = MODE_CUTTING if w_f >= lam else MODE_LOST_CONTACT
-        else:
-            w_f, wob, tob, mode = 0.0, 0.0, 0.0, MODE_OFF_BOTTOM
-            v_new = v + psi * dt * w_app      # free fall: no force from the rock
-        omega_new = omega + (t_pipe - tob) * dt   # eq. (25) right
-        if omega_new <= 0.0:
-            omega_new = 0.0                   # no backward rotation
-            if doc >= 0.0:                    # eq. (32): the bit sticks on the rock
-                stuck = True
-                v_new = 0.0
-    row[C_TAU] = st[S_TAU]
-    row[C_U] = u
-    row[C_V] = v
-    row[C_PHI] = phi
-    row[C_OMEGA] = omega
-    row[C_PHI_S] = st[S_PHI_S]
-    row[C_OMEGA_S] = st[S_OMEGA_S]
-    row[C_W_APP] = w_app
-    row[C_WOB] = wob
-    row[C_TOB] = tob
-    row[C_DOC] = doc
-    row[C_WF] = w_f
-    row[C_T_PIPE] = t_pipe
-    row[C_MODE] = mode
-    st[S_V] = v_new
-    st[S_U] = u + v_new * dt
-    st[S_OMEGA] = omega_new
-    st[S_PHI] = phi + omega_new * dt
-    st[S_PHI_S] += st[S_OMEGA_S] * dt
-    st[S_OMEGA_S] = _ramp(st[S_OMEGA_S], tgt[I_OMEGA_S], prm[P_OMEGA_RATE], dt)
-    st[S_W_APP] = _ramp(w_app, tgt[I_W_APP], prm[P_W_RATE], dt)
-    st[S_STUCK] = 1.0 if stuck else 0.0
-    st[S_TAU] += dt
-    st[S_STEP] += 1.0
-
-
-@njit(cache=True, inline="always")
-def _accumulate(acc: np.ndarray, row: np.ndarray, tau_avg: float) -> None:
-    """Add one step's sample to the running statistics."""
-    mode = row[C_MODE]
-    if mode == MODE_STUCK and math.isnan(acc[A_FIRST_STICK]):
-        acc[A_FIRST_STICK] = row[C_TAU]
-    if mode == MODE_OFF_BOTTOM and math.isnan(acc[A_FIRST_BOUNCE]):
-        acc[A_FIRST_BOUNCE] = row[C_TAU]
-    if row[C_TAU] < tau_avg:
-        return
-    omega = row[C_OMEGA]
-    acc[A_COUNT] += 1.0
-    acc[A_WF] += row[C_WF]
-    acc[A_TOB] += row[C_TOB]
-    acc[A_DOC] += row[C_DOC]
-    acc[A_WOB] += row[C_WOB]
-    acc[A_OMEGA] += omega
-    acc[A_T_PIPE] += row[C_T_PIPE]
-    acc[A_V] += row[C_V]
-    acc[A_DOC_OMEGA] += row[C_DOC] * omega
-    acc[A_OMEGA_MIN] = min(acc[A_OMEGA_MIN], omega)
-    acc[A_OMEGA_MAX] = max(acc[A_OMEGA_MAX], omega)
-    if mode == MODE_STUCK:
-        acc[A_STUCK] += 1.0
+        v_new = v + kick * w_app              # off bottom: T = W = 0, the bit falls
+        w_f, wob, tob, mode = 0.0, 0.0, 0.0, MODE_OFF_BOTTOM
+    omega_new = omega + (t_pipe - tob) * dt   # eq. (25) right, in absolute angles
+    if omega_new > 0.0:
+        return v_new, omega_new, w_f, wob, tob, mode, False
+    if doc >= 0.0:                            # eq. (32): the bit sticks on the rock
+        return 0.0, 0.0, w_f, wob, tob, mode, True
+    return v_new, 0.0, w_f, wob, tob, mode, False   # never backward rotation
 
 
 @njit(cache=True)
-def _first_countdown(step: float, every: int) -> int:
+def _first_countdown(step: int, every: int) -> int:
     """Steps until the next global step that is a multiple of ``every`` (-1: never)."""
     if every <= 0:
         return -1
-    return (every - int(step) % every) % every
-
-
-@njit(cache=True, inline="always")
-def _emit(row: np.ndarray, out: np.ndarray, n_rows: int, countdown: int,
-          every: int) -> tuple[int, int]:
-    """Copy ``row`` into ``out`` when ``countdown`` hits zero; returns (rows, countdown)."""
-    if countdown == 0:
-        if n_rows < out.shape[0]:
-            out[n_rows, :] = row
-            n_rows += 1
-        return n_rows, every - 1
-    return n_rows, countdown - 1
-
-
-@njit(cache=True)
-def advance_profile(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarray,
-                    acc: np.ndarray, out: np.ndarray, n_steps: int,
-                    every: int) -> tuple[int, int]:
-    """Advance ``n_steps`` with the bottom-hole-profile delay (the production path).
-
-    profile: shape (n_nodes,), rock height per node of one blade sector (2 pi / n). The
-    bit reads the height left by the previous blade (eq. 6: U(t - t_n) where eq. 7 holds)
-    by linear interpolation in angle, and re-cuts every node it passes to
-    ``max(old, U_crossing)``.
-    out: shape (rows, N_COLS); a row is written when the global step % every == 0.
-    Returns ``(status, rows_written)``.
-    """
-    n_nodes = profile.shape[0]
-    spacing = 2.0 * math.pi / prm[P_N] / n_nodes
-    inv_spacing = 1.0 / spacing
-    tau_avg = prm[P_TAU_AVG]
-    row = np.empty(N_COLS)
-    node = int(st[S_NODE])
-    frac = st[S_FRAC]
-    h_old = st[S_H_OLD]
-    n_rows = 0
-    countdown = _first_countdown(st[S_STEP], every)
-    for _ in range(n_steps):
-        nxt = node + 1 if node + 1 < n_nodes else 0
-        surface = h_old + frac * (profile[nxt] - h_old)
-        u0 = st[S_U]
-        _step(st, prm, tgt, surface, row)
-        _accumulate(acc, row, tau_avg)
-        n_rows, countdown = _emit(row, out, n_rows, countdown, every)
-        # angle bookkeeping: nodes crossed during the step are re-cut (max rule)
-        dfrac = (st[S_PHI] - row[C_PHI]) * inv_spacing
-        f_start = frac
-        frac += dfrac
-        while frac >= 1.0:
-            frac -= 1.0
-            node = nxt
-            nxt = node + 1 if node + 1 < n_nodes else 0
-            u_cross = u0 + (st[S_U] - u0) * (1.0 - f_start) / dfrac
-            f_start -= 1.0
-            h_old = profile[node]
-            if u_cross > h_old:
-                profile[node] = u_cross
-    st[S_NODE] = node
-    st[S_FRAC] = frac
-    st[S_H_OLD] = h_old
-    if not (math.isfinite(st[S_U]) and math.isfinite(st[S_V]) and math.isfinite(st[S_OMEGA])
-            and math.isfinite(st[S_PHI])):
-        return STATUS_NONFINITE, n_rows
-    return STATUS_OK, n_rows
+    return (every - step % every) % every
 
 
 @njit(cache=True)
@@ -319,7 +197,7 @@ def _delayed_depth(hist_phi: np.ndarray, hist_u: np.ndarray, head: int, count: i
     """U at the latest time the bit angle was ``phi_target`` (eq. 7), by interpolation.
 
     History is a ring buffer (capacity = len(hist_phi)) of ``count`` samples ending at
-    ``head - 1``, with PHI non-decreasing. ``cursor`` (an age-ordered index) only moves
+    ``head - 1``, with PHI increasing. ``cursor`` (an age-ordered index) only moves
     forward because ``phi_target`` does. Returns ``(U, cursor)``.
     """
     cap = hist_phi.shape[0]
@@ -330,54 +208,167 @@ def _delayed_depth(hist_phi: np.ndarray, hist_u: np.ndarray, head: int, count: i
     if cursor + 1 >= count:
         return hist_u[i0], cursor
     i1 = (start + cursor + 1) % cap
-    dphi = hist_phi[i1] - hist_phi[i0]
-    if dphi <= 0.0:
-        return hist_u[i1], cursor
-    w = (phi_target - hist_phi[i0]) / dphi
+    w = (phi_target - hist_phi[i0]) / (hist_phi[i1] - hist_phi[i0])
     return hist_u[i0] + w * (hist_u[i1] - hist_u[i0]), cursor
 
 
 @njit(cache=True)
+def _advance(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarray,
+             hist: np.ndarray, meta: np.ndarray, acc: np.ndarray, out: np.ndarray,
+             n_steps: int, every: int, exact: bool) -> tuple[int, int]:
+    """The stepping loop; state, statistics and bookkeeping live in locals.
+
+    Delay (eqs. 6-8, 26-28): ``exact`` solves eq. (7) in the stored (PHI, U) history
+    (RGD07 App. C); otherwise the rock height under the bit is read from ``profile``.
+    """
+    n, beta, lam, dt = prm[P_N], prm[P_BETA], prm[P_LAM], prm[P_DT]
+    kick = prm[P_PSI] * dt
+    omega_rate, w_rate, tau_avg = prm[P_OMEGA_RATE], prm[P_W_RATE], prm[P_TAU_AVG]
+    tgt_omega, tgt_w = tgt[I_OMEGA_S], tgt[I_W_APP]
+    u, v, phi, omega = st[S_U], st[S_V], st[S_PHI], st[S_OMEGA]
+    phi_s, omega_s, w_app = st[S_PHI_S], st[S_OMEGA_S], st[S_W_APP]
+    stuck = st[S_STUCK] != 0.0
+    step = int(st[S_STEP])
+    sector = 2.0 * math.pi / n
+    n_nodes = profile.shape[0]
+    inv_spacing = n_nodes / sector
+    node, frac, h_old = int(st[S_NODE]), st[S_FRAC], st[S_H_OLD]
+    cap = hist.shape[1]
+    head, count, cursor = meta[0], meta[1], meta[2]
+    a_count, a_wf, a_tob, a_doc = acc[A_COUNT], acc[A_WF], acc[A_TOB], acc[A_DOC]
+    a_wob, a_omega, a_tp, a_v = acc[A_WOB], acc[A_OMEGA], acc[A_T_PIPE], acc[A_V]
+    a_dom, a_stuck = acc[A_DOC_OMEGA], acc[A_STUCK]
+    om_min, om_max = acc[A_OMEGA_MIN], acc[A_OMEGA_MAX]
+    first_stick, first_bounce = acc[A_FIRST_STICK], acc[A_FIRST_BOUNCE]
+    countdown = _first_countdown(step, every)
+    n_rows = 0
+    status = STATUS_OK
+    for _ in range(n_steps):
+        tau = step * dt
+        # ---- depth of cut: delta = n (U(tau) - U(tau - tau_n)), eqs. (8), (26)-(28)
+        if exact:
+            surface, cursor = _delayed_depth(hist[0], hist[1], head, count, cursor,
+                                             phi - sector)
+        else:
+            nxt = node + 1 if node + 1 < n_nodes else 0
+            surface = h_old + frac * (profile[nxt] - h_old)
+        doc = n * (u - surface)
+        t_pipe = phi_s - phi                  # pipe torque C (PHI_S - PHI), scaled
+        v_new, omega_new, w_f, wob, tob, mode, stuck = _bit_response(
+            v, omega, t_pipe, w_app, doc, stuck, beta, lam, kick, dt)
+        # ---- statistics
+        if mode == MODE_STUCK and first_stick != first_stick:
+            first_stick = tau
+        if mode == MODE_OFF_BOTTOM and first_bounce != first_bounce:
+            first_bounce = tau
+        if tau >= tau_avg:
+            a_count += 1.0
+            a_wf += w_f
+            a_tob += tob
+            a_doc += doc
+            a_wob += wob
+            a_omega += omega
+            a_tp += t_pipe
+            a_v += v
+            a_dom += doc * omega
+            om_min = min(om_min, omega)
+            om_max = max(om_max, omega)
+            if mode == MODE_STUCK:
+                a_stuck += 1.0
+        # ---- sample at the start of the step
+        if countdown == 0:
+            if n_rows < out.shape[0]:
+                r = out[n_rows]
+                r[C_TAU], r[C_U], r[C_V], r[C_PHI], r[C_OMEGA] = tau, u, v, phi, omega
+                r[C_PHI_S], r[C_OMEGA_S], r[C_W_APP] = phi_s, omega_s, w_app
+                r[C_WOB], r[C_TOB], r[C_DOC], r[C_WF] = wob, tob, doc, w_f
+                r[C_T_PIPE], r[C_MODE] = t_pipe, mode
+                n_rows += 1
+            countdown = every - 1
+        else:
+            countdown -= 1
+        # ---- symplectic Euler (eq. C.1 with the updated velocities)
+        u_new = u + v_new * dt
+        phi_new = phi + omega_new * dt
+        if exact:
+            if phi_new > phi:                 # store (PHI, U) only when the bit turns
+                if count == cap:
+                    if cursor == 0:
+                        status = STATUS_HISTORY_FULL
+                        break
+                    count -= 1
+                    cursor -= 1
+                hist[0, head] = phi_new
+                hist[1, head] = u_new
+                head = head + 1 if head + 1 < cap else 0
+                count += 1
+            while cursor > 1:                 # forget what is older than one sector
+                count -= 1
+                cursor -= 1
+        else:
+            # nodes passed during the step are re-cut to the bit depth (max rule)
+            dfrac = (phi_new - phi) * inv_spacing
+            f_start = frac
+            frac += dfrac
+            while frac >= 1.0:
+                frac -= 1.0
+                node = node + 1 if node + 1 < n_nodes else 0
+                u_cross = u + (u_new - u) * (1.0 - f_start) / dfrac
+                f_start -= 1.0
+                h_old = profile[node]
+                if u_cross > h_old:
+                    profile[node] = u_cross
+        u, v, phi, omega = u_new, v_new, phi_new, omega_new
+        phi_s += omega_s * dt
+        omega_s = _ramp(omega_s, tgt_omega, omega_rate, dt)
+        w_app = _ramp(w_app, tgt_w, w_rate, dt)
+        step += 1
+    st[S_U], st[S_V], st[S_PHI], st[S_OMEGA] = u, v, phi, omega
+    st[S_PHI_S], st[S_OMEGA_S], st[S_W_APP] = phi_s, omega_s, w_app
+    st[S_STUCK] = 1.0 if stuck else 0.0
+    st[S_STEP] = step
+    st[S_TAU] = step * dt
+    st[S_NODE], st[S_FRAC], st[S_H_OLD] = node, frac, h_old
+    meta[0], meta[1], meta[2] = head, count, cursor
+    acc[A_COUNT], acc[A_WF], acc[A_TOB], acc[A_DOC] = a_count, a_wf, a_tob, a_doc
+    acc[A_WOB], acc[A_OMEGA], acc[A_T_PIPE], acc[A_V] = a_wob, a_omega, a_tp, a_v
+    acc[A_DOC_OMEGA], acc[A_STUCK] = a_dom, a_stuck
+    acc[A_OMEGA_MIN], acc[A_OMEGA_MAX] = om_min, om_max
+    acc[A_FIRST_STICK], acc[A_FIRST_BOUNCE] = first_stick, first_bounce
+    if status == STATUS_OK and not (math.isfinite(u) and math.isfinite(v)
+                                    and math.isfinite(phi) and math.isfinite(omega)):
+        status = STATUS_NONFINITE
+    return status, n_rows
+
+
+_NO_HISTORY = np.zeros((2, 1))
+
+
+def advance_profile(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarray,
+                    acc: np.ndarray, out: np.ndarray, n_steps: int,
+                    every: int) -> tuple[int, int]:
+    """Advance ``n_steps`` with the bottom-hole-profile delay (the production path).
+
+    profile: shape (n_nodes,), rock height per node of one blade sector (2 pi / n). The
+    bit reads the height left by the previous blade (eq. 6: U(t - t_n) where eq. 7 holds)
+    by linear interpolation in angle, and re-cuts every node it passes to
+    ``max(old, U_crossing)``. out: shape (rows, N_COLS); a row is written when the global
+    step % every == 0. Returns ``(status, rows_written)``.
+    """
+    meta = np.zeros(3, dtype=np.int64)
+    return _advance(st, prm, tgt, profile, _NO_HISTORY, meta, acc, out, n_steps, every,
+                    False)
+
+
 def advance_exact(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, hist: np.ndarray,
                   meta: np.ndarray, acc: np.ndarray, out: np.ndarray, n_steps: int,
                   every: int) -> tuple[int, int]:
     """Reference path: the exact time-history delay of RGD07 Appendix C.
 
-    hist: shape (2, capacity) ring buffer of (PHI, U) samples; meta (int64, 3):
-    head, count, cursor. Solves eq. (7) PHI(t) - PHI(t - t_n) = 2 pi / n by interpolation in
-    the stored history and uses delta = n (U(t) - U(t - t_n)) (eq. 8). Samples are stored
-    only when the angle advances; those older than one sector are forgotten.
+    hist: shape (2, capacity) ring buffer of (PHI, U) samples; meta (int64, 3): head,
+    count, cursor. Solves eq. (7) PHI(t) - PHI(t - t_n) = 2 pi / n by interpolation in the
+    stored history and uses delta = n (U(t) - U(t - t_n)) (eq. 8). Samples are stored only
+    when the angle advances; those older than one sector are forgotten.
     """
-    sector = 2.0 * math.pi / prm[P_N]
-    cap = hist.shape[1]
-    head, count, cursor = meta[0], meta[1], meta[2]
-    tau_avg = prm[P_TAU_AVG]
-    row = np.empty(N_COLS)
-    n_rows = 0
-    countdown = _first_countdown(st[S_STEP], every)
-    status = STATUS_OK
-    for _ in range(n_steps):
-        surface, cursor = _delayed_depth(hist[0], hist[1], head, count, cursor,
-                                         st[S_PHI] - sector)
-        _step(st, prm, tgt, surface, row)
-        _accumulate(acc, row, tau_avg)
-        n_rows, countdown = _emit(row, out, n_rows, countdown, every)
-        if st[S_PHI] > row[C_PHI]:
-            if count == cap:
-                if cursor == 0:
-                    status = STATUS_HISTORY_FULL
-                    break
-                count -= 1
-                cursor -= 1
-            hist[0, head % cap] = st[S_PHI]
-            hist[1, head % cap] = st[S_U]
-            head = (head + 1) % cap
-            count += 1
-        # forget what is older than the sector behind (keep one sample before it)
-        while cursor > 1:
-            count -= 1
-            cursor -= 1
-    meta[0], meta[1], meta[2] = head, count, cursor
-    if status == STATUS_OK and not (math.isfinite(st[S_U]) and math.isfinite(st[S_OMEGA])):
-        status = STATUS_NONFINITE
-    return status, n_rows
+    profile = np.zeros(1)
+    return _advance(st, prm, tgt, profile, hist, meta, acc, out, n_steps, every, True)

@@ -89,8 +89,8 @@ class PhysicalParams:
     intrinsic_specific_energy_pa: float = 230e6
     zeta: float = 0.729
     mu_gamma: float = 0.48
-    contact_stress_times_wearflat_n_per_m: float = 1.5e5
-    applied_wob_n: float = 40e3
+    contact_stress_times_wearflat_n_per_m: float = 3.0e5
+    applied_wob_n: float = 60e3
     surface_rpm: float = 60.0
 
     def __post_init__(self) -> None:

@@ -1,0 +1,360 @@
+"""Offline command line: ``drill_sim run | sweep | presets | info``.
+
+``drill_sim run`` integrates the RGD07 model without ROS and prints a summary (or one JSON
+object with ``--json``). The run is dimensionless unless ``--params`` names a physical
+preset, in which case SI figures are added.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+import math
+import sys
+import time
+from collections.abc import Iterator, Sequence
+from dataclasses import dataclass, fields
+from pathlib import Path
+from typing import Any, TextIO
+
+from drill_sim_ros.model import analysis
+from drill_sim_ros.model import kernel as k
+from drill_sim_ros.model.errors import DrillSimError
+from drill_sim_ros.model.params import UNIT_SCALES, DimensionlessParams, Scales
+from drill_sim_ros.model.presets import Preset, available_presets, load_preset
+from drill_sim_ros.model.simulator import SimConfig, Simulator
+
+GROUPS = ("n", "psi", "beta", "lam", "w0", "omega0")
+TRACE_COLUMNS = ("tau", "omega", "v", "wob", "tob", "depth_of_cut", "surface_torque", "mode")
+TRACE_SI_COLUMNS = ("time_s", "bit_rpm", "rop_m_s", "wob_n", "tob_nm", "depth_of_cut_m",
+                    "surface_torque_nm")
+CHUNK_STEPS = 500_000
+
+
+@dataclass(frozen=True)
+class RunSpec:
+    """Everything a run needs, validated."""
+
+    params: DimensionlessParams
+    scales: Scales
+    physical: bool
+    tau_end: float
+    dtau: float
+    average_from: float
+    perturb_v: float
+    perturb_omega: float
+    method: str
+    n_nodes: int
+
+
+# ---- argument parsing ---------------------------------------------------------------------
+def _add_model_args(p: argparse.ArgumentParser) -> None:
+    g = p.add_argument_group("model (dimensionless groups, RGD07 eqs. 23-24)")
+    g.add_argument("--params", help="preset name or YAML file (config/presets/*.yaml); "
+                   "a physical preset makes the run report SI units too")
+    g.add_argument("--n", type=int, help="number of blades (default 6)")
+    g.add_argument("--psi", type=float, help="system number psi (default 50)")
+    g.add_argument("--beta", type=float, help="bit-rock number beta (default 0.3)")
+    g.add_argument("--lam", type=float, help="bluntness lambda (default 5)")
+    g.add_argument("--w0", type=float, help="applied weight W0 (default 7)")
+    g.add_argument("--omega0", type=float, help="top-drive speed omega0 (default 5)")
+    r = p.add_argument_group("run")
+    r.add_argument("--tau-end", type=float, default=None,
+                   help="end of the run, dimensionless time (default 600)")
+    r.add_argument("--t-end", type=float, default=None, help="end of the run in seconds "
+                   "(physical presets only)")
+    r.add_argument("--dtau", type=float, default=None, help="time step (default: the preset's, "
+                   "else 1e-4)")
+    r.add_argument("--average-from", type=float, default=None,
+                   help="averages over [average-from, tau-end] (default tau-end / 2)")
+    r.add_argument("--perturb-v", type=float, default=0.01,
+                   help="added to the trivial axial velocity at tau = 0 (default 0.01)")
+    r.add_argument("--perturb-omega", type=float, default=0.0,
+                   help="added to the trivial angular velocity at tau = 0 (default 0)")
+    r.add_argument("--method", choices=("profile", "exact"), default="profile",
+                   help="delay evaluation: bottom-hole profile (default) or exact history")
+    r.add_argument("--nodes", type=int, default=None, help="profile nodes per blade sector")
+    r.add_argument("--progress", action="store_true", help="progress bar even when stderr "
+                   "is not a terminal")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="drill_sim", description=__doc__.splitlines()[0])
+    sub = parser.add_subparsers(dest="command", required=True)
+    run = sub.add_parser("run", help="one run; summary or --json")
+    _add_model_args(run)
+    run.add_argument("--json", action="store_true", help="print one JSON object")
+    run.add_argument("--trace", type=Path, help="write samples to this CSV file")
+    run.add_argument("--trace-every", type=int, default=100, help="a trace row every K steps")
+    sweep = sub.add_parser("sweep", help="repeat a run over values of one group; JSON lines")
+    _add_model_args(sweep)
+    sweep.add_argument("--vary", required=True, choices=GROUPS, help="group to vary")
+    sweep.add_argument("--values", required=True,
+                       help="comma-separated values, or start:stop:count")
+    sub.add_parser("presets", help="list the presets")
+    info = sub.add_parser("info", help="groups, scales and stability of a preset")
+    info.add_argument("preset", nargs="?", default="field_8p5in_shale")
+    return parser
+
+
+def _resolve(args: argparse.Namespace) -> RunSpec:
+    """Turn parsed arguments into a validated :class:`RunSpec`."""
+    preset: Preset | None = load_preset(args.params) if args.params else None
+    base = preset.params if preset else DimensionlessParams()
+    overrides = {g: getattr(args, g) for g in GROUPS if getattr(args, g) is not None}
+    params = base.with_(**overrides) if overrides else base
+    scales = preset.scales if preset else UNIT_SCALES
+    physical = bool(preset and preset.is_physical)
+    tau_end = _tau_end(args, scales, physical)
+    dtau = args.dtau if args.dtau is not None else (preset.dtau if preset else 1e-4)
+    nodes = args.nodes or (preset.n_nodes if preset and preset.n_nodes else None)
+    average_from = tau_end / 2.0 if args.average_from is None else args.average_from
+    if not 0.0 <= average_from <= tau_end:
+        raise DrillSimError(f"--average-from = {average_from!r} must lie in [0, tau-end = "
+                            f"{tau_end!r}]")
+    config = SimConfig(dtau=dtau, method=args.method, **({"n_nodes": nodes} if nodes else {}))
+    return RunSpec(params, scales, physical, tau_end, config.dtau, average_from,
+                   args.perturb_v, args.perturb_omega, args.method, config.n_nodes)
+
+
+def _tau_end(args: argparse.Namespace, scales: Scales, physical: bool) -> float:
+    if args.t_end is not None:
+        if not physical:
+            raise DrillSimError("--t-end needs a physical preset (--params); use --tau-end")
+        tau_end = args.t_end / scales.time_s
+    else:
+        tau_end = 600.0 if args.tau_end is None else args.tau_end
+    if not (math.isfinite(tau_end) and tau_end > 0.0):
+        raise DrillSimError(f"--tau-end = {tau_end!r} must be a positive number")
+    return tau_end
+
+
+# ---- running ------------------------------------------------------------------------------
+class Progress:
+    """A one-line progress bar on stderr (only when asked or on a terminal)."""
+
+    def __init__(self, total: int, enabled: bool, stream: TextIO = sys.stderr) -> None:
+        self.total, self.enabled, self.stream = total, enabled, stream
+        self.start = time.perf_counter()
+
+    def update(self, done: int) -> None:
+        if not self.enabled:
+            return
+        frac = done / self.total if self.total else 1.0
+        elapsed = time.perf_counter() - self.start
+        eta = elapsed * (1.0 - frac) / frac if frac > 0 else math.inf
+        bar = "#" * int(30 * frac)
+        self.stream.write(f"\r[{bar:<30}] {100 * frac:5.1f}%  {done:,}/{self.total:,} steps  "
+                          f"eta {eta:5.1f} s ")
+        self.stream.flush()
+
+    def close(self) -> None:
+        if self.enabled:
+            self.stream.write("\n")
+            self.stream.flush()
+
+
+def _chunks(total: int, size: int) -> Iterator[int]:
+    while total > 0:
+        step = min(size, total)
+        total -= step
+        yield step
+
+
+def simulate(spec: RunSpec, trace: TextIO | None = None, trace_every: int = 100,
+             progress: bool = False) -> dict[str, Any]:
+    """Run ``spec`` and return the summary dictionary (the ``--json`` object)."""
+    sim = Simulator(spec.params, SimConfig(dtau=spec.dtau, n_nodes=spec.n_nodes,
+                                           method=spec.method, tau_avg=spec.average_from),
+                    perturb_v=spec.perturb_v, perturb_omega=spec.perturb_omega)
+    sim.advance(0, every=1)               # compile (or load from cache) outside the timing
+    total = sim.steps_for(spec.tau_end)
+    writer = _trace_writer(trace, spec) if trace else None
+    bar = Progress(total, progress)
+    kernel_seconds = 0.0
+    for n in _chunks(total, CHUNK_STEPS):
+        t0 = time.perf_counter()
+        samples = sim.advance(n, every=trace_every if writer else 0)
+        kernel_seconds += time.perf_counter() - t0
+        if writer:
+            _write_trace(writer, samples, spec)
+        bar.update(sim.steps)
+    bar.close()
+    return summarize(spec, sim, kernel_seconds)
+
+
+def summarize(spec: RunSpec, sim: Simulator, kernel_seconds: float) -> dict[str, Any]:
+    """The run's figures: events, cycle averages (eqs. 42-48), stability (App. B)."""
+    p = spec.params
+    acc = sim.accumulators
+    avg = analysis.cycle_averages(p, acc)
+    stick, bounce = analysis.first_event_tau(acc)
+    triv = analysis.trivial_solution(p)
+    root = analysis.rightmost_root(p)
+    ssi = (avg.omega_max - avg.omega_min) / (2.0 * avg.mean_omega) if avg.mean_omega else None
+    out: dict[str, Any] = {
+        "params": {g: getattr(p, g) for g in GROUPS},
+        "tau_end": spec.tau_end, "dtau": spec.dtau, "average_from": spec.average_from,
+        "method": spec.method, "nodes": spec.n_nodes,
+        "first_stick_tau": stick, "bounce_tau": bounce,
+        "stick_fraction": avg.stick_fraction, "kappa": avg.kappa, "eta": avg.eta,
+        "mean_torque": avg.mean_torque, "mean_depth_of_cut": avg.mean_depth_of_cut,
+        "mean_wob": avg.mean_wob, "mean_omega": avg.mean_omega,
+        "mean_pipe_torque": avg.mean_pipe_torque, "mean_rop": avg.mean_rop,
+        "specific_energy": avg.specific_energy, "drilling_strength": avg.drilling_strength,
+        "omega_min": avg.omega_min, "omega_max": avg.omega_max, "ssi": ssi,
+        "utr": (p.omega0 - avg.omega_min) / p.omega0 if p.omega0 else None,
+        "trivial_torque": triv.torque, "trivial_depth_of_cut": triv.depth_of_cut,
+        "trivial_rop": triv.v, "trivial_delay": analysis.trivial_delay(p),
+        "critical_delay": analysis.critical_delay(p),
+        "growth_rate": root.real, "growth_frequency": root.imag,
+        "steps": sim.steps, "kernel_seconds": kernel_seconds,
+        "ns_per_step": 1e9 * kernel_seconds / sim.steps if sim.steps else None,
+    }
+    if spec.physical:
+        out["si"] = _si_summary(spec.scales, out)
+    return {key: _clean(value) for key, value in out.items()}
+
+
+def _si_summary(sc: Scales, d: dict[str, Any]) -> dict[str, Any]:
+    def t(x: float | None) -> float | None:
+        return None if x is None else x * sc.time_s
+    return {
+        "t_star_s": sc.time_s, "l_star_m": sc.length_m,
+        "first_stick_s": t(d["first_stick_tau"]), "bounce_s": t(d["bounce_tau"]),
+        "mean_tob_nm": sc.tob_nm(d["mean_torque"]), "mean_wob_n": sc.wob_n(d["mean_wob"]),
+        "mean_rop_m_per_h": sc.rop_m_s(d["mean_rop"]) * 3600.0,
+        "mean_depth_of_cut_mm": d["mean_depth_of_cut"] * sc.length_m * 1e3,
+        "bit_rpm_min": sc.rpm(d["omega_min"]), "bit_rpm_max": sc.rpm(d["omega_max"]),
+        "mean_bit_rpm": sc.rpm(d["mean_omega"]),
+    }
+
+
+def _clean(value: Any) -> Any:
+    """JSON-safe: numpy scalars to float, NaN/inf to None."""
+    if isinstance(value, dict):
+        return {k_: _clean(v) for k_, v in value.items()}
+    if hasattr(value, "item"):
+        value = value.item()
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return value
+
+
+# ---- trace --------------------------------------------------------------------------------
+def _trace_writer(stream: TextIO, spec: RunSpec) -> Any:
+    writer = csv.writer(stream)
+    writer.writerow(TRACE_COLUMNS + (TRACE_SI_COLUMNS if spec.physical else ()))
+    return writer
+
+
+def _write_trace(writer: Any, samples: Any, spec: RunSpec) -> None:
+    cols = [samples.column(c) for c in (k.C_TAU, k.C_OMEGA, k.C_V, k.C_WOB, k.C_TOB,
+                                        k.C_DOC, k.C_T_PIPE, k.C_MODE)]
+    sc = spec.scales
+    for i in range(len(samples)):
+        row = [f"{c[i]:.10g}" for c in cols[:-1]] + [int(cols[-1][i])]
+        if spec.physical:
+            row += [f"{x:.10g}" for x in (cols[0][i] * sc.time_s, sc.rpm(cols[1][i]),
+                                          sc.rop_m_s(cols[2][i]), sc.wob_n(cols[3][i]),
+                                          sc.tob_nm(cols[4][i]), cols[5][i] * sc.length_m,
+                                          sc.tob_nm(cols[6][i]))]
+        writer.writerow(row)
+
+
+# ---- output -------------------------------------------------------------------------------
+def format_summary(d: dict[str, Any]) -> str:
+    """A readable multi-line summary of :func:`simulate`'s dictionary."""
+    def f(x: Any, fmt: str = ".4g") -> str:
+        return "none" if x is None else format(x, fmt)
+    p = d["params"]
+    lines = [
+        "drill_sim run  (Richard, Germay & Detournay 2007)",
+        "  groups      " + "  ".join(f"{g}={p[g]:g}" for g in GROUPS),
+        f"  numerics    dtau={d['dtau']:g}  tau_end={d['tau_end']:g}  method={d['method']}  "
+        f"steps={d['steps']:,}  kernel {f(d['kernel_seconds'], '.3f')} s "
+        f"({f(d['ns_per_step'], '.1f')} ns/step)",
+        f"  stability   tau_n0={f(d['trivial_delay'])}  critical={f(d['critical_delay'])}  "
+        f"growth rate={f(d['growth_rate'])}  frequency={f(d['growth_frequency'])}",
+        f"  events      first stick tau={f(d['first_stick_tau'])}  "
+        f"first bounce tau={f(d['bounce_tau'])}",
+        f"  averages    over tau in [{d['average_from']:g}, {d['tau_end']:g}]",
+        f"    kappa={f(d['kappa'])}  eta={f(d['eta'])}  stick fraction={f(d['stick_fraction'])}",
+        f"    <T>={f(d['mean_torque'])} (trivial {f(d['trivial_torque'])})  "
+        f"<delta>={f(d['mean_depth_of_cut'])} (trivial {f(d['trivial_depth_of_cut'])})  "
+        f"<W>={f(d['mean_wob'])}",
+        f"    omega in [{f(d['omega_min'])}, {f(d['omega_max'])}]  SSI={f(d['ssi'])}  "
+        f"E={f(d['specific_energy'])}  S={f(d['drilling_strength'])}",
+    ]
+    if "si" in d:
+        si = d["si"]
+        lines += [
+            f"  SI          t*={si['t_star_s']:.4g} s  L*={si['l_star_m'] * 1e3:.4g} mm  "
+            f"first stick {f(si['first_stick_s'])} s",
+            f"    bit rpm {f(si['bit_rpm_min'], '.1f')}..{f(si['bit_rpm_max'], '.1f')} "
+            f"(mean {f(si['mean_bit_rpm'], '.1f')})  <TOB>={f(si['mean_tob_nm'], '.4g')} N m  "
+            f"<WOB>={f(si['mean_wob_n'], '.4g')} N  ROP={f(si['mean_rop_m_per_h'], '.3g')} m/h",
+        ]
+    return "\n".join(lines)
+
+
+def _sweep_values(text: str) -> list[float]:
+    if ":" in text:
+        start, stop, count = text.split(":")
+        n = int(count)
+        return [float(start) + i * (float(stop) - float(start)) / max(n - 1, 1)
+                for i in range(n)]
+    return [float(x) for x in text.split(",") if x.strip()]
+
+
+def _cmd_run(args: argparse.Namespace) -> int:
+    spec = _resolve(args)
+    progress = args.progress or sys.stderr.isatty()
+    if args.trace:
+        with args.trace.open("w", newline="") as stream:
+            result = simulate(spec, stream, args.trace_every, progress)
+    else:
+        result = simulate(spec, progress=progress)
+    print(json.dumps(result) if args.json else format_summary(result))
+    return 0
+
+
+def _cmd_sweep(args: argparse.Namespace) -> int:
+    values = _sweep_values(args.values)
+    progress = args.progress or sys.stderr.isatty()
+    for value in values:
+        setattr(args, args.vary, int(value) if args.vary == "n" else value)
+        result = simulate(_resolve(args), progress=progress)
+        print(json.dumps(result), flush=True)
+    return 0
+
+
+def _cmd_info(args: argparse.Namespace) -> int:
+    preset = load_preset(args.preset)
+    p = preset.params
+    print(f"{preset.name}: {preset.description}")
+    print("  groups  " + "  ".join(f"{g}={getattr(p, g):.4g}" for g in GROUPS))
+    for fld in fields(preset.scales):
+        print(f"  {fld.name:10s} {getattr(preset.scales, fld.name):.6g}")
+    root = analysis.rightmost_root(p)
+    print(f"  tau_n0={analysis.trivial_delay(p):.4g}  critical delay="
+          f"{analysis.critical_delay(p):.4g}  rightmost root={root.real:.4g}+{root.imag:.4g}i")
+    return 0
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    try:
+        if args.command == "presets":
+            for name in available_presets():
+                print(f"{name:22s} {load_preset(name).description.splitlines()[0]}")
+            return 0
+        return {"run": _cmd_run, "sweep": _cmd_sweep, "info": _cmd_info}[args.command](args)
+    except DrillSimError as exc:
+        print(f"drill_sim: error: {exc}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())
