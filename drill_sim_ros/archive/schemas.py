@@ -81,4 +81,5 @@ def message_definition(type_name: str) -> MessageDefinition:
         dep_package, dep_name = split_type_name(dependency["type_name"])
         dep_text = _msg_file(dep_package, dep_name, ".msg").read_text(encoding="utf-8")
         blocks.append(f"{SEPARATOR}\nMSG: {dep_package}/{dep_name}\n{dep_text.rstrip(chr(10))}")
-    return MessageDefinition(full_name, "\n".join(blocks) + "\n", _own_hash(description, full_name))
+    text = "\n".join(blocks) + "\n"
+    return MessageDefinition(full_name, text, _own_hash(description, full_name))
