@@ -1,0 +1,41 @@
+"""Shared set-up for the model tests: the paper's cases and small run helpers."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from drill_sim_ros.model import kernel as k
+from drill_sim_ros.model.params import DimensionlessParams
+from drill_sim_ros.model.simulator import SimConfig, Simulator
+
+FIG8A = DimensionlessParams(n=6, psi=50.0, beta=0.3, lam=5.0, w0=7.0, omega0=5.0)
+FIG8B = FIG8A.with_(beta=1.3)
+
+
+def run(params: DimensionlessParams, tau_end: float, dtau: float = 1e-4,
+        every: int = 0, **kwargs) -> tuple[Simulator, np.ndarray]:
+    """Run from tau = 0 to ``tau_end``; return the simulator and the sample rows."""
+    config_keys = {"n_nodes", "method", "tau_avg", "omega_rate", "w_rate"}
+    config = SimConfig(dtau=dtau, **{key: kwargs.pop(key) for key in list(kwargs)
+                                     if key in config_keys})
+    sim = Simulator(params, config, **kwargs)
+    samples = sim.advance(sim.steps_for(tau_end), every=every)
+    return sim, samples.data
+
+
+def advance_to_stick_onset(sim: Simulator, limit_tau: float, chunk: int = 200) -> bool:
+    """Step until the bit enters a stick phase (the sample of a step is stuck and the
+    previous was not); stop right at that step. False if ``limit_tau`` passes first."""
+    last_mode = -1.0
+    while sim.tau < limit_tau:
+        snap = sim.snapshot()
+        rows = sim.advance(chunk, every=1).data
+        modes = rows[:, k.C_MODE]
+        prev = np.concatenate(([last_mode], modes[:-1]))
+        onset = np.flatnonzero((modes == k.MODE_STUCK) & (prev != k.MODE_STUCK))
+        if onset.size:
+            sim.restore(snap)
+            sim.advance(int(onset[0]))
+            return True
+        last_mode = modes[-1]
+    return False
