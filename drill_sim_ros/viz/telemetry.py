@@ -43,8 +43,9 @@ class TelemetryBatch:
     def from_rows(cls, rows: np.ndarray | Sequence[Sequence[float]],
                   order: np.ndarray | None = None) -> TelemetryBatch:
         """Build from message rows (n, >= N_FIELDS); ``order`` from :func:`field_order`."""
-        data = np.asarray(rows, dtype=np.float64).reshape(-1, np.shape(rows)[-1] if
-                                                          len(rows) else N_FIELDS)
+        data = np.asarray(rows, dtype=np.float64)
+        if data.size == 0:
+            data = np.empty((0, N_FIELDS))
         index = np.arange(N_FIELDS) if order is None else order
         return cls(np.ascontiguousarray(data[:, index]))
 
