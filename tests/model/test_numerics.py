@@ -93,7 +93,8 @@ def test_rebasing_keeps_large_depths_exact() -> None:
     rows_b = b.advance(30_000_000, every=100).data  # rebases only once, at the end
     # a missed shift would jump the depth of cut by n * shift ~ 1e4; rounding drifts ~1e-6
     for col in (k.C_DOC, k.C_OMEGA, k.C_V, k.C_WOB):
-        assert np.max(np.abs(rows_a[:, col] - rows_b[:, col])) < 1e-4  # rounding drift
+        spread = np.ptp(rows_b[:, col])
+        assert np.max(np.abs(rows_a[:, col] - rows_b[:, col])) < 1e-3 * spread
 
 
 @pytest.mark.parametrize("bad", [{"dtau": 0.0}, {"dtau": float("nan")}, {"n_nodes": 3},

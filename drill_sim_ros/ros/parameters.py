@@ -1,0 +1,187 @@
+"""The sim_node parameters: one table of specs feeding descriptors, defaults and validation.
+
+Each :class:`ParamSpec` names a parameter, its type, default (a value, or a function of the
+loaded preset for the physical overrides), range, unit and whether it may change at runtime.
+The same table produces the rclpy ``ParameterDescriptor`` (with ``FloatingPointRange`` /
+``IntegerRange``) and validates values in the set-parameters callback, so the reason a value
+is rejected always names the parameter and its allowed range.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
+
+from drill_sim_ros.model.params import structure
+from drill_sim_ros.model.presets import DEFAULT_PRESET, Preset
+
+GRAVITY_M_S2 = 9.80665
+MUD_DENSITY_KG_M3 = 1200.0
+DOUBLE, INTEGER, BOOL, STRING = "double", "int", "bool", "string"
+
+
+@dataclass(frozen=True)
+class ParamSpec:
+    """One parameter: ``default`` may be a callable of the loaded :class:`Preset`."""
+
+    name: str
+    kind: str
+    default: Any
+    description: str
+    low: float | None = None
+    high: float | None = None
+    read_only: bool = False
+
+    def default_for(self, preset: Preset | None) -> Any:
+        return self.default(preset) if callable(self.default) else self.default
+
+
+def submerged_string_weight_n(preset: Preset | None,
+                              mud_density_kg_m3: float = MUD_DENSITY_KG_M3) -> float:
+    """Buoyed weight of pipe + BHA: steel mass x g x (1 - rho_mud / rho_steel); 0 if none."""
+    if preset is None or preset.physical is None:
+        return 0.0
+    phys = preset.physical
+    pipe_m3 = math.pi * (phys.pipe_outer_radius_m**2 - phys.pipe_inner_radius_m**2) \
+        * phys.pipe_length_m
+    mass_kg = pipe_m3 * phys.density_kg_m3 + structure(phys).mass_kg
+    return mass_kg * GRAVITY_M_S2 * (1.0 - mud_density_kg_m3 / phys.density_kg_m3)
+
+
+def _preset_wob_n(preset: Preset | None) -> float:
+    return 0.0 if preset is None else preset.scales.wob_n(preset.params.w0)
+
+
+def _preset_rpm(preset: Preset | None) -> float:
+    return 0.0 if preset is None else preset.scales.rpm(preset.params.omega0)
+
+
+def _preset_dtau(preset: Preset | None) -> float:
+    return 1e-4 if preset is None else preset.dtau
+
+
+def _preset_nodes(preset: Preset | None) -> int:
+    return 2048 if preset is None or preset.n_nodes is None else preset.n_nodes
+
+
+def _max_wob_n(preset: Preset | None) -> float:
+    return max(10.0 * _preset_wob_n(preset), 1.0)
+
+
+SPECS: tuple[ParamSpec, ...] = (
+    ParamSpec("model.preset", STRING, DEFAULT_PRESET,
+              "Preset name (config/presets/<name>.yaml) or path to a preset YAML file.",
+              read_only=True),
+    ParamSpec("model.applied_wob_n", DOUBLE, _preset_wob_n,
+              "Initial applied weight on bit [N] (default: the preset's); /drill/cmd/wob "
+              "changes the live setpoint, ~/reset returns to this value.",
+              0.0, 1e9, read_only=True),
+    ParamSpec("model.surface_rpm", DOUBLE, _preset_rpm,
+              "Initial top-drive speed [rev/min] (default: the preset's); "
+              "/drill/cmd/surface_rpm changes the live setpoint.", 0.0, 1e4, read_only=True),
+    ParamSpec("model.dtau", DOUBLE, _preset_dtau,
+              "Largest dimensionless integrator step (RGD07 units of t*); refined so that a "
+              "whole number of steps fills one publish period.", 1e-7, 0.05, read_only=True),
+    ParamSpec("model.n_nodes", INTEGER, _preset_nodes,
+              "Bottom-hole profile nodes per blade sector.", 16, 1 << 22, read_only=True),
+    ParamSpec("model.perturb_v", DOUBLE, 1e-3,
+              "Dimensionless axial-velocity perturbation added at t = 0 (seeds the "
+              "instability).", -1e3, 1e3, read_only=True),
+    ParamSpec("model.submerged_string_weight_n", DOUBLE, submerged_string_weight_n,
+              "Buoyed weight of drill pipe + BHA [N]; hook load = this - applied WOB. "
+              "Default: steel mass x g x (1 - 1200 kg/m3 mud / steel density); 0 for "
+              "dimensionless presets.", 0.0, 1e10),
+    ParamSpec("limits.max_surface_rpm", DOUBLE, 300.0,
+              "Surface-rpm commands above this [rev/min] are rejected.", 0.0, 1e4),
+    ParamSpec("limits.max_wob_n", DOUBLE, _max_wob_n,
+              "WOB commands above this [N] are rejected (default: 10 x the preset's WOB).",
+              0.0, 1e9),
+    ParamSpec("limits.top_drive_accel_rpm_s", DOUBLE, 0.0,
+              "Top-drive acceleration limit [rev/min per s]; 0 = step changes.", 0.0, 1e6,
+              read_only=True),
+    ParamSpec("limits.wob_rate_n_s", DOUBLE, 0.0,
+              "Applied-WOB rate limit [N/s]; 0 = step changes.", 0.0, 1e9, read_only=True),
+    ParamSpec("publish_rate_hz", DOUBLE, 100.0,
+              "Samples published per second of SIMULATED time.", 1.0, 1000.0, read_only=True),
+    ParamSpec("publish_clock", BOOL, True, "Publish /clock (rosgraph_msgs/Clock) in sim time."),
+    ParamSpec("real_time_factor", DOUBLE, 1.0,
+              "Simulated seconds per wall second; 0 = as fast as possible.", 0.0, 1000.0),
+    ParamSpec("lockstep", BOOL, False,
+              "Advance only on ~/step (one publish period per call); deterministic."),
+    ParamSpec("run_seconds", DOUBLE, 0.0,
+              "Exit cleanly after this many wall seconds; 0 = run until stopped.", 0.0, 1e9,
+              read_only=True),
+    ParamSpec("record.path", STRING, "",
+              "Record every published message to this MCAP file (in process); '' = off.",
+              read_only=True),
+    ParamSpec("diagnostics.window_s", DOUBLE, 20.0,
+              "Simulated seconds of bit speed behind the stick-slip severity on /diagnostics.",
+              0.1, 3600.0, read_only=True),
+    ParamSpec("status_line", BOOL, True,
+              "Show one live status line when stderr is a terminal."),
+)
+SPEC_BY_NAME = {spec.name: spec for spec in SPECS}
+
+
+def descriptor(spec: ParamSpec) -> ParameterDescriptor:
+    """The rclpy descriptor of ``spec``; doubles accept integers too (``-p x:=2``)."""
+    desc = ParameterDescriptor(description=spec.description, read_only=spec.read_only)
+    if spec.kind == DOUBLE:
+        desc.dynamic_typing = True
+        desc.floating_point_range = [FloatingPointRange(
+            from_value=float(spec.low), to_value=float(spec.high), step=0.0)]
+    elif spec.kind == INTEGER:
+        desc.integer_range = [IntegerRange(
+            from_value=int(spec.low), to_value=int(spec.high), step=1)]
+    return desc
+
+
+def validate(spec: ParamSpec, value: Any) -> str | None:
+    """None if ``value`` is acceptable for ``spec``, else the reason (naming the range)."""
+    if spec.kind == DOUBLE:
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            return f"{spec.name} must be a number, got {value!r}"
+        if not (math.isfinite(value) and spec.low <= value <= spec.high):
+            return f"{spec.name} = {value!r} is outside [{spec.low:g}, {spec.high:g}]"
+    elif spec.kind == INTEGER:
+        if isinstance(value, bool) or not isinstance(value, int):
+            return f"{spec.name} must be an integer, got {value!r}"
+        if not spec.low <= value <= spec.high:
+            return f"{spec.name} = {value!r} is outside [{spec.low:g}, {spec.high:g}]"
+    elif spec.kind == BOOL and not isinstance(value, bool):
+        return f"{spec.name} must be true or false, got {value!r}"
+    elif spec.kind == STRING and not isinstance(value, str):
+        return f"{spec.name} must be a string, got {value!r}"
+    return None
+
+
+def coerce(spec: ParamSpec, value: Any) -> Any:
+    """The Python value the node uses (doubles given as integers become floats)."""
+    return float(value) if spec.kind == DOUBLE else value
+
+
+def yaml_defaults(preset: Preset | None = None) -> dict[str, Any]:
+    """``{name: default}`` for a plain YAML loader or documentation."""
+    return {spec.name: spec.default_for(preset) for spec in SPECS}
+
+
+def declare_all(node: Any, load: Callable[[str], Preset]) -> tuple[Preset, dict[str, Any]]:
+    """Declare every spec on ``node``; returns the loaded preset and the values in use.
+
+    ``model.preset`` is declared first so the physical defaults can come from it.
+    """
+    first = SPECS[0]
+    name = node.declare_parameter(first.name, first.default, descriptor(first)).value
+    preset = load(name)
+    values: dict[str, Any] = {first.name: name}
+    for spec in SPECS[1:]:
+        param = node.declare_parameter(spec.name, spec.default_for(preset), descriptor(spec))
+        reason = validate(spec, param.value)
+        if reason is not None:
+            raise ValueError(reason)
+        values[spec.name] = coerce(spec, param.value)
+    return preset, values
