@@ -20,23 +20,26 @@ from drill_sim_ros.model.presets import Preset, load_preset
 class PaperUnits:
     """Scales to dimensionless form plus the reference (trivial, eq. 34) motion.
 
-    v0, omega0, delta0: trivial ROP, bit speed and depth of cut (dimensionless);
-    beta: slope of the friction line (eq. 50).
+    v0, omega0, delta0, w0, t0: trivial ROP, bit speed, depth of cut, WOB and TOB
+    (dimensionless); beta: slope of the friction line (eq. 50); n: number of blades.
     """
 
     preset: str
     scales: Scales
     beta: float
+    n: int
     v0: float
     omega0: float
     delta0: float
     w0: float
+    t0: float
 
     @classmethod
     def from_preset(cls, preset: Preset) -> PaperUnits:
         triv = trivial_solution(preset.params)
         return cls(preset=preset.name, scales=preset.scales, beta=preset.params.beta,
-                   v0=triv.v, omega0=triv.omega, delta0=triv.depth_of_cut, w0=triv.wob)
+                   n=preset.params.n, v0=triv.v, omega0=triv.omega,
+                   delta0=triv.depth_of_cut, w0=triv.wob, t0=triv.torque)
 
     @classmethod
     def load(cls, name: str) -> PaperUnits:
