@@ -1,0 +1,154 @@
+"""``mcap_recorder``: record the sim's topics over DDS into MCAP, bytes unchanged.
+
+    mcap_recorder -o FILE.mcap [--topics REGEX] [--compression zstd|none]
+                  [--split-size MB | --split-duration S]
+
+Topics matching REGEX (default: every /drill/... topic, /diagnostics and /clock) are found by
+discovery as they appear. Each is subscribed with raw=True, so the serialized CDR bytes go to
+the file unchanged, with a QoS compatible with what its publishers offer; the offered profiles
+are stored in the channel metadata. SIGINT or SIGTERM finishes the file with its summary.
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import re
+import sys
+from collections.abc import Callable
+
+import rclpy
+from rclpy.executors import ExternalShutdownException
+from rclpy.node import Node
+from rclpy.utilities import remove_ros_args
+
+from drill_sim_ros.archive.background import BackgroundWriter
+from drill_sim_ros.archive.errors import ArchiveError
+from drill_sim_ros.archive.qos import qos_profiles_yaml, subscription_qos
+from drill_sim_ros.archive.ros_types import message_class
+from drill_sim_ros.archive.rotation import RotatingWriter
+from drill_sim_ros.archive.status import StatusLine
+
+_log = logging.getLogger(__name__)
+
+DEFAULT_TOPICS = r"/drill/.*|/diagnostics|/clock"
+DISCOVERY_PERIOD_S = 0.5
+STATUS_PERIOD_S = 0.5
+
+
+class McapRecorder(Node):
+    """Subscribes to matching topics as they appear and queues their raw bytes to ``sink``."""
+
+    def __init__(self, sink: BackgroundWriter, topics_regex: str = DEFAULT_TOPICS) -> None:
+        super().__init__("mcap_recorder")
+        self._sink = sink
+        self._pattern = re.compile(topics_regex)
+        self._recorded: dict[str, object] = {}
+        self._skipped: set[str] = set()
+        self._discovery = self.create_timer(DISCOVERY_PERIOD_S, self.discover)
+
+    @property
+    def topics(self) -> list[str]:
+        return sorted(self._recorded)
+
+    def discover(self) -> None:
+        """Subscribe to every matching topic that has a publisher and no subscription yet."""
+        for topic, types in self.get_topic_names_and_types():
+            if topic in self._recorded or topic in self._skipped:
+                continue
+            if self._pattern.fullmatch(topic) and types:
+                self._subscribe(topic, types[0])
+
+    def _subscribe(self, topic: str, type_name: str) -> None:
+        offered = [info.qos_profile for info in self.get_publishers_info_by_topic(topic)]
+        if not offered:
+            return  # a subscriber-only topic; retry once a publisher shows up
+        try:
+            msg_class = message_class(type_name)
+        except ArchiveError as exc:
+            self._skipped.add(topic)
+            self.get_logger().warning(f"not recording {topic}: {exc}")
+            return
+        self._sink.add_channel(topic, type_name, qos_profiles_yaml(offered))
+        self._recorded[topic] = self.create_subscription(
+            msg_class, topic, self._callback(topic), subscription_qos(offered), raw=True
+        )
+        self.get_logger().info(f"recording {topic} [{type_name}]")
+
+    def _callback(self, topic: str) -> Callable[[bytes], None]:
+        put, clock = self._sink.put, self.get_clock()
+
+        def on_message(data: bytes) -> None:
+            put(topic, data, clock.now().nanoseconds)
+
+        return on_message
+
+
+def _parse(argv: list[str]) -> argparse.Namespace:
+    parser = argparse.ArgumentParser(prog="mcap_recorder", description=__doc__.splitlines()[0])
+    parser.add_argument("-o", "--output", required=True, help="output .mcap file")
+    parser.add_argument("--topics", default=DEFAULT_TOPICS,
+                        help=f"regex that topic names must match (default: {DEFAULT_TOPICS})")
+    parser.add_argument("--compression", choices=("zstd", "none"), default="zstd")
+    split = parser.add_mutually_exclusive_group()
+    split.add_argument("--split-size", type=float, metavar="MB",
+                       help="start a new file after MB megabytes")
+    split.add_argument("--split-duration", type=float, metavar="S",
+                       help="start a new file after S seconds of log time")
+    args = parser.parse_args(argv)
+    if (args.split_size or 1) <= 0 or (args.split_duration or 1) <= 0:
+        parser.error("split limits must be positive")
+    try:
+        re.compile(args.topics)
+    except re.error as exc:
+        parser.error(f"bad --topics regex: {exc}")
+    return args
+
+
+def _open_sink(args: argparse.Namespace) -> tuple[RotatingWriter, BackgroundWriter]:
+    split_bytes = int(args.split_size * 1e6) if args.split_size else None
+    files = RotatingWriter(args.output, args.compression, split_bytes, args.split_duration)
+    return files, BackgroundWriter(files, name="mcap-recorder")
+
+
+def _status_text(files: RotatingWriter, sink: BackgroundWriter, node: McapRecorder) -> str:
+    return (f"[mcap_recorder] {sink.written} msgs  {files.bytes_written / 1e6:.2f} MB  "
+            f"{len(node.topics)} topics  dropped {sink.dropped}  -> {files.paths[-1].name}")
+
+
+def _spin(node: McapRecorder, files: RotatingWriter, sink: BackgroundWriter) -> None:
+    status = StatusLine()
+    if status.enabled:
+        node.create_timer(STATUS_PERIOD_S, lambda: status.show(_status_text(files, sink, node)))
+    try:
+        rclpy.spin(node)
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        status.end()
+
+
+def main(args: list[str] | None = None) -> int:
+    logging.basicConfig(level=logging.INFO, format="[mcap_recorder] %(levelname)s %(message)s")
+    argv = sys.argv if args is None else args
+    options = _parse(remove_ros_args(argv)[1:])
+    try:
+        files, sink = _open_sink(options)
+    except (ArchiveError, OSError) as exc:
+        _log.error("%s", exc)
+        return 2
+    rclpy.init(args=argv)
+    node = McapRecorder(sink, options.topics)
+    try:
+        _spin(node, files, sink)
+    finally:
+        node.destroy_node()
+        rclpy.try_shutdown()
+        sink.close()
+    _log.info("%d messages on %d topics in %s (%d dropped)", sink.written, len(node.topics),
+              ", ".join(str(p) for p in files.paths), sink.dropped)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
