@@ -82,7 +82,9 @@ def rightmost_root(p: DimensionlessParams, tau: float | None = None) -> complex:
     for x in np.linspace(-radius, radius, 9):
         for y in np.linspace(0.05 * radius, 3.0 * radius, 31):
             root = _newton(complex(x, y), npsi, tau)
-            if root is None or abs(root) < 1e-8 * radius or abs(_char_axial(root, npsi, tau)[0]) > 1e-6 * npsi:
+            if root is None or abs(root) < 1e-8 * radius:
+                continue                      # diverged, or the root at the origin (B.3)
+            if abs(_char_axial(root, npsi, tau)[0]) > 1e-6 * npsi:
                 continue
             root = complex(root.real, abs(root.imag))
             if best is None or root.real > best.real + 1e-12:

@@ -243,6 +243,7 @@ def _advance(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarr
     countdown = _first_countdown(step, every)
     n_rows = 0
     status = STATUS_OK
+    probe = 0.0                               # NaN would vanish in the contact/stick logic
     for _ in range(n_steps):
         tau = step * dt
         # ---- depth of cut: delta = n (U(tau) - U(tau - tau_n)), eqs. (8), (26)-(28)
@@ -256,6 +257,7 @@ def _advance(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarr
         t_pipe = phi_s - phi                  # pipe torque C (PHI_S - PHI), scaled
         v_new, omega_new, w_f, wob, tob, mode, stuck = _bit_response(
             v, omega, t_pipe, w_app, doc, stuck, beta, lam, kick, dt)
+        probe += w_f + tob
         # ---- statistics
         if mode == MODE_STUCK and first_stick != first_stick:
             first_stick = tau
@@ -335,8 +337,8 @@ def _advance(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarr
     acc[A_DOC_OMEGA], acc[A_STUCK] = a_dom, a_stuck
     acc[A_OMEGA_MIN], acc[A_OMEGA_MAX] = om_min, om_max
     acc[A_FIRST_STICK], acc[A_FIRST_BOUNCE] = first_stick, first_bounce
-    if status == STATUS_OK and not (math.isfinite(u) and math.isfinite(v)
-                                    and math.isfinite(phi) and math.isfinite(omega)):
+    if status == STATUS_OK and not (math.isfinite(u) and math.isfinite(v) and math.isfinite(phi)
+                                    and math.isfinite(omega) and math.isfinite(probe)):
         status = STATUS_NONFINITE
     return status, n_rows
 

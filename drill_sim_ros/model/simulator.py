@@ -180,7 +180,7 @@ class Simulator:
         cap = self.config.history_capacity
         sector = 2.0 * math.pi / self.params.n
         dphi = self.params.omega0 * self.config.dtau
-        count = min(cap // 2, int(math.ceil(sector / dphi)) + 2)
+        count = min(cap // 2, math.ceil(sector / dphi) + 2)
         phi = -dphi * np.arange(count - 1, -1, -1)
         self._hist = np.zeros((2, cap))
         self._hist[0, :count] = phi
@@ -216,7 +216,7 @@ class Simulator:
         """Whole steps covering ``duration`` (rounded to the nearest step)."""
         if not math.isfinite(duration) or duration < 0.0:
             raise ParameterError(f"duration {duration!r} must be finite and >= 0")
-        return int(round(duration / self.config.dtau))
+        return round(duration / self.config.dtau)
 
     def advance(self, n_steps: int, every: int = 0) -> Samples:
         """Advance ``n_steps``; return a sample every ``every`` global steps (0: none).

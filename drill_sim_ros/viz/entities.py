@@ -63,3 +63,4 @@ PER_SAMPLE = (*(s[0] for s in SCALAR_SERIES), PHASE_TRAJECTORY, BOTTOM_HOLE_PATT
 
 MODE_COLORS = ((31, 119, 180), (255, 127, 14), (214, 39, 40), (148, 103, 189))
 """RGB per mode: cutting blue, lost contact orange, stuck red, off bottom purple."""
+MODE_COLOR_NAMES = ("blue", "orange", "red", "purple")

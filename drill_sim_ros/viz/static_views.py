@@ -86,7 +86,7 @@ def log_es_reference(rec: rr.RecordingStream, units: PaperUnits) -> None:
 
 def info_markdown(units: PaperUnits, window_s: float) -> str:
     """The run description shown next to the plots."""
-    colors = ", ".join(f"{n} {'blue orange red purple'.split()[i]}"
+    colors = ", ".join(f"{n} {ent.MODE_COLOR_NAMES[i]}"
                        for i, n in enumerate(MODE_NAMES))
     return "\n".join([
         f"## drill_sim_ros run (preset `{units.preset}`)",

@@ -1,0 +1,374 @@
+"""sim_node: the real-time ROS 2 node around the RGD07 drill-bit simulator (node ``drill_sim``).
+
+Publishes the bit and surface state at ``publish_rate_hz`` of simulated time (stamps in
+simulated time, one stamp per sample on every topic), /diagnostics at 1 Hz wall and /clock;
+takes surface-rpm and WOB setpoints; serves ~/reset, ~/pause and ~/step (lockstep).
+Pacing follows the monotonic clock without drift (:mod:`drill_sim_ros.ros.pacing`).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from pathlib import Path
+from typing import Any
+
+import rclpy
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+from rcl_interfaces.msg import SetParametersResult
+from rclpy.clock import Clock, ClockType
+from rclpy.executors import ExternalShutdownException
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.task import Future
+from std_msgs.msg import Float64
+from std_srvs.srv import SetBool, Trigger
+
+from drill_sim_ros import topics
+from drill_sim_ros.model.errors import DrillSimError, NumericalFault
+from drill_sim_ros.model.presets import load_preset
+from drill_sim_ros.ros import messages
+from drill_sim_ros.ros.conversions import MessageFactory, stamp
+from drill_sim_ros.ros.pacing import Pacer, RateMeter
+from drill_sim_ros.ros.parameters import SPEC_BY_NAME, coerce, declare_all, validate
+from drill_sim_ros.ros.session import SessionConfig, SimSession
+from drill_sim_ros.ros.status_line import StatusLine, format_status
+
+DATA_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=100,
+                      reliability=ReliabilityPolicy.RELIABLE)
+CLOCK_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=10,
+                       reliability=ReliabilityPolicy.RELIABLE)
+COMMAND_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=10,
+                         reliability=ReliabilityPolicy.RELIABLE)
+FREE_RUN_BATCH = 20          # periods per callback when running as fast as possible
+MAX_CATCH_UP = 50            # periods per callback when catching up in real time
+DIAGNOSTICS_PERIOD_S = 1.0
+STATUS_PERIOD_S = 0.25
+WARN_THROTTLE_S = 1.0
+SAMPLE_TOPICS = (topics.BIT_WOB, topics.BIT_TOB, topics.BIT_ROP, topics.BIT_RPM,
+                 topics.BIT_DEPTH_OF_CUT, topics.BIT_MODE, topics.BIT_JOINT_STATES,
+                 topics.SURFACE_JOINT_STATES, topics.TELEMETRY)
+
+
+def session_config(values: dict[str, Any], preset: Any) -> SessionConfig:
+    """The session settings from the declared parameter values."""
+    return SessionConfig(
+        preset=preset, publish_rate_hz=values["publish_rate_hz"],
+        dtau_max=values["model.dtau"], n_nodes=values["model.n_nodes"],
+        perturb_v=values["model.perturb_v"], applied_wob_n=values["model.applied_wob_n"],
+        surface_rpm=values["model.surface_rpm"],
+        top_drive_accel_rpm_s=values["limits.top_drive_accel_rpm_s"],
+        wob_rate_n_s=values["limits.wob_rate_n_s"], window_s=values["diagnostics.window_s"])
+
+
+def command_problem(value: float, limit: float, unit: str) -> str | None:
+    """Why a setpoint command is unacceptable (None if it is fine)."""
+    if not math.isfinite(value):
+        return f"{value!r} is not finite"
+    if value < 0.0:
+        return f"{value:g} {unit} is negative"
+    if value > limit:
+        return f"{value:g} {unit} exceeds the limit {limit:g} {unit}"
+    return None
+
+
+class SimNode(Node):
+    """The ``drill_sim`` node; ``finished`` completes when ``run_seconds`` have passed."""
+
+    def __init__(self, **node_kwargs: Any) -> None:
+        super().__init__(topics.NODE_NAME, **node_kwargs)
+        self._steady = Clock(clock_type=ClockType.STEADY_TIME)
+        self._preset, self._values = declare_all(self, load_preset)
+        self._session = SimSession(session_config(self._values, self._preset))
+        self._factory = MessageFactory()
+        self._pacer = Pacer(self._wall_period_ns(1.0))
+        self._rate = RateMeter(time.monotonic_ns(), 0.0)
+        self._status = StatusLine()
+        self.finished = Future()
+        self._paused = False
+        self._fault: str | None = None
+        self.rejected_commands = 0
+        self._last_row: list[float] | None = None
+        self._pubs = {t: self.create_publisher(messages.type_of(t), t, self._qos(t))
+                            for t in (*SAMPLE_TOPICS, topics.CLOCK, topics.DIAGNOSTICS)}
+        self._recorder = self._open_recorder(self._values["record.path"])
+        self.create_subscription(Float64, topics.CMD_SURFACE_RPM, self._on_surface_rpm,
+                                 COMMAND_QOS)
+        self.create_subscription(Float64, topics.CMD_WOB, self._on_wob, COMMAND_QOS)
+        self.create_service(Trigger, "~/reset", self._on_reset)
+        self.create_service(SetBool, "~/pause", self._on_pause)
+        self.create_service(Trigger, "~/step", self._on_step)
+        self._tick_timer = None
+        self._restart_ticks()
+        self.create_timer(DIAGNOSTICS_PERIOD_S, self._publish_diagnostics, clock=self._steady)
+        self.create_timer(STATUS_PERIOD_S, self._show_status, clock=self._steady)
+        self._stop_timer = self._start_run_limit(self._values["run_seconds"])
+        self.add_on_set_parameters_callback(self._validate_parameters)
+        self.add_post_set_parameters_callback(self._apply_parameters)
+        self._log_start()
+
+    # ---- set-up ------------------------------------------------------------------------
+    @staticmethod
+    def _qos(topic: str) -> QoSProfile:
+        return CLOCK_QOS if topic in (topics.CLOCK, topics.DIAGNOSTICS) else DATA_QOS
+
+    def _open_recorder(self, path: str) -> Any:
+        """The in-process MCAP recorder of ``record.path`` (None when off or unavailable)."""
+        if not path:
+            return None
+        try:
+            from drill_sim_ros.archive.inprocess import InProcessRecorder
+            Path(path).parent.mkdir(parents=True, exist_ok=True)
+            recorder = InProcessRecorder(path, node_name=topics.NODE_NAME)
+            for topic in self._pubs:
+                recorder.add_topic(topic, topics.MSG_TYPES[topic], self._qos(topic))
+        except Exception as exc:  # recording is optional: keep simulating
+            self.get_logger().error(f"recording to {path!r} is off: {exc}")
+            return None
+        self.get_logger().info(f"recording to {path}")
+        return recorder
+
+    def _start_run_limit(self, run_seconds: float) -> Any:
+        if run_seconds <= 0:
+            return None
+        return self.create_timer(run_seconds, self._on_run_limit, clock=self._steady)
+
+    def _log_start(self) -> None:
+        s = self._session
+        self.get_logger().info(
+            f"preset {self._preset.name}: {s.steps} steps of dtau {s.dtau:.4g} per "
+            f"{s.period_ns * 1e-6:g} ms period; real_time_factor {self._rtf:g}, "
+            f"lockstep {self._lockstep}")
+
+    # ---- parameters --------------------------------------------------------------------
+    @property
+    def _rtf(self) -> float:
+        return self._values["real_time_factor"]
+
+    @property
+    def _lockstep(self) -> bool:
+        return self._values["lockstep"]
+
+    def _validate_parameters(self, params: list[Parameter]) -> SetParametersResult:
+        for param in params:
+            spec = SPEC_BY_NAME.get(param.name)
+            reason = None if spec is None else validate(spec, param.value)
+            if reason is not None:
+                return SetParametersResult(successful=False, reason=reason)
+        return SetParametersResult(successful=True)
+
+    def _apply_parameters(self, params: list[Parameter]) -> None:
+        for param in params:
+            if param.name in SPEC_BY_NAME:
+                self._values[param.name] = coerce(SPEC_BY_NAME[param.name], param.value)
+        if any(p.name in ("real_time_factor", "lockstep") for p in params):
+            self._restart_ticks()
+
+    # ---- pacing ------------------------------------------------------------------------
+    def _wall_period_ns(self, rtf: float) -> int:
+        return max(1, round(self._session.period_ns / rtf)) if rtf > 0 else 1
+
+    def _restart_ticks(self) -> None:
+        """(Re)create the tick timer for the current factor and anchor the schedule."""
+        if self._tick_timer is not None:
+            self.destroy_timer(self._tick_timer)
+            self._tick_timer = None
+        if self._lockstep:
+            return
+        free_run = self._rtf <= 0
+        self._pacer = Pacer(self._wall_period_ns(self._rtf))
+        period_s = 0.0 if free_run else self._pacer.period_ns * 1e-9
+        self._tick_timer = self.create_timer(period_s, self._on_tick, clock=self._steady)
+        self._anchor()
+
+    def _anchor(self) -> None:
+        """Align the schedule with the tick timer's next expiry."""
+        if self._tick_timer is not None:
+            self._pacer.anchor(time.monotonic_ns() + self._tick_timer.time_until_next_call())
+
+    def _on_tick(self) -> None:
+        if self._paused or self._fault is not None:
+            return
+        if self._rtf <= 0:
+            self._advance(FREE_RUN_BATCH)
+            return
+        count = self._pacer.due(time.monotonic_ns(), MAX_CATCH_UP)
+        if count > 0 and self._advance(count):
+            self._pacer.complete(count, time.monotonic_ns())
+
+    def _advance(self, periods: int) -> bool:
+        """Simulate and publish ``periods`` samples; False on a numerical fault."""
+        try:
+            stamps, rows = self._session.run(periods, self._values[
+                "model.submerged_string_weight_n"])
+        except NumericalFault as exc:
+            self._fault = str(exc)
+            self.get_logger().error(f"numerical fault: {exc}; call ~/reset to recover")
+            return False
+        with_clock = self._values["publish_clock"]
+        for time_ns, row in zip(stamps, rows, strict=True):
+            self._publish_all(self._factory.build(row, time_ns, with_clock), time_ns)
+        self._last_row = rows[-1].tolist()
+        return True
+
+    def _publish_all(self, msgs: dict[str, object], time_ns: int) -> None:
+        for topic, msg in msgs.items():
+            self._pubs[topic].publish(msg)
+            if self._recorder is not None:
+                self._recorder.write(topic, msg, time_ns)
+
+    # ---- commands ----------------------------------------------------------------------
+    def _on_surface_rpm(self, msg: Float64) -> None:
+        problem = command_problem(msg.data, self._values["limits.max_surface_rpm"], "rev/min")
+        if problem is None:
+            self._session.set_surface_rpm(msg.data)
+        else:
+            self._reject(topics.CMD_SURFACE_RPM, problem)
+
+    def _on_wob(self, msg: Float64) -> None:
+        problem = command_problem(msg.data, self._values["limits.max_wob_n"], "N")
+        if problem is None:
+            self._session.set_wob_n(msg.data)
+        else:
+            self._reject(topics.CMD_WOB, problem)
+
+    def _reject(self, topic: str, problem: str) -> None:
+        self.rejected_commands += 1
+        self.get_logger().warning(
+            f"rejected {topic}: {problem}; the last valid setpoint stays "
+            f"({self.rejected_commands} rejected so far)", throttle_duration_sec=WARN_THROTTLE_S)
+
+    # ---- services ----------------------------------------------------------------------
+    def _on_reset(self, _request: Trigger.Request, response: Trigger.Response
+                  ) -> Trigger.Response:
+        self._session.reset()
+        self._fault = None
+        response.success = True
+        response.message = (f"model reset to its initial state at t = "
+                            f"{self._session.sim_time_ns * 1e-9:.3f} s (sim time runs on)")
+        self.get_logger().info(response.message)
+        return response
+
+    def _on_pause(self, request: SetBool.Request, response: SetBool.Response
+                  ) -> SetBool.Response:
+        was_paused, self._paused = self._paused, bool(request.data)
+        if was_paused and not self._paused:
+            self._anchor()
+        response.success = True
+        response.message = "paused" if self._paused else "running"
+        return response
+
+    def _on_step(self, _request: Trigger.Request, response: Trigger.Response
+                 ) -> Trigger.Response:
+        if not (self._lockstep or self._paused):
+            response.message = "~/step needs lockstep:=true or a paused simulation"
+        elif self._fault is not None:
+            response.message = f"numerical fault ({self._fault}); call ~/reset"
+        else:
+            time_ns = self._session.sim_time_ns
+            response.success = self._advance(1)
+            response.message = f"published t = {time_ns * 1e-9:.6f} s"
+        return response
+
+    # ---- diagnostics, status, shutdown -------------------------------------------------
+    def _publish_diagnostics(self) -> None:
+        time_ns = max(0, self._session.sim_time_ns - self._session.period_ns)
+        achieved = self._rate.update(time.monotonic_ns(), time_ns * 1e-9)
+        msg = DiagnosticArray(status=[self._node_status(achieved), self._dynamics_status()])
+        msg.header.stamp = stamp(time_ns)
+        self._pubs[topics.DIAGNOSTICS].publish(msg)
+        if self._recorder is not None:
+            self._recorder.write(topics.DIAGNOSTICS, msg, time_ns)
+
+    def _node_status(self, achieved_rtf: float) -> DiagnosticStatus:
+        p50, p99 = self._pacer.lateness_percentiles_ms(50, 99)
+        values = {
+            "state": self._state_text(),
+            "sim_time_s": f"{self._session.sim_time_ns * 1e-9:.3f}",
+            "real_time_factor_target": f"{self._rtf:g}",
+            "real_time_factor_achieved": f"{achieved_rtf:.4g}",
+            "overruns": str(self._pacer.overruns),
+            "tick_lateness_p50_ms": f"{p50:.4g}",
+            "tick_lateness_p99_ms": f"{p99:.4g}",
+            "rejected_commands": str(self.rejected_commands),
+            "recorder_dropped": str(self._recorder_count("dropped")),
+            "recorder_written": str(self._recorder_count("written")),
+            "fault": self._fault or "",
+        }
+        if self._fault is not None:
+            level, message = DiagnosticStatus.ERROR, f"numerical fault: {self._fault}"
+        elif self._pacer.overruns or self._recorder_count("dropped"):
+            level, message = DiagnosticStatus.WARN, "overruns or recorder drops"
+        else:
+            level, message = DiagnosticStatus.OK, self._state_text()
+        return messages.status(f"{topics.NODE_NAME}: simulation", level, message, values)
+
+    def _dynamics_status(self) -> DiagnosticStatus:
+        sev, stick_fraction = self._session.severity()
+        mode = topics.MODE_NAMES[int(self._last_row[topics.TELEMETRY_INDEX["mode"]])] \
+            if self._last_row is not None else "none"
+        values = {"mode": mode, "stick_slip_severity": f"{sev.ssi:.4g}",
+                  "under_torque_ratio": f"{sev.utr:.4g}",
+                  "stick_fraction": f"{stick_fraction:.4g}",
+                  "window_s": f"{self._values['diagnostics.window_s']:g}"}
+        stick_slip = stick_fraction > 0 or sev.ssi > 0.5
+        level = DiagnosticStatus.WARN if stick_slip else DiagnosticStatus.OK
+        message = "stick-slip" if stick_slip else "smooth drilling"
+        return messages.status(f"{topics.NODE_NAME}: bit dynamics", level, message, values)
+
+    def _recorder_count(self, name: str) -> int:
+        return 0 if self._recorder is None else int(getattr(self._recorder, name))
+
+    def _state_text(self) -> str:
+        if self._fault is not None:
+            return "fault"
+        if self._paused:
+            return "paused"
+        return "lockstep" if self._lockstep else "running"
+
+    def _show_status(self) -> None:
+        if self._values["status_line"] and self._last_row is not None:
+            self._status.show(format_status(self._last_row, self._rate.last, self._state_text()))
+
+    def _on_run_limit(self) -> None:
+        self._stop_timer.cancel()
+        self.get_logger().info(f"run_seconds = {self._values['run_seconds']:g} reached")
+        if not self.finished.done():
+            self.finished.set_result(True)
+
+    def close(self) -> None:
+        """Finish the recording and the status line (idempotent)."""
+        self._status.close()
+        if self._recorder is not None:
+            recorder, self._recorder = self._recorder, None
+            recorder.close()
+            self.get_logger().info(f"recording closed: {recorder.written} messages written, "
+                                   f"{recorder.dropped} dropped")
+
+    def destroy_node(self) -> None:
+        self.close()
+        super().destroy_node()
+
+
+def main(args: list[str] | None = None) -> int:
+    """Console script ``sim_node`` (``ros2 run drill_sim_ros sim_node``)."""
+    rclpy.init(args=args)
+    node = None
+    try:
+        node = SimNode()
+        rclpy.spin_until_future_complete(node, node.finished)
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    except (DrillSimError, ValueError) as exc:
+        rclpy.logging.get_logger(topics.NODE_NAME).fatal(str(exc))
+        return 1
+    finally:
+        if node is not None:
+            node.destroy_node()
+        rclpy.try_shutdown()
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

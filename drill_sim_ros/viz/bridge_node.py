@@ -1,0 +1,139 @@
+"""``rerun_bridge [--save FILE.rrd] [--connect URL] [--serve]``: the live drilling dashboard.
+
+A ROS 2 node that subscribes to ``/drill/telemetry`` (one atomic sample per message, SI) and
+logs it on the ``sim_time`` timeline taken from the record's ``sim_time_s``. Samples are
+buffered and sent with ``send_columns`` ``flush_hz`` times a second. ``--serve`` hosts a
+gRPC server bound to 127.0.0.1 only. Turns rerun's analytics off first.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+
+import numpy as np
+import rclpy
+from rclpy.executors import ExternalShutdownException
+from rclpy.node import Node
+from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.utilities import remove_ros_args
+from std_msgs.msg import Float64MultiArray
+
+from drill_sim_ros import topics
+from drill_sim_ros.model.presets import DEFAULT_PRESET
+from drill_sim_ros.viz.analytics_off import disable_analytics
+from drill_sim_ros.viz.blueprint import build_blueprint
+from drill_sim_ros.viz.dashboard import Dashboard
+from drill_sim_ros.viz.paper_units import PaperUnits
+from drill_sim_ros.viz.recording import (
+    DEFAULT_SERVE_PORT,
+    DEFAULT_VIEWER_URL,
+    close_recording,
+    open_recording,
+)
+from drill_sim_ros.viz.running_stats import default_window_s
+from drill_sim_ros.viz.telemetry import N_FIELDS, TelemetryBatch, field_order
+
+NODE_NAME = "rerun_bridge"
+QUEUE_DEPTH = 1000          # 10 s of telemetry at the sim's default 100 Hz
+
+
+class RerunBridge(Node):
+    """Buffers telemetry rows and hands them to a :class:`Dashboard` in batches."""
+
+    def __init__(self, dashboard: Dashboard, flush_hz: float = 4.0,
+                 status_period_s: float = 2.0, best_effort: bool = False) -> None:
+        super().__init__(NODE_NAME)
+        self._dashboard = dashboard
+        self._pending: list[np.ndarray] = []
+        self._order: np.ndarray | None = None
+        self.dropped = 0
+        self._status_period_s = status_period_s
+        self._last_status = (time.monotonic(), 0)
+        reliability = ReliabilityPolicy.BEST_EFFORT if best_effort else ReliabilityPolicy.RELIABLE
+        qos = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=QUEUE_DEPTH,
+                         reliability=reliability)
+        self.create_subscription(Float64MultiArray, topics.TELEMETRY, self._on_telemetry, qos)
+        self.create_timer(1.0 / flush_hz, self.flush)
+
+    def _on_telemetry(self, msg: Float64MultiArray) -> None:
+        if self._order is None:
+            self._order = field_order([d.label for d in msg.layout.dim])
+        if len(msg.data) < N_FIELDS:
+            self.dropped += 1
+            return
+        self._pending.append(np.frombuffer(msg.data, dtype=np.float64))
+
+    def flush(self) -> None:
+        """Log the buffered samples in one batch, then maybe print the status line."""
+        if self._pending:
+            rows, self._pending = self._pending, []
+            self._dashboard.log_batch(TelemetryBatch.from_rows(np.stack(rows), self._order))
+        self._status(force=False)
+
+    def _status(self, force: bool) -> None:
+        now, count = time.monotonic(), self._dashboard.samples
+        if count == self._last_status[1] or (
+                not force and now - self._last_status[0] < self._status_period_s):
+            return
+        self._last_status = (now, count)
+        sim_time = self._dashboard.last_time_s or 0.0
+        self.get_logger().info(f"{count} telemetry samples logged, sim_time {sim_time:.3f} s, "
+                               f"{self.dropped} malformed")
+
+    def finish(self) -> None:
+        """Flush what is buffered and report the final count."""
+        self.flush()
+        self._status(force=True)
+
+
+def parse_args(argv: list[str]) -> argparse.Namespace:
+    parser = argparse.ArgumentParser(prog="rerun_bridge", description=__doc__.splitlines()[0])
+    parser.add_argument("--save", metavar="FILE.rrd", help="write the recording to this file")
+    parser.add_argument("--connect", metavar="URL", nargs="?", const=DEFAULT_VIEWER_URL,
+                        help=f"stream to a viewer (default URL {DEFAULT_VIEWER_URL})")
+    parser.add_argument("--serve", action="store_true",
+                        help="host a gRPC server on 127.0.0.1 for viewers to connect to")
+    parser.add_argument("--serve-port", type=int, default=DEFAULT_SERVE_PORT)
+    parser.add_argument("--preset", default=DEFAULT_PRESET,
+                        help="model preset of the running sim (scales of the 2D views)")
+    parser.add_argument("--window-s", type=float, default=None,
+                        help="sliding window for E-S and severity, s (default 20 t*)")
+    parser.add_argument("--flush-hz", type=float, default=4.0)
+    parser.add_argument("--best-effort", action="store_true",
+                        help="subscribe best-effort (default: reliable)")
+    args = parser.parse_args(argv)
+    if not (args.save or args.connect or args.serve):
+        args.connect = DEFAULT_VIEWER_URL
+    return args
+
+
+def make_dashboard(args: argparse.Namespace) -> Dashboard:
+    units = PaperUnits.load(args.preset)
+    window = default_window_s(units) if args.window_s is None else args.window_s
+    rec = open_recording(build_blueprint(window), save=args.save, connect=args.connect,
+                         serve_port=args.serve_port if args.serve else None)
+    return Dashboard(rec, units, window)
+
+
+def main(argv: list[str] | None = None) -> None:
+    disable_analytics()
+    argv = sys.argv if argv is None else argv
+    args = parse_args(remove_ros_args(argv)[1:])
+    rclpy.init(args=argv)
+    dashboard = make_dashboard(args)
+    node = RerunBridge(dashboard, args.flush_hz, best_effort=args.best_effort)
+    try:
+        rclpy.spin(node)
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        node.finish()
+        node.destroy_node()
+        rclpy.try_shutdown()
+        close_recording(dashboard.rec)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,60 @@
+"""The offline CLI answers for the Fig. 8 cases (subprocess, as a user runs it)."""
+
+from __future__ import annotations
+
+import csv
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+REQUIRED = ("first_stick_tau", "bounce_tau", "stick_fraction", "kappa", "mean_torque",
+            "mean_depth_of_cut", "mean_wob", "omega_min", "omega_max", "trivial_torque",
+            "trivial_depth_of_cut", "critical_delay", "growth_rate", "steps", "kernel_seconds")
+
+
+def drill_sim(*args: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([sys.executable, "-m", "drill_sim_ros.cli", *args],
+                          capture_output=True, text=True, timeout=240)
+
+
+@pytest.mark.parametrize(("beta", "sticks"), [("0.3", True), ("1.3", False)])
+def test_run_json_fig8(beta: str, sticks: bool, tmp_path: Path) -> None:
+    trace = tmp_path / "trace.csv"
+    result = drill_sim("run", "--n", "6", "--psi", "50", "--beta", beta, "--lam", "5",
+                       "--w0", "7", "--omega0", "5", "--tau-end", "300", "--dtau", "1e-4",
+                       "--average-from", "150", "--json", "--trace", str(trace),
+                       "--trace-every", "1000")
+    assert result.returncode == 0, result.stderr
+    out = json.loads(result.stdout)
+    assert set(REQUIRED) <= set(out)
+    assert out["steps"] == 3_000_000
+    assert (out["first_stick_tau"] is not None) == sticks
+    assert out["trivial_torque"] == pytest.approx(7 + 5 * (float(beta) - 1))     # eq. 34
+    with trace.open() as stream:
+        rows = list(csv.DictReader(stream))
+    assert list(rows[0]) == ["tau", "omega", "v", "wob", "tob", "depth_of_cut",
+                             "surface_torque", "mode"]
+    assert len(rows) == 3000
+    assert float(rows[1]["tau"]) == pytest.approx(0.1)
+
+
+def test_physical_preset_reports_si(tmp_path: Path) -> None:
+    result = drill_sim("run", "--params", "field_8p5in_shale", "--t-end", "5", "--json")
+    assert result.returncode == 0, result.stderr
+    si = json.loads(result.stdout)["si"]
+    assert si["t_star_s"] > 0 and si["mean_wob_n"] > 0
+
+
+def test_bad_argument_is_named_with_nonzero_exit() -> None:
+    result = drill_sim("run", "--psi", "-3", "--tau-end", "1")
+    assert result.returncode == 2
+    assert "'psi'" in result.stderr
+
+
+def test_readable_summary() -> None:
+    result = drill_sim("run", "--tau-end", "20")
+    assert result.returncode == 0, result.stderr
+    assert "kappa" in result.stdout and "first stick" in result.stdout
