@@ -333,6 +333,7 @@ class SimNode(Node):
 
     def _on_run_limit(self) -> None:
         self._stop_timer.cancel()
+        self._status.close()
         self.get_logger().info(f"run_seconds = {self._values['run_seconds']:g} reached")
         if not self.finished.done():
             self.finished.set_result(True)
