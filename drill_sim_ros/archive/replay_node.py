@@ -1,0 +1,208 @@
+"""``mcap_replay``: republish a recording with its original types and timing.
+
+    mcap_replay FILE [--rate R] [--loop] [--start-offset S] [--topics REGEX] [--clock]
+
+Messages are sent as the stored CDR bytes (``publisher.publish(bytes)``: no decode, no
+re-encode) on publishers of the recorded types and offered QoS, spaced by their log times
+divided by R. ``--clock`` publishes /clock (rosgraph_msgs/Clock) from the log time, so nodes
+with use_sim_time follow the replay. A missing or non-MCAP file is an error (exit 2); of a
+truncated or corrupt file, the readable part is replayed with a warning (exit 1).
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import re
+import sys
+import time
+from dataclasses import dataclass
+
+import rclpy
+from builtin_interfaces.msg import Time
+from rclpy.executors import ExternalShutdownException
+from rclpy.node import Node
+from rclpy.publisher import Publisher
+from rclpy.qos import QoSProfile
+from rclpy.utilities import remove_ros_args
+from rosgraph_msgs.msg import Clock
+
+from drill_sim_ros.archive.errors import ArchiveError
+from drill_sim_ros.archive.pacing import Pacer
+from drill_sim_ros.archive.qos import replay_qos
+from drill_sim_ros.archive.reader import ArchiveReader, RecordedChannel
+from drill_sim_ros.archive.ros_types import message_class
+from drill_sim_ros.archive.status import StatusLine
+
+_log = logging.getLogger(__name__)
+
+PROGRESS_PERIOD_S = 0.2
+CLOCK_TOPIC = "/clock"
+
+
+@dataclass
+class Plan:
+    """What a replay will send: the channels and the log-time extent (ns)."""
+
+    channels: list[RecordedChannel]
+    first_log_ns: int
+    last_log_ns: int
+
+
+def plan(reader: ArchiveReader, topics: re.Pattern[str]) -> Plan:
+    """Channels and time extent, from one pass over the file (which needs no summary)."""
+    first, last = None, 0
+    for message in reader.messages(topics.fullmatch):
+        first = message.log_time_ns if first is None else min(first, message.log_time_ns)
+        last = max(last, message.log_time_ns)
+    chosen = [c for c in reader.channels.values() if topics.fullmatch(c.topic)]
+    return Plan(chosen, first or 0, last)
+
+
+class Replayer:
+    """Publishers for the recorded topics (plus /clock) on one node."""
+
+    def __init__(self, node: Node, channels: list[RecordedChannel], clock: bool) -> None:
+        self.node = node
+        self.publishers: dict[int, Publisher] = {}
+        for channel in channels:
+            self._add(channel)
+        qos = QoSProfile(depth=100)
+        self.clock = node.create_publisher(Clock, CLOCK_TOPIC, qos) if clock else None
+        self.sent = 0
+
+    def _add(self, channel: RecordedChannel) -> None:
+        try:
+            msg_class = message_class(channel.type_name)
+        except ArchiveError as exc:
+            _log.warning("not replaying %s: %s", channel.topic, exc)
+            return
+        qos = replay_qos(channel.offered_qos_yaml)
+        self.publishers[channel.channel_id] = self.node.create_publisher(
+            msg_class, channel.topic, qos
+        )
+
+    def wait_for_subscribers(self, timeout_s: float) -> bool:
+        """Wait (bounded) until every topic has a subscriber; True if they all do."""
+        deadline = time.monotonic() + timeout_s
+        while time.monotonic() < deadline and rclpy.ok():
+            if all(p.get_subscription_count() > 0 for p in self.publishers.values()):
+                return True
+            time.sleep(0.02)
+        return False
+
+    def publish_clock(self, log_time_ns: int) -> None:
+        sec, nanosec = divmod(log_time_ns, 1_000_000_000)
+        self.clock.publish(Clock(clock=Time(sec=sec, nanosec=nanosec)))
+
+
+class Progress:
+    """The terminal progress line: replayed log time, fraction, messages sent."""
+
+    def __init__(self, extent: Plan, rate: float) -> None:
+        self._line = StatusLine()
+        self._extent = extent
+        self._rate = rate
+        self._next_s = 0.0
+
+    def update(self, log_time_ns: int, sent: int, force: bool = False) -> None:
+        now = time.monotonic()
+        if not force and now < self._next_s:
+            return
+        self._next_s = now + PROGRESS_PERIOD_S
+        total = max(1, self._extent.last_log_ns - self._extent.first_log_ns)
+        done = log_time_ns - self._extent.first_log_ns
+        self._line.show(f"[mcap_replay] {done / 1e9:8.2f} / {total / 1e9:.2f} s "
+                        f"({100 * done / total:5.1f} %)  {sent} msgs  x{self._rate:g}")
+
+    def end(self) -> None:
+        self._line.end()
+
+
+def play_once(reader: ArchiveReader, replayer: Replayer, pacer: Pacer, options: argparse.Namespace,
+              progress: Progress) -> bool:
+    """Replay the file once; False if interrupted."""
+    topics = re.compile(options.topics)
+    start_ns = pacer.first_log_ns
+    last_clock_ns = None
+    for message in reader.messages(topics.fullmatch):
+        publisher = replayer.publishers.get(message.channel.channel_id)
+        if publisher is None or message.log_time_ns < start_ns:
+            continue
+        if not pacer.wait_until(message.log_time_ns, rclpy.ok):
+            return False
+        if replayer.clock is not None and message.log_time_ns != last_clock_ns:
+            replayer.publish_clock(message.log_time_ns)
+            last_clock_ns = message.log_time_ns
+        publisher.publish(message.data)
+        replayer.sent += 1
+        progress.update(message.log_time_ns, replayer.sent)
+    return True
+
+
+def _parse(argv: list[str]) -> argparse.Namespace:
+    parser = argparse.ArgumentParser(prog="mcap_replay", description=__doc__.splitlines()[0])
+    parser.add_argument("file", help="MCAP file to replay")
+    parser.add_argument("--rate", type=float, default=1.0, help="speed factor (default 1)")
+    parser.add_argument("--loop", action="store_true", help="start over at the end")
+    parser.add_argument("--start-offset", type=float, default=0.0, metavar="S",
+                        help="skip the first S seconds of log time")
+    parser.add_argument("--topics", default=".*", help="regex of topics to replay (default all)")
+    parser.add_argument("--clock", action="store_true", help="publish /clock from log time")
+    parser.add_argument("--delay", type=float, default=0.5, metavar="S",
+                        help="wait S seconds after creating publishers (discovery)")
+    parser.add_argument("--wait-for-subscribers", type=float, default=0.0, metavar="S",
+                        help="wait up to S seconds for a subscriber on every topic")
+    args = parser.parse_args(argv)
+    if not args.rate > 0 or args.start_offset < 0 or args.delay < 0:
+        parser.error("--rate must be > 0; --start-offset and --delay must be >= 0")
+    try:
+        re.compile(args.topics)
+    except re.error as exc:
+        parser.error(f"bad --topics regex: {exc}")
+    return args
+
+
+def _replay(reader: ArchiveReader, extent: Plan, options: argparse.Namespace) -> None:
+    node = Node("mcap_replay")
+    replayer = Replayer(node, extent.channels, options.clock)
+    progress = Progress(extent, options.rate)
+    try:
+        if options.wait_for_subscribers > 0:
+            replayer.wait_for_subscribers(options.wait_for_subscribers)
+        time.sleep(options.delay)
+        pacer = Pacer(extent.first_log_ns + int(options.start_offset * 1e9), options.rate)
+        while play_once(reader, replayer, pacer, options, progress) and options.loop:
+            pacer.restart()
+        progress.update(extent.last_log_ns, replayer.sent, force=True)
+    finally:
+        progress.end()
+        _log.info("sent %d messages", replayer.sent)
+        node.destroy_node()
+
+
+def main(args: list[str] | None = None) -> int:
+    logging.basicConfig(level=logging.INFO, format="[mcap_replay] %(levelname)s %(message)s")
+    argv = sys.argv if args is None else args
+    options = _parse(remove_ros_args(argv)[1:])
+    try:
+        reader = ArchiveReader(options.file)
+    except ArchiveError as exc:
+        _log.error("%s", exc)
+        return 2
+    extent = plan(reader, re.compile(options.topics))
+    if not extent.channels:
+        _log.error("%s: no readable messages on topics matching %r", options.file, options.topics)
+        return 2
+    rclpy.init(args=argv)
+    try:
+        _replay(reader, extent, options)
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        rclpy.try_shutdown()
+    return 1 if reader.problem else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
