@@ -22,7 +22,8 @@ class EntityData:
     static: dict[str, list] = field(default_factory=dict)
 
     def scalars(self) -> np.ndarray:
-        return np.array([v[0] for v in self.columns["Scalars:scalars"]], dtype=np.float64)
+        values = self.columns.get("Scalars:scalars", [])
+        return np.array([v[0] for v in values], dtype=np.float64)
 
     def points(self) -> np.ndarray:
         return np.array([v[0] for v in self.columns["Points2D:positions"]], dtype=np.float64)

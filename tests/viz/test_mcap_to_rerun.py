@@ -1,0 +1,156 @@
+"""A recorded run (MCAP written by mcap_ros2 from the real Simulator) through mcap_to_rerun."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from mcap.reader import make_reader
+
+from drill_sim_ros import topics
+from drill_sim_ros.model.presets import load_preset
+from tests.viz import expected as ex
+from tests.viz.rrd_read import read_recording, view_origins
+from tests.viz.sim_telemetry import telemetry_rows, write_mcap
+
+PRESET = "field_8p5in_shale"
+SECONDS = 40.0
+F = topics.TELEMETRY_INDEX
+
+
+def run_cli(*args: str) -> subprocess.CompletedProcess:
+    exe = Path(sys.prefix) / "bin" / "mcap_to_rerun"
+    return subprocess.run([str(exe), *args], capture_output=True, text=True, timeout=120,
+                          check=False)
+
+
+@pytest.fixture(scope="module")
+def run(tmp_path_factory: pytest.TempPathFactory) -> dict:
+    tmp = tmp_path_factory.mktemp("mcap_to_rerun")
+    preset = load_preset(PRESET)
+    rows = telemetry_rows(preset, SECONDS)
+    mcap, rrd = tmp / "run.mcap", tmp / "run.rrd"
+    write_mcap(mcap, rows)
+    proc = run_cli(str(mcap), "-o", str(rrd))
+    assert proc.returncode == 0, proc.stderr
+    with open(mcap, "rb") as stream:
+        summary = make_reader(stream).get_summary()
+    channel = next(c.id for c in summary.channels.values() if c.topic == topics.TELEMETRY)
+    count = summary.statistics.channel_message_counts[channel]
+    return {"rows": rows, "preset": preset, "rrd": rrd, "count": count,
+            "data": read_recording(rrd), "window_s": 20.0 * preset.scales.time_s}
+
+
+def test_input_is_a_stick_slip_run(run: dict) -> None:
+    modes = run["rows"][:, F["mode"]]
+    assert run["count"] == len(run["rows"]) > 1000
+    assert np.any(modes == ex.STUCK), "the test run should contain stick phases"
+
+
+def test_blueprint_is_stored_and_every_view_has_data(run: dict) -> None:
+    origins = set(view_origins(run["rrd"]).values())
+    assert origins == ex.VIEW_ORIGINS
+    for origin in origins:
+        assert any(path == origin or path.startswith(origin + "/") for path in run["data"]), origin
+
+
+@pytest.mark.parametrize("path", [*ex.SCALARS, "/phase_portrait/trajectory",
+                                  "/bottom_hole/pattern", "/severity/ssi",
+                                  "/severity/stick_fraction"])
+def test_sample_counts_equal_message_count(run: dict, path: str) -> None:
+    data = run["data"][path]
+    assert len(data.time_ns) == run["count"]
+    assert np.all(np.abs(data.time_ns - run["rows"][:, F["sim_time_s"]] * 1e9) <= 1.0)
+
+
+@pytest.mark.parametrize("path", list(ex.SCALARS))
+def test_scalar_values_round_trip(run: dict, path: str) -> None:
+    field, factor = ex.SCALARS[path]
+    np.testing.assert_allclose(run["data"][path].scalars(), run["rows"][:, F[field]] * factor,
+                               rtol=1e-15, atol=0.0)
+
+
+def test_phase_markers_sit_on_stick_and_off_bottom_samples(run: dict) -> None:
+    rows, data = run["rows"], run["data"]
+    for path, field, factor, mode in (("/timeseries/rpm/stick", "bit_rpm", 1.0, ex.STUCK),
+                                      ("/timeseries/wob/off_bottom", "wob_n", 1e-3,
+                                       ex.OFF_BOTTOM)):
+        sel = rows[:, F["mode"]] == mode
+        got = data[path].scalars()
+        np.testing.assert_array_equal(got, rows[sel, F[field]] * factor)
+
+
+def test_phase_portrait_and_bottom_hole_points(run: dict) -> None:
+    for path, want in (("/phase_portrait/trajectory", ex.phase_portrait),
+                       ("/bottom_hole/pattern", ex.bottom_hole)):
+        expected = want(run["rows"], run["preset"])
+        got = run["data"][path].points()
+        np.testing.assert_allclose(got, expected, rtol=1e-6, atol=1e-6 * np.abs(expected).max())
+    colors = np.array(run["data"]["/phase_portrait/trajectory"].columns["Points2D:colors"])
+    stuck = run["rows"][:, F["mode"]] == ex.STUCK
+    assert len(np.unique(colors[stuck])) == 1
+    assert not np.isin(colors[~stuck], colors[stuck]).any()
+
+
+def test_severity_matches_analysis_severity_over_the_window(run: dict) -> None:
+    rows, data, window_s = run["rows"], run["data"], run["window_s"]
+    ssi, stick = data["/severity/ssi"].scalars(), data["/severity/stick_fraction"].scalars()
+    for i in np.linspace(10, len(rows) - 1, 25).astype(int):
+        want_ssi, want_stick = ex.severity_at(rows, i, window_s)
+        assert stick[i] == pytest.approx(want_stick, abs=1e-12)
+        if np.isfinite(want_ssi):
+            assert ssi[i] == pytest.approx(want_ssi, rel=1e-9)
+        else:
+            assert np.isnan(ssi[i])
+
+
+def test_es_running_average_matches_eq_48_in_si(run: dict) -> None:
+    rows, data, window_s = run["rows"], run["data"], run["window_s"]
+    es = data["/es_diagram/running_average"]
+    t_ns = es.time_ns
+    points = es.points()
+    index = {t: k for k, t in enumerate(t_ns)}
+    times = np.round(rows[:, F["sim_time_s"]] * 1e9).astype(np.int64)
+    checked = 0
+    for i in np.linspace(100, len(rows) - 1, 25).astype(int):
+        energy, strength = ex.es_at(rows, i, window_s, run["preset"])
+        k = index.get(times[i], index.get(times[i] - 1, index.get(times[i] + 1)))
+        if not (np.isfinite(energy) and ex.window(rows, i, window_s)[:, F["depth_of_cut_m"]]
+                .mean() > 0):
+            assert k is None
+            continue
+        assert points[k] == pytest.approx([strength, -energy], rel=1e-5)
+        checked += 1
+    assert checked > 0
+
+
+def test_friction_line_follows_eq_50(run: dict) -> None:
+    static = run["data"]["/es_diagram/friction_line"].static
+    (strip,) = static["LineStrips2D:strips"][0]
+    (s1, e1), (s2, e2) = strip
+    beta = run["preset"].params.beta
+    assert (s1, -e1) == pytest.approx((1.0, 1.0))
+    assert -e2 == pytest.approx(1.0 - beta + beta * s2, rel=1e-6)
+
+
+def test_missing_telemetry_is_a_clear_error(tmp_path: Path) -> None:
+    empty = tmp_path / "empty.mcap"
+    write_mcap(empty, np.empty((0, len(topics.TELEMETRY_FIELDS))))
+    proc = run_cli(str(empty), "-o", str(tmp_path / "x.rrd"))
+    assert proc.returncode == 1
+    assert "/drill/telemetry" in proc.stderr
+
+
+def test_preset_comes_from_the_file_metadata(tmp_path: Path) -> None:
+    rows = telemetry_rows(load_preset("fig5_8a"), 5.0)
+    mcap, rrd = tmp_path / "fig5.mcap", tmp_path / "fig5.rrd"
+    write_mcap(mcap, rows, metadata={"preset": "fig5_8a"})
+    assert run_cli(str(mcap), "-o", str(rrd)).returncode == 0
+    info = read_recording(rrd)["/info"].static["TextDocument:text"][0][0]
+    assert "fig5_8a" in info
+    expected = ex.phase_portrait(rows, load_preset("fig5_8a"))
+    np.testing.assert_allclose(read_recording(rrd)["/phase_portrait/trajectory"].points(),
+                               expected, rtol=1e-6, atol=1e-6)
