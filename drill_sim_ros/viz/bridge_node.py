@@ -122,17 +122,22 @@ def main(argv: list[str] | None = None) -> None:
     argv = sys.argv if argv is None else argv
     args = parse_args(remove_ros_args(argv)[1:])
     rclpy.init(args=argv)
-    dashboard = make_dashboard(args)
-    node = RerunBridge(dashboard, args.flush_hz, best_effort=args.best_effort)
+    dashboard: Dashboard | None = None
+    node: RerunBridge | None = None
     try:
+        dashboard = make_dashboard(args)
+        node = RerunBridge(dashboard, args.flush_hz, best_effort=args.best_effort)
+        node.get_logger().info(f"ready: {topics.TELEMETRY} -> rerun (preset {args.preset})")
         rclpy.spin(node)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:
-        node.finish()
-        node.destroy_node()
+        if node is not None:
+            node.finish()
+            node.destroy_node()
         rclpy.try_shutdown()
-        close_recording(dashboard.rec)
+        if dashboard is not None:
+            close_recording(dashboard.rec)
 
 
 if __name__ == "__main__":
