@@ -2,15 +2,27 @@
 
 from __future__ import annotations
 
+import os
 import re
 import signal
 import subprocess
 import sys
 import threading
 import time
+import uuid
 from pathlib import Path
 
 STATUS = re.compile(r"(\d+) telemetry samples logged")
+
+
+def private_topic(name: str = "telemetry") -> str:
+    """A topic no other session on this machine uses (domain ids can collide)."""
+    return f"/viz_test_{os.getpid()}_{uuid.uuid4().hex[:8]}/{name}"
+
+
+def remap_telemetry(topic: str) -> list[str]:
+    """ROS arguments that move the node's /drill/telemetry to ``topic``."""
+    return ["--ros-args", "-r", f"/drill/telemetry:={topic}"]
 
 
 class BridgeProcess:

@@ -16,13 +16,13 @@ from drill_sim_ros import topics
 class TelemetryPublisher:
     """Own context and node; ``publish(rows, rate_hz)`` paces the messages."""
 
-    def __init__(self, name: str = "viz_test_publisher") -> None:
+    def __init__(self, topic: str = topics.TELEMETRY, name: str = "viz_test_publisher") -> None:
         self.context = Context()
         rclpy.init(context=self.context)
         self.node = rclpy.create_node(name, context=self.context)
         qos = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1000,
                          reliability=ReliabilityPolicy.RELIABLE)
-        self.publisher = self.node.create_publisher(Float64MultiArray, topics.TELEMETRY, qos)
+        self.publisher = self.node.create_publisher(Float64MultiArray, topic, qos)
         label = ",".join(topics.TELEMETRY_FIELDS)
         n = len(topics.TELEMETRY_FIELDS)
         self._dim = MultiArrayDimension(label=label, size=n, stride=n)

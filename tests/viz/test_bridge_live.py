@@ -8,7 +8,7 @@ import pytest
 from drill_sim_ros import topics
 from drill_sim_ros.model.presets import load_preset
 from tests.viz import expected as ex
-from tests.viz.bridge_process import BridgeProcess
+from tests.viz.bridge_process import BridgeProcess, private_topic, remap_telemetry
 from tests.viz.rrd_read import read_recording, view_origins
 from tests.viz.sim_telemetry import telemetry_rows
 
@@ -24,8 +24,9 @@ def live(tmp_path_factory: pytest.TempPathFactory) -> dict:
     preset = load_preset(PRESET)
     rows = telemetry_rows(preset, 8.0)
     rrd = tmp_path_factory.mktemp("bridge") / "live.rrd"
-    bridge = BridgeProcess("--save", str(rrd), "--preset", PRESET)
-    publisher = TelemetryPublisher()
+    topic = private_topic()
+    bridge = BridgeProcess("--save", str(rrd), "--preset", PRESET, *remap_telemetry(topic))
+    publisher = TelemetryPublisher(topic)
     try:
         assert publisher.wait_for_subscriber(30.0), bridge.output()
         publisher.publish(rows, rate_hz=400.0)
