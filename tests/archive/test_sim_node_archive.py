@@ -1,0 +1,80 @@
+"""The real sim_node, recorded in lockstep: in process (record.path) and over DDS (mcap_recorder).
+
+In lockstep every ~/step publishes exactly one sample on each data topic and /clock, so the
+recorded counts must equal the number of steps exactly; /diagnostics (1 Hz wall) is only
+checked against the file's own statistics.
+"""
+
+from __future__ import annotations
+
+import signal
+import time
+
+import pytest
+from std_srvs.srv import Trigger
+
+from drill_sim_ros import topics
+from tests.archive.helpers import (
+    counts_mcap_ros2,
+    counts_rosbags,
+    running,
+    statistics_counts,
+    stop,
+    wait_for,
+)
+from tests.archive.ros_fixtures import ros_node
+
+pytestmark = pytest.mark.ros
+
+STEPS = 40
+SAMPLE_TOPICS = [t for t in topics.MSG_TYPES
+                 if t not in (topics.CMD_SURFACE_RPM, topics.CMD_WOB, topics.DIAGNOSTICS)]
+
+
+def _sim_command(*params: str) -> list[str]:
+    args = ["lockstep:=true", "status_line:=false", *params]
+    return ["sim_node", "--ros-args", *[a for p in args for a in ("-p", p)]]
+
+
+def _step(node, count: int) -> None:
+    client = node.create_client(Trigger, f"/{topics.NODE_NAME}/step")
+    assert client.wait_for_service(timeout_sec=30), "sim_node's ~/step never appeared"
+    for _ in range(count):
+        future = client.call_async(Trigger.Request())
+        assert wait_for(future.done, 10), "~/step did not answer"
+        assert future.result().success, future.result().message
+
+
+def _check(path) -> None:
+    counts = counts_mcap_ros2(path)
+    assert counts == counts_rosbags(path) == statistics_counts(path)
+    assert {t: counts[t] for t in SAMPLE_TOPICS} == dict.fromkeys(SAMPLE_TOPICS, STEPS)
+
+
+def test_lockstep_in_process_recording_is_exact(tmp_path) -> None:
+    path = tmp_path / "inprocess.mcap"
+    with running(_sim_command(f"record.path:={path}"), tmp_path / "sim.log") as sim, \
+            ros_node("test_stepper") as node:
+        _step(node, STEPS)
+        assert stop(sim, signal.SIGINT) == 0, (tmp_path / "sim.log").read_text()
+    _check(path)
+    assert "0 dropped" in (tmp_path / "sim.log").read_text()
+
+
+def _recorder_ready(node) -> bool:
+    return all(node.count_subscribers(t) > 0 for t in SAMPLE_TOPICS)
+
+
+def test_lockstep_sim_recorded_over_dds_is_exact(tmp_path) -> None:
+    path = tmp_path / "dds.mcap"
+    recorder_cmd = ["mcap_recorder", "-o", str(path)]
+    with running(_sim_command(), tmp_path / "sim.log") as sim, \
+            running(recorder_cmd, tmp_path / "rec.log") as recorder, \
+            ros_node("test_stepper") as node:
+        assert wait_for(lambda: _recorder_ready(node), 30), "recorder never subscribed"
+        time.sleep(0.3)
+        _step(node, STEPS)
+        time.sleep(0.5)
+        assert stop(recorder, signal.SIGINT) == 0, (tmp_path / "rec.log").read_text()
+        stop(sim, signal.SIGINT)
+    _check(path)
