@@ -1,0 +1,340 @@
+"""sim_node over loopback DDS: topics, physics of the published means, commands, parameters,
+reset, pause/step, numerical faults and wall-clock pacing (issue 3)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from diagnostic_msgs.msg import DiagnosticStatus
+from rcl_interfaces.srv import GetParameters, SetParameters
+from rclpy.duration import Duration
+from rclpy.parameter import Parameter
+from std_msgs.msg import Float64
+from std_srvs.srv import SetBool, Trigger
+
+from drill_sim_ros import topics
+from drill_sim_ros.model.errors import NumericalFault
+from drill_sim_ros.model.params import RPM_PER_RAD_S
+from drill_sim_ros.model.presets import load_preset
+from drill_sim_ros.ros.parameters import submerged_string_weight_n
+from drill_sim_ros.ros.sim_node import SAMPLE_TOPICS, SimNode
+from tests.ros import physics
+from tests.ros.harness import Probe, Ros, overrides, ros_context
+
+pytestmark = pytest.mark.ros
+F = topics.TELEMETRY_INDEX
+FIELD = "field_8p5in_shale"
+PERIOD_S = 0.01          # publish_rate_hz 100 (the default)
+NODE = f"/{topics.NODE_NAME}"
+FAST = 20.0             # a real-time factor the probe keeps up with
+
+
+@pytest.fixture
+def ros():
+    with ros_context() as r:
+        yield r
+
+
+def start_node(ros: Ros, **params) -> SimNode:
+    params.setdefault("status_line", False)
+    return ros.add(SimNode(context=ros.context, parameter_overrides=overrides(**params)))
+
+
+def start_probe(ros: Ros, topic_names, raw: bool = False) -> Probe:
+    return ros.add(Probe(ros.context, topic_names, raw=raw))
+
+
+def sim_time_reached(probe: Probe, t_s: float):
+    msgs = probe.received[topics.TELEMETRY]
+    return lambda: bool(msgs) and msgs[-1][1].data[F["sim_time_s"]] >= t_s
+
+
+def publish_acked(ros: Ros, probe: Probe, topic: str, value: float) -> None:
+    """Publish a command and wait until the node's subscription has acknowledged it."""
+    pub = getattr(probe, "_cmd_pubs", {}).get(topic)
+    if pub is None:
+        pub = probe.create_publisher(Float64, topic, 10)
+        probe.__dict__.setdefault("_cmd_pubs", {})[topic] = pub
+    assert ros.spin_until(lambda: pub.get_subscription_count() > 0, 10.0)
+    pub.publish(Float64(data=value))
+    assert pub.wait_for_all_acked(Duration(seconds=5))
+
+
+def diagnostic_values(array_msg) -> dict[str, str]:
+    return {kv.key: kv.value for status in array_msg.status for kv in status.values}
+
+
+def stamp_s(header) -> float:
+    return header.stamp.sec + header.stamp.nanosec * 1e-9
+
+
+# ---- every topic -------------------------------------------------------------------------
+def test_every_topic_published_with_its_type_and_one_stamp_per_sample(ros):
+    node = start_node(ros, real_time_factor=2.0)
+    all_topics = (*SAMPLE_TOPICS, topics.CLOCK, topics.DIAGNOSTICS)
+    probe = start_probe(ros, all_topics)
+    count = 300
+    paced = (*SAMPLE_TOPICS, topics.CLOCK)
+    assert ros.spin_until(lambda: all(probe.count(t) >= count for t in paced)
+                          and probe.count(topics.DIAGNOSTICS) >= 1, 20.0), {
+        t: probe.count(t) for t in all_topics}
+    for topic in all_topics:
+        expected = topics.MSG_TYPES[topic].replace("/msg/", ".msg.").split(".")
+        msg = probe.messages(topic)[0]
+        assert type(msg).__module__.startswith(f"{expected[0]}.msg"), topic
+        assert type(msg).__name__ == expected[2], topic
+
+    tele = probe.messages(topics.TELEMETRY)[:count]
+    dim = tele[0].layout.dim[0]
+    assert dim.label == ",".join(topics.TELEMETRY_FIELDS)
+    assert dim.size == len(topics.TELEMETRY_FIELDS)
+    rows = physics.telemetry_rows(tele)
+    t = rows[:, F["sim_time_s"]]
+    assert t[0] == 0.0 and physics.consecutive(t, PERIOD_S)
+
+    # One sample, one stamp, one set of values on every topic.
+    bit = probe.messages(topics.BIT_JOINT_STATES)[:count]
+    surf = probe.messages(topics.SURFACE_JOINT_STATES)[:count]
+    clock = probe.messages(topics.CLOCK)[:count]
+    for i in range(count):
+        assert stamp_s(bit[i].header) == pytest.approx(t[i], abs=1e-9)
+        assert stamp_s(surf[i].header) == pytest.approx(t[i], abs=1e-9)
+        assert clock[i].clock.sec + clock[i].clock.nanosec * 1e-9 == pytest.approx(t[i], abs=1e-9)
+    scalar = {topics.BIT_WOB: "wob_n", topics.BIT_TOB: "tob_nm", topics.BIT_ROP: "rop_m_s",
+              topics.BIT_RPM: "bit_rpm", topics.BIT_DEPTH_OF_CUT: "depth_of_cut_m",
+              topics.BIT_MODE: "mode"}
+    for topic, name in scalar.items():
+        values = [m.data for m in probe.messages(topic)[:count]]
+        np.testing.assert_array_equal(values, rows[:, F[name]], err_msg=topic)
+
+    assert list(bit[0].name) == list(topics.BIT_JOINTS)
+    assert list(surf[0].name) == list(topics.SURFACE_JOINTS)
+    bit_arr = np.array([[*m.position, *m.velocity, *m.effort] for m in bit])
+    np.testing.assert_allclose(bit_arr[:, 0], rows[:, F["bit_angle_rad"]])
+    np.testing.assert_allclose(bit_arr[:, 1], rows[:, F["bit_depth_m"]])
+    np.testing.assert_allclose(bit_arr[:, 2] * RPM_PER_RAD_S, rows[:, F["bit_rpm"]])
+    np.testing.assert_allclose(bit_arr[:, 3], rows[:, F["rop_m_s"]])
+    np.testing.assert_allclose(bit_arr[:, 4:], rows[:, [F["tob_nm"], F["wob_n"]]])
+    surf_arr = np.array([[*m.position, *m.velocity, *m.effort] for m in surf])
+    np.testing.assert_allclose(surf_arr[:, 0], rows[:, F["surface_angle_rad"]])
+    np.testing.assert_allclose(surf_arr[:, 2] * RPM_PER_RAD_S, rows[:, F["surface_rpm"]])
+    np.testing.assert_allclose(surf_arr[:, 4], rows[:, F["surface_torque_nm"]])
+    np.testing.assert_allclose(surf_arr[:, 5], rows[:, F["hook_load_n"]])
+
+    # Plausible values for the field preset (60 rpm, 60 kN, 2500 m of 5-in pipe + 200 m BHA).
+    preset = load_preset(FIELD)
+    wob0 = preset.physical.applied_wob_n
+    np.testing.assert_allclose(rows[:, F["surface_rpm"]], preset.physical.surface_rpm)
+    np.testing.assert_allclose(rows[:, F["applied_wob_n"]], wob0)
+    weight = node.get_parameter("model.submerged_string_weight_n").value
+    assert weight == pytest.approx(submerged_string_weight_n(preset))
+    np.testing.assert_allclose(rows[:, F["hook_load_n"]], weight - wob0)
+    assert np.all(rows[:, F["bit_rpm"]] >= 0.0)            # eq. (32): the bit never backs up
+    assert np.all(rows[:, F["wob_n"]] >= 0.0)              # contact forces push
+    assert set(np.unique(rows[:, F["mode"]])) <= {0.0, 1.0, 2.0, 3.0}
+    assert np.all(rows[:, F["wearflat_wob_n"]] <= rows[:, F["wob_n"]] + 1e-9)
+
+    diag = probe.messages(topics.DIAGNOSTICS)[0]
+    names = [s.name for s in diag.status]
+    assert names == [f"{topics.NODE_NAME}: simulation", f"{topics.NODE_NAME}: bit dynamics"]
+    keys = diagnostic_values(diag)
+    for key in ("mode", "stick_slip_severity", "stick_fraction", "real_time_factor_achieved",
+                "overruns", "rejected_commands", "recorder_dropped"):
+        assert key in keys, key
+
+
+# ---- physics of the published means -------------------------------------------------------
+def run_field(ros: Ros, until_s: float, command_at_s: float | None = None,
+              command_rpm: float = 0.0) -> np.ndarray:
+    """Run the field preset to ``until_s`` (optionally commanding a new rpm).
+
+    20 x real time: fast, yet slow enough for the probe to take every sample.
+    """
+    start_node(ros, real_time_factor=FAST)
+    probe = start_probe(ros, [topics.TELEMETRY])
+    if command_at_s is not None:
+        assert ros.spin_until(sim_time_reached(probe, command_at_s), 30.0)
+        publish_acked(ros, probe, topics.CMD_SURFACE_RPM, command_rpm)
+    assert ros.spin_until(sim_time_reached(probe, until_s), 60.0)
+    rows = physics.telemetry_rows(probe.messages(topics.TELEMETRY))
+    assert physics.consecutive(rows[:, F["sim_time_s"]], PERIOD_S)
+    return rows
+
+
+def test_mean_wob_and_bit_rpm_equal_the_setpoints_over_whole_cycles(ros):
+    preset = load_preset(FIELD)
+    rows = run_field(ros, until_s=90.0)
+    rpm0, wob0 = preset.physical.surface_rpm, preset.physical.applied_wob_n
+    a, b = physics.cycle_window(rows, rpm0, t_from_s=30.0)
+    assert np.any(rows[a:b, F["mode"]] == 2), "the field preset should be in stick-slip"
+    assert b - a > 1000, "need several whole cycles"
+    mean_wob = rows[a:b, F["wob_n"]].mean()
+    expected, tol = physics.wob_expectation(rows, a, b, preset)
+    assert expected == pytest.approx(wob0, rel=1e-3)       # whole cycles: <W> = W_app
+    assert abs(mean_wob - expected) <= tol
+    mean_rpm = rows[a:b, F["bit_rpm"]].mean()
+    expected, tol = physics.rpm_expectation(rows, a, b, preset)
+    assert abs(mean_rpm - expected) <= tol
+    assert abs(mean_rpm - rpm0) <= tol + abs(expected - rpm0)
+    assert abs(expected - rpm0) < 0.02 * rpm0               # whole cycles: bounded twist
+
+
+def test_surface_rpm_command_moves_the_mean_bit_rpm(ros):
+    preset = load_preset(FIELD)
+    rpm0, rpm1 = preset.physical.surface_rpm, 100.0
+    rows = run_field(ros, until_s=80.0, command_at_s=10.0, command_rpm=rpm1)
+    surface = rows[:, F["surface_rpm"]]
+    changed = np.nonzero(surface != surface[0])[0]
+    assert changed.size and np.all(np.isclose(surface[changed[0]:], rpm1))
+    t_cmd = rows[changed[0], F["sim_time_s"]]
+    assert 10.0 <= t_cmd < 80.0 - 40.0
+    a, b = physics.cycle_window(rows, rpm1, t_from_s=t_cmd + 10.0)
+    mean_rpm = rows[a:b, F["bit_rpm"]].mean()
+    expected, tol = physics.rpm_expectation(rows, a, b, preset)
+    assert abs(mean_rpm - expected) <= tol
+    assert abs(mean_rpm - rpm1) < 0.05 * rpm1
+    assert abs(mean_rpm - rpm0) > 0.5 * (rpm1 - rpm0)
+
+
+# ---- commands and parameters ---------------------------------------------------------------
+def test_bad_commands_are_rejected_counted_and_the_node_keeps_publishing(ros):
+    preset = load_preset(FIELD)
+    start_node(ros, real_time_factor=5.0)
+    probe = start_probe(ros, [topics.TELEMETRY, topics.DIAGNOSTICS])
+    assert ros.spin_until(lambda: probe.count(topics.TELEMETRY) > 10, 20.0)
+    bad = [(topics.CMD_SURFACE_RPM, v) for v in (math.nan, math.inf, -10.0, 301.0)] + \
+          [(topics.CMD_WOB, v) for v in (math.nan, -math.inf, -1.0, 1e9)]
+    for topic, value in bad:
+        publish_acked(ros, probe, topic, value)
+
+    def rejected() -> int:
+        diags = probe.messages(topics.DIAGNOSTICS)
+        return int(diagnostic_values(diags[-1])["rejected_commands"]) if diags else -1
+
+    assert ros.spin_until(lambda: rejected() == len(bad), 5.0), rejected()
+    seen = probe.count(topics.TELEMETRY)
+    assert ros.spin_until(lambda: probe.count(topics.TELEMETRY) > seen + 50, 10.0)
+    rows = physics.telemetry_rows(probe.messages(topics.TELEMETRY))
+    np.testing.assert_allclose(rows[:, F["surface_rpm"]], preset.physical.surface_rpm)
+    np.testing.assert_allclose(rows[:, F["applied_wob_n"]], preset.physical.applied_wob_n)
+    assert physics.consecutive(rows[:, F["sim_time_s"]], PERIOD_S)
+    # A valid command after the bad ones still works.
+    publish_acked(ros, probe, topics.CMD_WOB, 50e3)
+    assert ros.spin_until(lambda: probe.messages(topics.TELEMETRY)[-1].data[
+        F["applied_wob_n"]] == pytest.approx(50e3), 10.0)
+
+
+def set_parameter(ros: Ros, probe: Probe, name: str, value) -> tuple[bool, str]:
+    request = SetParameters.Request(parameters=[Parameter(name, value=value).to_parameter_msg()])
+    result = ros.call(probe, SetParameters, f"{NODE}/set_parameters", request).results[0]
+    return result.successful, result.reason
+
+
+def test_bad_parameters_are_rejected_with_a_reason(ros):
+    start_node(ros, real_time_factor=1.0)
+    probe = start_probe(ros, [])
+    for name, value, words in [("real_time_factor", -1.0, ("real_time_factor", "1000")),
+                               ("real_time_factor", math.nan, ("real_time_factor",)),
+                               ("real_time_factor", "fast", ("real_time_factor", "number")),
+                               ("limits.max_wob_n", -5.0, ("limits.max_wob_n",)),
+                               ("publish_rate_hz", 50.0, ("read-only", "publish_rate_hz"))]:
+        ok, reason = set_parameter(ros, probe, name, value)
+        assert not ok, (name, value)
+        assert all(w in reason for w in words), reason
+    ok, reason = set_parameter(ros, probe, "real_time_factor", 2)    # an integer is a number
+    assert ok, reason
+    request = GetParameters.Request(names=["real_time_factor", "publish_rate_hz"])
+    values = ros.call(probe, GetParameters, f"{NODE}/get_parameters", request).values
+    assert values[0].integer_value == 2 and values[1].double_value == 100.0
+
+
+# ---- services ----------------------------------------------------------------------------------
+def test_reset_returns_the_model_to_its_initial_state_and_setpoints(ros):
+    preset = load_preset(FIELD)
+    node = start_node(ros, real_time_factor=FAST)
+    probe = start_probe(ros, [topics.TELEMETRY])
+    assert ros.spin_until(sim_time_reached(probe, 5.0), 30.0)
+    publish_acked(ros, probe, topics.CMD_SURFACE_RPM, 80.0)
+    assert ros.spin_until(lambda: probe.messages(topics.TELEMETRY)[-1].data[
+        F["surface_rpm"]] == pytest.approx(80.0), 10.0)
+    response = ros.call(probe, Trigger, f"{NODE}/reset", Trigger.Request())
+    assert response.success, response.message
+    reset_at_s = node._session.sim_time_ns * 1e-9       # a bound: the reset came before
+    assert ros.spin_until(sim_time_reached(probe, reset_at_s + 1.0), 20.0)
+    rows = physics.telemetry_rows(probe.messages(topics.TELEMETRY))
+    assert physics.consecutive(rows[:, F["sim_time_s"]], PERIOD_S)   # sim time runs on
+    starts = np.nonzero((rows[:, F["bit_depth_m"]] == 0.0) & (rows[:, F["bit_angle_rad"]]
+                                                              == 0.0))[0]
+    assert starts.tolist()[:1] == [0] and starts.size == 2, starts
+    after = rows[starts[1]:]
+    np.testing.assert_allclose(after[:, F["surface_rpm"]], preset.physical.surface_rpm)
+    np.testing.assert_array_equal(rows[starts[1], F["bit_rpm"]:], rows[0, F["bit_rpm"]:])
+
+
+def test_pause_stops_the_clock_and_step_advances_one_period(ros):
+    start_node(ros, real_time_factor=1.0)
+    probe = start_probe(ros, [topics.TELEMETRY])
+    assert ros.spin_until(lambda: probe.count(topics.TELEMETRY) > 5, 20.0)
+    assert not ros.call(probe, Trigger, f"{NODE}/step", Trigger.Request()).success
+    assert ros.call(probe, SetBool, f"{NODE}/pause", SetBool.Request(data=True)).success
+    ros.spin_for(0.3)
+    seen = probe.count(topics.TELEMETRY)
+    ros.spin_for(0.3)
+    assert probe.count(topics.TELEMETRY) == seen
+    assert ros.call(probe, Trigger, f"{NODE}/step", Trigger.Request()).success
+    assert ros.spin_until(lambda: probe.count(topics.TELEMETRY) == seen + 1, 5.0)
+    assert ros.call(probe, SetBool, f"{NODE}/pause", SetBool.Request(data=False)).success
+    assert ros.spin_until(lambda: probe.count(topics.TELEMETRY) > seen + 20, 5.0)
+    rows = physics.telemetry_rows(probe.messages(topics.TELEMETRY))
+    assert physics.consecutive(rows[:, F["sim_time_s"]], PERIOD_S)
+
+
+def test_numerical_fault_gives_an_error_diagnostic_and_reset_recovers(ros):
+    node = start_node(ros, real_time_factor=5.0)
+    probe = start_probe(ros, [topics.TELEMETRY, topics.DIAGNOSTICS])
+    assert ros.spin_until(lambda: probe.count(topics.TELEMETRY) > 5, 20.0)
+    sim = node._session.sim
+    real_advance = sim.advance
+
+    def faulty_advance(*args, **kwargs):
+        sim.advance = real_advance
+        raise NumericalFault("non-finite state (injected by the test)")
+
+    sim.advance = faulty_advance
+
+    def levels() -> list[bytes]:
+        return [s.level for d in probe.messages(topics.DIAGNOSTICS) for s in d.status]
+
+    assert ros.spin_until(lambda: DiagnosticStatus.ERROR in levels(), 5.0)
+    seen = probe.count(topics.TELEMETRY)
+    ros.spin_for(0.2)
+    assert seen <= probe.count(topics.TELEMETRY) <= seen + 1    # halted (one may be in flight)
+    assert not ros.call(probe, Trigger, f"{NODE}/step", Trigger.Request()).success
+    assert ros.call(probe, Trigger, f"{NODE}/reset", Trigger.Request()).success
+    seen = probe.count(topics.TELEMETRY)
+    assert ros.spin_until(lambda: probe.count(topics.TELEMETRY) > seen + 20, 5.0)
+    n_diag = probe.count(topics.DIAGNOSTICS)
+    assert ros.spin_until(lambda: probe.count(topics.DIAGNOSTICS) > n_diag, 5.0)
+    assert probe.messages(topics.DIAGNOSTICS)[-1].status[0].level != DiagnosticStatus.ERROR
+
+
+# ---- pacing ----------------------------------------------------------------------------------
+def test_pacing_follows_the_wall_clock_without_drift(ros):
+    factor = 2.0
+    start_node(ros, real_time_factor=factor)
+    probe = start_probe(ros, [topics.TELEMETRY])
+    assert ros.spin_until(lambda: probe.count(topics.TELEMETRY) > 0, 20.0)
+    ros.spin_for(3.0)
+    received = probe.received[topics.TELEMETRY]
+    wall = np.array([w for w, _ in received])
+    sim = np.array([m.data[F["sim_time_s"]] for _, m in received])
+    assert physics.consecutive(sim, PERIOD_S)
+    # wall - sim/factor: the schedule's offset plus this sample's latency. Its floor must not
+    # move: after N s the node has published N x factor of sim time, within one period.
+    offset = wall - sim / factor
+    head = offset[wall < wall[0] + 0.5].min()
+    tail = offset[wall > wall[-1] - 0.5].min()
+    assert abs(tail - head) <= PERIOD_S / factor
+    assert (sim[-1] - sim[0]) / (wall[-1] - wall[0]) == pytest.approx(factor, rel=0.05)
