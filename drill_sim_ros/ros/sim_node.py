@@ -18,6 +18,7 @@ from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from rcl_interfaces.msg import SetParametersResult
 from rclpy.clock import Clock, ClockType
 from rclpy.executors import ExternalShutdownException
+from rclpy.impl.implementation_singleton import rclpy_implementation
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
@@ -35,6 +36,7 @@ from drill_sim_ros.ros.parameters import SPEC_BY_NAME, coerce, declare_all, vali
 from drill_sim_ros.ros.session import SessionConfig, SimSession
 from drill_sim_ros.ros.status_line import StatusLine, format_status
 
+RCLError = rclpy_implementation.RCLError
 DATA_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=100,
                       reliability=ReliabilityPolicy.RELIABLE)
 CLOCK_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=10,
@@ -361,6 +363,10 @@ def main(args: list[str] | None = None) -> int:
         rclpy.spin_until_future_complete(node, node.finished)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
+    except RCLError:
+        if rclpy.ok():
+            raise
+        # SIGTERM shut the context down while the executor built its wait set: a clean stop.
     except (DrillSimError, ValueError) as exc:
         rclpy.logging.get_logger(topics.NODE_NAME).fatal(str(exc))
         return 1

@@ -1,0 +1,115 @@
+"""The package as ROS 2 tools see it: colcon builds an install tree, ament_index resolves it the
+way `ros2 run drill_sim_ros sim_node` does, and that executable publishes and stops cleanly on
+SIGINT; SIGTERM also ends a run cleanly with its MCAP recording finished (issue 3)."""
+
+from __future__ import annotations
+
+import os
+import shutil
+import signal
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from drill_sim_ros import topics
+from tests.ros.harness import Probe, ros_context
+
+pytestmark = pytest.mark.ros
+REPO = Path(__file__).resolve().parents[2]
+PACKAGE = "drill_sim_ros"
+PACKAGE_FILES = ("setup.py", "setup.cfg", "package.xml", "resource", "config", PACKAGE)
+VENV_BIN = Path(sys.executable).parent
+
+
+def colcon_build(workspace: Path) -> Path:
+    """Copy the package into ``workspace``/src, colcon build it; returns the install prefix."""
+    src = workspace / "src" / PACKAGE
+    src.mkdir(parents=True)
+    ignore = shutil.ignore_patterns("__pycache__", "*.pyc", "*.nbi", "*.nbc")
+    for name in PACKAGE_FILES:
+        source = REPO / name
+        if source.is_dir():
+            shutil.copytree(source, src / name, ignore=ignore)
+        else:
+            shutil.copy2(source, src / name)
+    env = {**os.environ, "PATH": f"{VENV_BIN}{os.pathsep}{os.environ.get('PATH', '')}"}
+    done = subprocess.run([str(VENV_BIN / "colcon"), "build", "--base-paths", "src"],
+                          cwd=workspace, env=env, capture_output=True, text=True, timeout=180)
+    assert done.returncode == 0, done.stdout + done.stderr
+    return workspace / "install" / PACKAGE
+
+
+def installed_env(prefix: Path) -> dict[str, str]:
+    """What `. install/setup.sh` sets for an ament_python package."""
+    site = prefix / "lib" / f"python{sys.version_info.major}.{sys.version_info.minor}" / \
+        "site-packages"
+    ament = [str(prefix), *[p for p in os.environ.get("AMENT_PREFIX_PATH", "").split(
+        os.pathsep) if p]]
+    return {**os.environ, "AMENT_PREFIX_PATH": os.pathsep.join(ament), "PYTHONPATH": str(site),
+            "PYTHONUNBUFFERED": "1"}
+
+
+def resolve_like_ros2_run(env: dict[str, str], cwd: Path) -> tuple[Path, Path]:
+    """(package prefix from ament_index, the package's import location) in ``env``."""
+    code = ("from ament_index_python.packages import get_package_prefix\n"
+            "import drill_sim_ros\n"
+            "print(get_package_prefix('drill_sim_ros')); print(drill_sim_ros.__file__)")
+    done = subprocess.run([sys.executable, "-c", code], env=env, cwd=cwd, capture_output=True,
+                          text=True, timeout=60)
+    assert done.returncode == 0, done.stderr
+    prefix, module = done.stdout.split()
+    return Path(prefix), Path(module)
+
+
+def run_until_published(command: list[str], env: dict[str, str], stop: signal.Signals
+                        ) -> subprocess.CompletedProcess:
+    """Start ``command``, wait for 20 telemetry samples, send ``stop``, return its result."""
+    with ros_context() as ros:
+        probe = ros.add(Probe(ros.context, [topics.TELEMETRY]))
+        proc = subprocess.Popen(command, env=env, stdout=subprocess.PIPE,
+                                stderr=subprocess.STDOUT, text=True)
+        try:
+            published = ros.spin_until(lambda: probe.count(topics.TELEMETRY) >= 20, 60.0)
+            proc.send_signal(stop)
+            out, _ = proc.communicate(timeout=20)
+        finally:
+            if proc.poll() is None:
+                proc.kill()
+                proc.communicate()
+    assert published, "the node did not publish"
+    return subprocess.CompletedProcess(command, proc.returncode, out)
+
+
+def test_colcon_install_tree_runs_like_ros2_run(tmp_path):
+    prefix = colcon_build(tmp_path)
+    executable = prefix / "lib" / PACKAGE / "sim_node"
+    assert executable.is_file() and os.access(executable, os.X_OK)
+    assert (prefix / "share" / "ament_index" / "resource_index" / "packages" / PACKAGE).is_file()
+    assert (prefix / "share" / PACKAGE / "config" / "sim.yaml").is_file()
+    env = installed_env(prefix)
+    found_prefix, module = resolve_like_ros2_run(env, tmp_path)
+    assert found_prefix == prefix
+    assert prefix in module.parents, "the installed copy, not the source tree, is imported"
+    ros2_run = found_prefix / "lib" / PACKAGE / "sim_node"   # what `ros2 run` executes
+    params = prefix / "share" / PACKAGE / "config" / "sim.yaml"
+    done = run_until_published([str(ros2_run), "--ros-args", "--params-file", str(params),
+                                "-p", "status_line:=false"], env, signal.SIGINT)
+    assert done.returncode == 0, done.stdout
+
+
+def test_sigterm_ends_a_recording_run_cleanly(tmp_path):
+    from mcap.reader import make_reader
+
+    path = tmp_path / "run" / "run.mcap"
+    done = run_until_published([str(VENV_BIN / "sim_node"), "--ros-args", "-p",
+                                f"record.path:={path}", "-p", "status_line:=false",
+                                "-p", "real_time_factor:=5"], os.environ.copy(),
+                               signal.SIGTERM)
+    assert done.returncode == 0, done.stdout
+    with path.open("rb") as stream:
+        summary = make_reader(stream).get_summary()
+    assert summary is not None and summary.statistics.message_count >= 20 * 9
+    recorded = {channel.topic for channel in summary.channels.values()}
+    assert set(topics.MSG_TYPES) - {topics.CMD_WOB, topics.CMD_SURFACE_RPM} <= recorded
