@@ -1,3 +1,3 @@
-"""drill_sim_ros: real-time simulation of drill-bit stick-slip (Richard, Germay & Detournay 2007)."""
+"""drill_sim_ros: real-time drill-bit stick-slip simulation (Richard, Germay & Detournay 2007)."""
 
 __version__ = "0.1.0"
