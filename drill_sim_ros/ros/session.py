@@ -72,6 +72,7 @@ class SimSession:
         period_tau = self.period_ns / NS_PER_S / self.scales.time_s
         self.steps = steps_per_period(period_tau, cfg.dtau_max)
         self.sim = build_simulator(cfg, period_tau, self.steps)
+        self.sim.advance(0)          # load the compiled kernel now, not on the first tick
         self.next_index = 0          # sample counter: stamps = index * period_ns
         size = max(2, round(cfg.window_s * cfg.publish_rate_hz))
         self._omega = np.zeros(size)

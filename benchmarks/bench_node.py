@@ -1,0 +1,131 @@
+"""sim_node figures with a subscriber on every topic: prints them (no asserts).
+
+(a) real time at 100 Hz: CPU % of one core (process CPU time / wall time, from
+    /proc/<pid>/stat) and the node's tick lateness p50/p99 (from its /diagnostics);
+(b) free run (real_time_factor 0): achieved real-time factor (sim seconds per wall second).
+Targets (issue 3): (a) <= 5 % CPU, p99 <= 2 ms; (b) >= 50x.
+Usage: .venv/bin/python benchmarks/bench_node.py [--seconds 10] [--preset field_8p5in_shale]
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import random
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+# Loopback DDS and a domain of our own, before rclpy is imported.
+os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
+os.environ.pop("ROS_LOCALHOST_ONLY", None)
+os.environ.setdefault("ROS_DOMAIN_ID", str(random.randint(1, 101)))
+os.environ.setdefault("AMENT_PREFIX_PATH", sys.prefix)
+
+import rclpy
+from rclpy.node import Node
+from rclpy.qos import QoSProfile, ReliabilityPolicy
+
+from drill_sim_ros import topics
+from drill_sim_ros.ros.messages import type_of
+
+BIN = Path(sys.prefix) / "bin"
+TICKS = os.sysconf("SC_CLK_TCK")
+PUBLISHED = [t for t in topics.MSG_TYPES if t not in (topics.CMD_WOB, topics.CMD_SURFACE_RPM)]
+
+
+def cpu_seconds(pid: int) -> float:
+    """utime + stime of a process, in seconds."""
+    fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / TICKS
+
+
+class Listener(Node):
+    """One subscription per published topic; keeps the last /diagnostics values."""
+
+    def __init__(self) -> None:
+        super().__init__("bench_listener")
+        self.count = 0
+        self.diagnostics: dict[str, str] = {}
+        qos = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE)
+        for topic in PUBLISHED:
+            self.create_subscription(type_of(topic), topic, self._on_message, qos)
+        self.create_subscription(type_of(topics.DIAGNOSTICS), topics.DIAGNOSTICS,
+                                 self._on_diagnostics, qos)
+
+    def _on_message(self, _msg: object) -> None:
+        self.count += 1
+
+    def _on_diagnostics(self, msg) -> None:
+        self.diagnostics = {kv.key: kv.value for s in msg.status for kv in s.values}
+
+
+def spin_for(node: Node, seconds: float) -> None:
+    end = time.monotonic() + seconds
+    while time.monotonic() < end:
+        rclpy.spin_once(node, timeout_sec=0.05)
+
+
+def start_node(preset: str, factor: float) -> subprocess.Popen:
+    return subprocess.Popen([str(BIN / "sim_node"), "--ros-args", "-p", f"model.preset:={preset}",
+                             "-p", f"real_time_factor:={factor}", "-p", "status_line:=false"],
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+
+
+def stop(proc: subprocess.Popen) -> None:
+    proc.send_signal(signal.SIGINT)
+    try:
+        proc.wait(timeout=10)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        proc.wait()
+
+
+def measure(listener: Listener, preset: str, factor: float, seconds: float) -> dict[str, float]:
+    """Run one node; CPU %, message rate and its diagnostics over a steady window."""
+    proc = start_node(preset, factor)
+    try:
+        spin_for(listener, 4.0)                       # start-up, JIT cache, discovery
+        cpu0, wall0, n0 = cpu_seconds(proc.pid), time.monotonic(), listener.count
+        sim0 = float(listener.diagnostics.get("sim_time_s", "nan"))
+        spin_for(listener, seconds)
+        cpu1, wall1, n1 = cpu_seconds(proc.pid), time.monotonic(), listener.count
+        spin_for(listener, 1.1)                       # the next /diagnostics
+        diag = dict(listener.diagnostics)
+    finally:
+        stop(proc)
+    wall = wall1 - wall0
+    return {"cpu_percent": 100.0 * (cpu1 - cpu0) / wall, "received_per_s": (n1 - n0) / wall,
+            "p50_ms": float(diag.get("tick_lateness_p50_ms", "nan")),
+            "p99_ms": float(diag.get("tick_lateness_p99_ms", "nan")),
+            "overruns": float(diag.get("overruns", "nan")),
+            "sim_rate": (float(diag.get("sim_time_s", "nan")) - sim0) / (wall + 1.1),
+            "rtf_reported": float(diag.get("real_time_factor_achieved", "nan"))}
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--seconds", type=float, default=10.0)
+    parser.add_argument("--preset", default="field_8p5in_shale")
+    args = parser.parse_args()
+    rclpy.init()
+    listener = Listener()
+    try:
+        rt = measure(listener, args.preset, 1.0, args.seconds)
+        print(f"(a) real time, 100 Hz, {len(PUBLISHED)} topics subscribed: "
+              f"CPU {rt['cpu_percent']:.1f} % of one core; tick lateness p50 "
+              f"{rt['p50_ms']:.3f} ms, p99 {rt['p99_ms']:.3f} ms; overruns {rt['overruns']:g}; "
+              f"{rt['received_per_s']:.0f} msg/s received")
+        free = measure(listener, args.preset, 0.0, args.seconds)
+        print(f"(b) free run: achieved real-time factor {free['sim_rate']:.1f}x "
+              f"(node's own last-second figure {free['rtf_reported']:.1f}x); CPU "
+              f"{free['cpu_percent']:.0f} %; {free['received_per_s']:.0f} msg/s received")
+    finally:
+        listener.destroy_node()
+        rclpy.try_shutdown()
+
+
+if __name__ == "__main__":
+    main()
