@@ -40,11 +40,19 @@ $(VENV)/.stamp: requirements.txt requirements-ros.txt setup.py
 	pipi --no-build-isolation --no-deps -e .; \
 	$(PY) -c 'import rclpy, numba, mcap, rerun, drill_sim_ros' ; \
 	$(PY) -m drill_sim_ros.viz.analytics_off; \
+	touch $(VENV)/COLCON_IGNORE; \
 	touch $@
 
+# The node records runs/<utc>/run.mcap in-process; when it stops (Ctrl-C, SIGTERM or
+# RUN_SECONDS), the recording is turned into runs/<utc>/run.rrd for the rerun viewer.
 run: venv
 	@mkdir -p $(RUN_DIR)
-	$(BIN)/sim_node --ros-args --params-file config/sim.yaml -p record.path:=$(RUN_DIR)/run.mcap -p run_seconds:=$(RUN_SECONDS)
+	@trap : INT TERM; \
+	$(BIN)/sim_node --ros-args --params-file config/sim.yaml \
+	  -p record.path:=$(RUN_DIR)/run.mcap -p run_seconds:=$(RUN_SECONDS); \
+	echo "[run] converting $(RUN_DIR)/run.mcap -> $(RUN_DIR)/run.rrd"; \
+	$(BIN)/mcap_to_rerun $(RUN_DIR)/run.mcap -o $(RUN_DIR)/run.rrd && \
+	echo "[run] replay: $(BIN)/mcap_replay $(RUN_DIR)/run.mcap   view: $(BIN)/rerun $(RUN_DIR)/run.rrd"
 
 test: venv
 	$(BIN)/ruff check drill_sim_ros tests benchmarks
@@ -55,6 +63,11 @@ lint: venv
 
 bench: venv
 	$(PY) benchmarks/bench_kernel.py
+
+# The ament_python install tree that `ros2 run drill_sim_ros sim_node` uses.
+colcon: venv
+	$(BIN)/colcon build --base-paths . --build-base build --install-base install
+	@echo "source install/setup.sh, then: ros2 run drill_sim_ros sim_node (or install/drill_sim_ros/lib/drill_sim_ros/sim_node)"
 
 clean:
 	rm -rf build install log .pytest_cache .ruff_cache .cache
