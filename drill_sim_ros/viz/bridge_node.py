@@ -1,22 +1,25 @@
 """``rerun_bridge [--save FILE.rrd] [--connect URL] [--serve]``: the live drilling dashboard.
 
 A ROS 2 node that subscribes to ``/drill/telemetry`` (one atomic sample per message, SI) and
-logs it on the ``sim_time`` timeline taken from the record's ``sim_time_s``. Samples are
-buffered and sent with ``send_columns`` ``flush_hz`` times a second. ``--serve`` hosts a
+logs it on the ``sim_time`` timeline taken from the record's ``sim_time_s``. Queued samples
+are taken and sent with ``send_columns`` ``flush_hz`` times a second. ``--serve`` hosts a
 gRPC server bound to 127.0.0.1 only. Turns rerun's analytics off first.
 """
 
 from __future__ import annotations
 
 import argparse
+import signal
 import sys
 import time
 
 import numpy as np
 import rclpy
+from rclpy.context import Context
 from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.signals import SignalHandlerOptions
 from rclpy.utilities import remove_ros_args
 from std_msgs.msg import Float64MultiArray
 
@@ -39,36 +42,67 @@ NODE_NAME = "rerun_bridge"
 QUEUE_DEPTH = 1000          # 10 s of telemetry at the sim's default 100 Hz
 
 
+def telemetry_qos(best_effort: bool = False) -> QoSProfile:
+    reliability = ReliabilityPolicy.BEST_EFFORT if best_effort else ReliabilityPolicy.RELIABLE
+    return QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=QUEUE_DEPTH,
+                      reliability=reliability)
+
+
+class TelemetryQueue:
+    """A /drill/telemetry subscription on a node that no executor spins.
+
+    DDS queues up to QUEUE_DEPTH samples; :meth:`take_all` drains them in one go, so the
+    bridge wakes ``flush_hz`` times a second instead of once per message (rclpy's executor
+    costs far more per message than the logging does).
+    """
+
+    def __init__(self, context: Context | None = None, best_effort: bool = False) -> None:
+        self.node = Node(f"{NODE_NAME}_telemetry", context=context)
+        self._sub = self.node.create_subscription(Float64MultiArray, topics.TELEMETRY,
+                                                  lambda _msg: None, telemetry_qos(best_effort))
+
+    def take_all(self, limit: int = 10 * QUEUE_DEPTH) -> list[Float64MultiArray]:
+        """Every message queued so far (at most ``limit``), oldest first."""
+        messages = []
+        handle = self._sub.handle
+        with handle:
+            while len(messages) < limit:
+                taken = handle.take_message(self._sub.msg_type, self._sub.raw)
+                if taken is None:
+                    break
+                messages.append(taken[0])
+        return messages
+
+    def destroy(self) -> None:
+        self.node.destroy_node()
+
+
 class RerunBridge(Node):
-    """Buffers telemetry rows and hands them to a :class:`Dashboard` in batches."""
+    """Drains the telemetry queue ``flush_hz`` times a second into a :class:`Dashboard`."""
 
     def __init__(self, dashboard: Dashboard, flush_hz: float = 4.0,
                  status_period_s: float = 2.0, best_effort: bool = False) -> None:
         super().__init__(NODE_NAME)
         self._dashboard = dashboard
-        self._pending: list[np.ndarray] = []
+        self._queue = TelemetryQueue(self.context, best_effort)
         self._order: np.ndarray | None = None
         self.dropped = 0
         self._status_period_s = status_period_s
         self._last_status = (time.monotonic(), 0)
-        reliability = ReliabilityPolicy.BEST_EFFORT if best_effort else ReliabilityPolicy.RELIABLE
-        qos = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=QUEUE_DEPTH,
-                         reliability=reliability)
-        self.create_subscription(Float64MultiArray, topics.TELEMETRY, self._on_telemetry, qos)
         self.create_timer(1.0 / flush_hz, self.flush)
 
-    def _on_telemetry(self, msg: Float64MultiArray) -> None:
-        if self._order is None:
-            self._order = field_order([d.label for d in msg.layout.dim])
-        if len(msg.data) < N_FIELDS:
-            self.dropped += 1
-            return
-        self._pending.append(np.frombuffer(msg.data, dtype=np.float64))
+    def _rows(self, messages: list[Float64MultiArray]) -> list[np.ndarray]:
+        if self._order is None and messages:
+            self._order = field_order([d.label for d in messages[0].layout.dim])
+        rows = [np.frombuffer(m.data, dtype=np.float64) for m in messages
+                if len(m.data) >= N_FIELDS]
+        self.dropped += len(messages) - len(rows)
+        return rows
 
     def flush(self) -> None:
         """Log the buffered samples in one batch, then maybe print the status line."""
-        if self._pending:
-            rows, self._pending = self._pending, []
+        rows = self._rows(self._queue.take_all())
+        if rows:
             self._dashboard.log_batch(TelemetryBatch.from_rows(np.stack(rows), self._order))
         self._status(force=False)
 
@@ -83,9 +117,11 @@ class RerunBridge(Node):
                                f"{self.dropped} malformed")
 
     def finish(self) -> None:
-        """Flush what is buffered and report the final count."""
-        self.flush()
+        """Log what is queued, report the final count, destroy the queue's node."""
+        if self.context.ok():
+            self.flush()
         self._status(force=True)
+        self._queue.destroy()
 
 
 def parse_args(argv: list[str]) -> argparse.Namespace:
@@ -117,11 +153,17 @@ def make_dashboard(args: argparse.Namespace) -> Dashboard:
     return Dashboard(rec, units, window)
 
 
+def _interrupt(signum: int, frame: object) -> None:
+    raise KeyboardInterrupt(f"signal {signum}")
+
+
 def main(argv: list[str] | None = None) -> None:
     disable_analytics()
     argv = sys.argv if argv is None else argv
     args = parse_args(remove_ros_args(argv)[1:])
-    rclpy.init(args=argv)
+    # Own signal handling: the context stays up on SIGINT/SIGTERM so the queue is drained.
+    rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
+    signal.signal(signal.SIGTERM, _interrupt)
     dashboard: Dashboard | None = None
     node: RerunBridge | None = None
     try:

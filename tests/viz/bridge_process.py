@@ -61,10 +61,10 @@ class BridgeProcess:
             time.sleep(0.1)
         return self.logged() >= count
 
-    def stop(self, timeout_s: float = 20.0) -> int:
-        """SIGINT, then SIGKILL if it does not exit in time; return the exit code."""
+    def stop(self, timeout_s: float = 20.0, signum: int = signal.SIGINT) -> int:
+        """``signum``, then SIGKILL if it does not exit in time; return the exit code."""
         if self.proc.poll() is None:
-            self.proc.send_signal(signal.SIGINT)
+            self.proc.send_signal(signum)
             try:
                 self.proc.wait(timeout=timeout_s)
             except subprocess.TimeoutExpired:
