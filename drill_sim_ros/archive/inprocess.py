@@ -19,12 +19,15 @@ from drill_sim_ros.archive.qos import qos_profiles_yaml
 from drill_sim_ros.archive.writer import Ros2McapWriter
 
 _log = logging.getLogger(__name__)
+RUN_METADATA = "drill_sim"
 
 
 class InProcessRecorder:
     """Records rclpy messages to ``path`` (MCAP, ROS 2 profile, zstd chunks).
 
     node_name: the publishing node, for the log; topics must be added before they are written.
+    metadata: written once as an MCAP metadata record named ``drill_sim`` (e.g. the preset,
+    so ``mcap_to_rerun`` picks the right scales).
     """
 
     def __init__(
@@ -33,13 +36,15 @@ class InProcessRecorder:
         node_name: str = "drill_sim",
         capacity: int = DEFAULT_CAPACITY,
         compression: str = "zstd",
+        metadata: dict[str, str] | None = None,
     ) -> None:
         self.path = path
         self.node_name = node_name
         self._topics: set[str] = set()
-        self._writer = BackgroundWriter(
-            Ros2McapWriter(path, compression=compression), capacity, name="mcap-inprocess"
-        )
+        writer = Ros2McapWriter(path, compression=compression)
+        if metadata:
+            writer.add_metadata(RUN_METADATA, {k: str(v) for k, v in metadata.items()})
+        self._writer = BackgroundWriter(writer, capacity, name="mcap-inprocess")
         self._unknown_topic_drops = 0
         self._closed = False
 
