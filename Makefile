@@ -14,8 +14,6 @@ export ROS_DOMAIN_ID
 export AMENT_PREFIX_PATH := $(if $(AMENT_PREFIX_PATH),$(AMENT_PREFIX_PATH):$(abspath $(VENV)),$(abspath $(VENV)))
 export NUMBA_CACHE_DIR ?= $(abspath .cache/numba)
 export PYTHONUNBUFFERED := 1
-# rerun: never send usage analytics from anything we start.
-export RERUN_ANALYTICS := 0
 
 RUN_DIR ?= runs/$(shell date -u +%Y%m%dT%H%M%SZ)
 RUN_SECONDS ?= 0
@@ -47,6 +45,7 @@ $(VENV)/.stamp: requirements.txt requirements-ros.txt setup.py
 # RUN_SECONDS), the recording is turned into runs/<utc>/run.rrd for the rerun viewer.
 run: venv
 	@mkdir -p $(RUN_DIR)
+	@$(PY) -m drill_sim_ros.viz.analytics_off
 	@trap : INT TERM; \
 	$(BIN)/sim_node --ros-args --params-file config/sim.yaml \
 	  -p record.path:=$(RUN_DIR)/run.mcap -p run_seconds:=$(RUN_SECONDS); \

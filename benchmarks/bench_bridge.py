@@ -29,7 +29,6 @@ def ros_environment() -> dict[str, str]:
     env.pop("ROS_LOCALHOST_ONLY", None)
     env.setdefault("ROS_DOMAIN_ID", str(random.randint(1, 101)))
     env.setdefault("AMENT_PREFIX_PATH", sys.prefix)
-    env["RERUN_ANALYTICS"] = "0"
     return env
 
 

@@ -1,4 +1,4 @@
-"""Test-session environment: DDS on loopback, a domain of our own, no rerun analytics.
+"""Test-session environment: DDS on loopback and a domain of our own.
 
 Set before anything imports rclpy, so every node and subprocess a test starts inherits it.
 """
@@ -15,4 +15,3 @@ os.environ.setdefault("ROS_DOMAIN_ID", str(1 + os.getpid() % 101))
 _prefixes = [p for p in os.environ.get("AMENT_PREFIX_PATH", "").split(os.pathsep) if p]
 if sys.prefix not in _prefixes:
     os.environ["AMENT_PREFIX_PATH"] = os.pathsep.join([*_prefixes, sys.prefix])
-os.environ["RERUN_ANALYTICS"] = "0"
