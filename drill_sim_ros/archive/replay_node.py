@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 import rclpy
 from builtin_interfaces.msg import Time
+from rclpy.duration import Duration
 from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.publisher import Publisher
@@ -59,6 +60,9 @@ def plan(reader: ArchiveReader, topics: re.Pattern[str]) -> Plan:
     return Plan(chosen, first or 0, last)
 
 
+DELIVERY_TIMEOUT_S = 2.0    # before exiting, let reliable subscribers receive the tail
+
+
 class Replayer:
     """Publishers for the recorded topics (plus /clock) on one node."""
 
@@ -90,6 +94,12 @@ class Replayer:
                 return True
             time.sleep(0.02)
         return False
+
+    def wait_for_delivery(self, timeout_s: float) -> bool:
+        """Wait (bounded) until reliable subscribers acknowledged everything sent."""
+        deadline = Duration(seconds=timeout_s)
+        pubs = [*self.publishers.values(), *([self.clock] if self.clock else [])]
+        return all(p.wait_for_all_acked(deadline) for p in pubs)
 
     def publish_clock(self, log_time_ns: int) -> None:
         sec, nanosec = divmod(log_time_ns, 1_000_000_000)
@@ -175,6 +185,8 @@ def _replay(reader: ArchiveReader, extent: Plan, options: argparse.Namespace) ->
         while play_once(reader, replayer, pacer, options, progress) and options.loop:
             pacer.restart()
         progress.update(extent.last_log_ns, replayer.sent, force=True)
+        if not replayer.wait_for_delivery(DELIVERY_TIMEOUT_S):
+            _log.warning("some subscribers did not acknowledge the last messages")
     finally:
         progress.end()
         _log.info("sent %d messages", replayer.sent)
