@@ -17,7 +17,7 @@ from drill_sim_ros.model import kernel as k
 from drill_sim_ros.model.analysis import Severity, severity
 from drill_sim_ros.model.presets import Preset
 from drill_sim_ros.model.simulator import SimConfig, Simulator
-from drill_sim_ros.ros.conversions import NS_PER_S, telemetry_rows
+from drill_sim_ros.ros.conversions import NS_PER_S, TelemetryConverter
 
 
 @dataclass(frozen=True)
@@ -74,9 +74,11 @@ class SimSession:
         self.sim = build_simulator(cfg, period_tau, self.steps)
         self.sim.advance(0)          # load the compiled kernel now, not on the first tick
         self.next_index = 0          # sample counter: stamps = index * period_ns
+        self._converter = TelemetryConverter(self.scales)
         size = max(2, round(cfg.window_s * cfg.publish_rate_hz))
-        self._omega = np.zeros(size)
-        self._stuck = np.zeros(size, dtype=bool)
+        self._omega = [0.0] * size       # ring buffers of the recent window
+        self._stuck = [False] * size
+        self._head = 0                   # where the next sample goes
         self._filled = 0
 
     @property
@@ -88,34 +90,33 @@ class SimSession:
         """Stamp of the next sample (the simulated clock)."""
         return self.next_index * self.period_ns
 
-    def run(self, periods: int, submerged_weight_n: float) -> tuple[list[int], np.ndarray]:
-        """Advance ``periods`` publish periods: (stamps ns, SI rows of shape (periods, F)).
+    def run(self, periods: int, submerged_weight_n: float) -> tuple[list[int], list[list[float]]]:
+        """Advance ``periods`` publish periods: (stamps ns, SI rows of ``TELEMETRY_FIELDS``).
 
         Row i is the state at the start of period i. Raises ``NumericalFault``.
         """
         samples = self.sim.advance(periods * self.steps, every=self.steps)
         stamps = [(self.next_index + i) * self.period_ns for i in range(len(samples))]
         self.next_index += len(samples)
-        rows = telemetry_rows(samples, self.scales, np.array(stamps) / NS_PER_S,
-                              submerged_weight_n)
-        self._remember(samples.column(k.C_OMEGA), samples.column(k.C_MODE))
+        rows = self._converter.rows(samples, [t / NS_PER_S for t in stamps],
+                                    submerged_weight_n)
+        self._remember(samples.data[:, k.C_OMEGA].tolist(), samples.data[:, k.C_MODE].tolist())
         return stamps, rows
 
-    def _remember(self, omega: np.ndarray, mode: np.ndarray) -> None:
-        size = self._omega.size
-        omega, mode = omega[-size:], mode[-size:]
-        self._omega = np.roll(self._omega, -omega.size)
-        self._stuck = np.roll(self._stuck, -omega.size)
-        self._omega[-omega.size:] = omega
-        self._stuck[-omega.size:] = mode == k.MODE_STUCK
-        self._filled = min(size, self._filled + omega.size)
+    def _remember(self, omega: list[float], mode: list[float]) -> None:
+        size = len(self._omega)
+        for value, state in zip(omega[-size:], mode[-size:], strict=True):
+            self._omega[self._head] = value
+            self._stuck[self._head] = state == k.MODE_STUCK
+            self._head = (self._head + 1) % size
+        self._filled = min(size, self._filled + len(omega))
 
     def severity(self) -> tuple[Severity, float]:
         """Stick-slip severity of the recent window and its stick fraction (nan if empty)."""
         if self._filled == 0:
             return severity(np.empty(0), 1.0), math.nan
-        omega = self._omega[-self._filled:]
-        stuck = self._stuck[-self._filled:]
+        omega = np.roll(self._omega, -self._head)[-self._filled:]
+        stuck = np.roll(self._stuck, -self._head)[-self._filled:]
         return severity(omega, self.sim.targets[0]), float(stuck.mean())
 
     def set_surface_rpm(self, rpm: float) -> None:

@@ -4,6 +4,11 @@ Publishes the bit and surface state at ``publish_rate_hz`` of simulated time (st
 simulated time, one stamp per sample on every topic), /diagnostics at 1 Hz wall and /clock;
 takes surface-rpm and WOB setpoints; serves ~/reset, ~/pause and ~/step (lockstep).
 Pacing follows the monotonic clock without drift (:mod:`drill_sim_ros.ros.pacing`).
+
+Threads: a :class:`~drill_sim_ros.ros.ticker.Ticker` advances and publishes the samples
+(starting with the first spin of the node); the executor's thread runs the commands,
+services, parameter callbacks and 1 Hz timers. Both take the node's :class:`HandoffLock`
+before touching the session, the schedule or the recorder. Lockstep uses no ticker.
 """
 
 from __future__ import annotations
@@ -31,11 +36,12 @@ from drill_sim_ros import topics
 from drill_sim_ros.model.errors import DrillSimError, NumericalFault
 from drill_sim_ros.model.presets import load_preset
 from drill_sim_ros.ros import messages
-from drill_sim_ros.ros.conversions import MessageFactory, stamp
+from drill_sim_ros.ros.conversions import SampleMessages, stamp
 from drill_sim_ros.ros.pacing import Pacer, RateMeter
 from drill_sim_ros.ros.parameters import SPEC_BY_NAME, coerce, declare_all, validate
 from drill_sim_ros.ros.session import SessionConfig, SimSession
 from drill_sim_ros.ros.status_line import StatusLine, format_status
+from drill_sim_ros.ros.ticker import HandoffLock, Ticker
 
 RCLError = rclpy_implementation.RCLError
 DATA_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=100,
@@ -47,8 +53,8 @@ COMMAND_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=10,
 # Reliable volatile publishers match every subscriber but transient-local ones; without the
 # default QoS-event handlers the executor's wait set is 2 entities per publisher smaller.
 QUIET_PUBLISHER = PublisherEventCallbacks(use_default_callbacks=False)
-FREE_RUN_BATCH = 20          # periods per callback when running as fast as possible
-MAX_CATCH_UP = 50            # periods per callback when catching up in real time
+FREE_RUN_BATCH = 20          # periods per turn of the ticker when running as fast as possible
+MAX_CATCH_UP = 50            # periods per turn of the ticker when catching up in real time
 DIAGNOSTICS_PERIOD_S = 1.0
 STATUS_PERIOD_S = 0.25
 WARN_THROTTLE_S = 1.0
@@ -87,7 +93,8 @@ class SimNode(Node):
         self._steady = Clock(clock_type=ClockType.STEADY_TIME)
         self._preset, self._values = declare_all(self, load_preset)
         self._session = SimSession(session_config(self._values, self._preset))
-        self._factory = MessageFactory()
+        self._messages = SampleMessages()
+        self._lock = HandoffLock()
         self._pacer = Pacer(self._wall_period_ns(1.0))
         self._rate = RateMeter(time.monotonic_ns(), 0.0)
         self._status = StatusLine()
@@ -99,6 +106,8 @@ class SimNode(Node):
         self._pubs = {t: self.create_publisher(messages.type_of(t), t, self._qos(t),
                                                event_callbacks=QUIET_PUBLISHER)
                       for t in (*SAMPLE_TOPICS, topics.CLOCK, topics.DIAGNOSTICS)}
+        self._outputs = {with_clock: self._sample_outputs(with_clock)
+                         for with_clock in (False, True)}
         self._recorder = self._open_recorder(self._values["record.path"])
         self.create_subscription(Float64, topics.CMD_SURFACE_RPM, self._on_surface_rpm,
                                  COMMAND_QOS)
@@ -106,10 +115,11 @@ class SimNode(Node):
         self.create_service(Trigger, "~/reset", self._on_reset)
         self.create_service(SetBool, "~/pause", self._on_pause)
         self.create_service(Trigger, "~/step", self._on_step)
-        self._tick_timer = None
-        self._restart_ticks()
+        self._ticker = Ticker(self._tick, self._on_tick_error, name="drill_sim_ticker")
+        self._first_spin = self.create_timer(0.0, self._start_ticker, clock=self._steady)
         self.create_timer(DIAGNOSTICS_PERIOD_S, self._publish_diagnostics, clock=self._steady)
-        self.create_timer(STATUS_PERIOD_S, self._show_status, clock=self._steady)
+        if self._status.active:
+            self.create_timer(STATUS_PERIOD_S, self._show_status, clock=self._steady)
         self._stop_timer = self._start_run_limit(self._values["run_seconds"])
         self.add_on_set_parameters_callback(self._validate_parameters)
         self.add_post_set_parameters_callback(self._apply_parameters)
@@ -119,6 +129,11 @@ class SimNode(Node):
     @staticmethod
     def _qos(topic: str) -> QoSProfile:
         return CLOCK_QOS if topic in (topics.CLOCK, topics.DIAGNOSTICS) else DATA_QOS
+
+    def _sample_outputs(self, with_clock: bool) -> list[tuple[Any, str, object]]:
+        """``(publish, topic, message)`` of every message of a sample, in publishing order."""
+        return [(self._pubs[topic].publish, topic, msg)
+                for topic, msg in self._messages.messages(with_clock)]
 
     def _open_recorder(self, path: str) -> Any:
         """The in-process MCAP recorder of ``record.path`` (None when off or unavailable)."""
@@ -166,43 +181,55 @@ class SimNode(Node):
         return SetParametersResult(successful=True)
 
     def _apply_parameters(self, params: list[Parameter]) -> None:
-        for param in params:
-            if param.name in SPEC_BY_NAME:
-                self._values[param.name] = coerce(SPEC_BY_NAME[param.name], param.value)
-        if any(p.name in ("real_time_factor", "lockstep") for p in params):
-            self._restart_ticks()
+        with self._lock.urgent():
+            for param in params:
+                if param.name in SPEC_BY_NAME:
+                    self._values[param.name] = coerce(SPEC_BY_NAME[param.name], param.value)
+            if any(p.name in ("real_time_factor", "lockstep") for p in params):
+                self._restart_ticks()
 
     # ---- pacing ------------------------------------------------------------------------
     def _wall_period_ns(self, rtf: float) -> int:
         return max(1, round(self._session.period_ns / rtf)) if rtf > 0 else 1
 
+    def _start_ticker(self) -> None:
+        """First spin: anchor the schedule and start the ticker thread."""
+        self.destroy_timer(self._first_spin)
+        with self._lock.urgent():
+            self._restart_ticks()
+        self._ticker.start()
+
     def _restart_ticks(self) -> None:
-        """(Re)create the tick timer for the current factor and anchor the schedule."""
-        if self._tick_timer is not None:
-            self.destroy_timer(self._tick_timer)
-            self._tick_timer = None
-        if self._lockstep:
-            return
-        free_run = self._rtf <= 0
+        """New schedule for the current factor, anchored now (call with the lock held)."""
         self._pacer = Pacer(self._wall_period_ns(self._rtf))
-        period_s = 0.0 if free_run else self._pacer.period_ns * 1e-9
-        self._tick_timer = self.create_timer(period_s, self._on_tick, clock=self._steady)
         self._anchor()
 
     def _anchor(self) -> None:
-        """Align the schedule with the tick timer's next expiry."""
-        if self._tick_timer is not None:
-            self._pacer.anchor(time.monotonic_ns() + self._tick_timer.time_until_next_call())
+        """The next tick is due now; wake the ticker (call with the lock held)."""
+        self._pacer.anchor(time.monotonic_ns())
+        self._ticker.wake()
 
-    def _on_tick(self) -> None:
-        if self._paused or self._fault is not None:
-            return
-        if self._rtf <= 0:
-            self._advance(FREE_RUN_BATCH)
-            return
-        count = self._pacer.due(time.monotonic_ns(), MAX_CATCH_UP)
-        if count > 0 and self._advance(count):
-            self._pacer.complete(count, time.monotonic_ns())
+    def _tick(self) -> float | None:
+        """One turn of the ticker thread; the seconds to wait before the next (None: idle)."""
+        with self._lock.background():
+            if self._lockstep or self._paused or self._fault is not None:
+                return None
+            if self._rtf <= 0:
+                self._advance(FREE_RUN_BATCH)
+                return 0.0
+            count = self._pacer.due(time.monotonic_ns(), MAX_CATCH_UP)
+            if count > 0 and self._advance(count):
+                self._pacer.complete(count, time.monotonic_ns())
+            return max(0.0, (self._pacer.deadline_ns() - time.monotonic_ns()) * 1e-9)
+
+    def _on_tick_error(self, exc: Exception) -> bool:
+        """An unexpected error on the ticker: quiet at shutdown, else a fault until reset."""
+        if not self.context.ok():
+            return False             # SIGINT/SIGTERM shut the context down mid-publish
+        with self._lock.urgent():
+            self._fault = f"internal error: {exc!r}"
+        self.get_logger().error(f"ticker: {exc!r}; call ~/reset to resume")
+        return True
 
     def _advance(self, periods: int) -> bool:
         """Simulate and publish ``periods`` samples; False on a numerical fault."""
@@ -213,30 +240,37 @@ class SimNode(Node):
             self._fault = str(exc)
             self.get_logger().error(f"numerical fault: {exc}; call ~/reset to recover")
             return False
-        with_clock = self._values["publish_clock"]
+        outputs = self._outputs[self._values["publish_clock"]]
         for time_ns, row in zip(stamps, rows, strict=True):
-            self._publish_all(self._factory.build(row, time_ns, with_clock), time_ns)
-        self._last_row = rows[-1].tolist()
+            self._publish_sample(row, time_ns, outputs)
+        if rows:
+            self._last_row = rows[-1]
         return True
 
-    def _publish_all(self, msgs: dict[str, object], time_ns: int) -> None:
-        for topic, msg in msgs.items():
-            self._pubs[topic].publish(msg)
-            if self._recorder is not None:
+    def _publish_sample(self, row: list[float], time_ns: int,
+                        outputs: list[tuple[Any, str, object]]) -> None:
+        payloads = self._messages.payloads(row, time_ns)     # /clock last: zip may drop it
+        for (publish, _, _), payload in zip(outputs, payloads, strict=False):
+            publish(payload)
+        if self._recorder is not None:
+            self._messages.fill(row, time_ns)
+            for _, topic, msg in outputs:
                 self._recorder.write(topic, msg, time_ns)
 
     # ---- commands ----------------------------------------------------------------------
     def _on_surface_rpm(self, msg: Float64) -> None:
         problem = command_problem(msg.data, self._values["limits.max_surface_rpm"], "rev/min")
         if problem is None:
-            self._session.set_surface_rpm(msg.data)
+            with self._lock.urgent():
+                self._session.set_surface_rpm(msg.data)
         else:
             self._reject(topics.CMD_SURFACE_RPM, problem)
 
     def _on_wob(self, msg: Float64) -> None:
         problem = command_problem(msg.data, self._values["limits.max_wob_n"], "N")
         if problem is None:
-            self._session.set_wob_n(msg.data)
+            with self._lock.urgent():
+                self._session.set_wob_n(msg.data)
         else:
             self._reject(topics.CMD_WOB, problem)
 
@@ -249,19 +283,24 @@ class SimNode(Node):
     # ---- services ----------------------------------------------------------------------
     def _on_reset(self, _request: Trigger.Request, response: Trigger.Response
                   ) -> Trigger.Response:
-        self._session.reset()
-        self._fault = None
+        with self._lock.urgent():
+            self._session.reset()
+            if self._fault is not None:
+                self._fault = None
+                self._anchor()       # no catching up on the time spent in the fault
+            time_s = self._session.sim_time_ns * 1e-9
         response.success = True
-        response.message = (f"model reset to its initial state at t = "
-                            f"{self._session.sim_time_ns * 1e-9:.3f} s (sim time runs on)")
+        response.message = (f"model reset to its initial state at t = {time_s:.3f} s "
+                            f"(sim time runs on)")
         self.get_logger().info(response.message)
         return response
 
     def _on_pause(self, request: SetBool.Request, response: SetBool.Response
                   ) -> SetBool.Response:
-        was_paused, self._paused = self._paused, bool(request.data)
-        if was_paused and not self._paused:
-            self._anchor()
+        with self._lock.urgent():
+            was_paused, self._paused = self._paused, bool(request.data)
+            if was_paused and not self._paused:
+                self._anchor()
         response.success = True
         response.message = "paused" if self._paused else "running"
         return response
@@ -273,20 +312,22 @@ class SimNode(Node):
         elif self._fault is not None:
             response.message = f"numerical fault ({self._fault}); call ~/reset"
         else:
-            time_ns = self._session.sim_time_ns
-            response.success = self._advance(1)
+            with self._lock.urgent():
+                time_ns = self._session.sim_time_ns
+                response.success = self._advance(1)
             response.message = f"published t = {time_ns * 1e-9:.6f} s"
         return response
 
     # ---- diagnostics, status, shutdown -------------------------------------------------
     def _publish_diagnostics(self) -> None:
-        time_ns = max(0, self._session.sim_time_ns - self._session.period_ns)
-        achieved = self._rate.update(time.monotonic_ns(), time_ns * 1e-9)
-        msg = DiagnosticArray(status=[self._node_status(achieved), self._dynamics_status()])
-        msg.header.stamp = stamp(time_ns)
-        self._pubs[topics.DIAGNOSTICS].publish(msg)
-        if self._recorder is not None:
-            self._recorder.write(topics.DIAGNOSTICS, msg, time_ns)
+        with self._lock.urgent():
+            time_ns = max(0, self._session.sim_time_ns - self._session.period_ns)
+            achieved = self._rate.update(time.monotonic_ns(), time_ns * 1e-9)
+            msg = DiagnosticArray(status=[self._node_status(achieved), self._dynamics_status()])
+            msg.header.stamp = stamp(time_ns)
+            self._pubs[topics.DIAGNOSTICS].publish(msg)
+            if self._recorder is not None:
+                self._recorder.write(topics.DIAGNOSTICS, msg, time_ns)
 
     def _node_status(self, achieved_rtf: float) -> DiagnosticStatus:
         p50, p99 = self._pacer.lateness_percentiles_ms(50, 99)
@@ -335,8 +376,10 @@ class SimNode(Node):
         return "lockstep" if self._lockstep else "running"
 
     def _show_status(self) -> None:
-        if self._values["status_line"] and self._last_row is not None:
-            self._status.show(format_status(self._last_row, self._rate.last, self._state_text()))
+        with self._lock.urgent():
+            row, state = self._last_row, self._state_text()
+        if self._values["status_line"] and row is not None:
+            self._status.show(format_status(row, self._rate.last, state))
 
     def _on_run_limit(self) -> None:
         self._stop_timer.cancel()
@@ -346,7 +389,8 @@ class SimNode(Node):
             self.finished.set_result(True)
 
     def close(self) -> None:
-        """Finish the recording and the status line (idempotent)."""
+        """Stop the ticker, then finish the recording and the status line (idempotent)."""
+        self._ticker.stop()
         self._status.close()
         if self._recorder is not None:
             recorder, self._recorder = self._recorder, None

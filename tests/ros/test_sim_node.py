@@ -291,6 +291,24 @@ def test_pause_stops_the_clock_and_step_advances_one_period(ros):
     assert physics.consecutive(rows[:, F["sim_time_s"]], PERIOD_S)
 
 
+def test_free_run_serves_pause_and_commands_while_the_ticker_runs_flat_out(ros):
+    start_node(ros, real_time_factor=0.0)
+    probe = start_probe(ros, [topics.TELEMETRY])
+    assert ros.spin_until(lambda: probe.count(topics.TELEMETRY) > 200, 20.0)
+    publish_acked(ros, probe, topics.CMD_WOB, 50e3)
+    assert ros.spin_until(lambda: probe.messages(topics.TELEMETRY)[-1].data[
+        F["applied_wob_n"]] == pytest.approx(50e3), 10.0)
+    assert ros.call(probe, SetBool, f"{NODE}/pause", SetBool.Request(data=True)).success
+    ros.spin_for(0.3)
+    seen = probe.count(topics.TELEMETRY)
+    ros.spin_for(0.3)
+    assert probe.count(topics.TELEMETRY) == seen
+    assert ros.call(probe, SetBool, f"{NODE}/pause", SetBool.Request(data=False)).success
+    assert ros.spin_until(lambda: probe.count(topics.TELEMETRY) > seen + 200, 10.0)
+    rows = physics.telemetry_rows(probe.messages(topics.TELEMETRY))
+    assert physics.consecutive(rows[:, F["sim_time_s"]], PERIOD_S)
+
+
 def test_numerical_fault_gives_an_error_diagnostic_and_reset_recovers(ros):
     node = start_node(ros, real_time_factor=5.0)
     probe = start_probe(ros, [topics.TELEMETRY, topics.DIAGNOSTICS])

@@ -1,0 +1,64 @@
+"""Ticker and HandoffLock (pure threading): a busy ticker never starves a callback, wake and
+stop take effect at once, errors are handed over."""
+
+from __future__ import annotations
+
+import threading
+import time
+
+from drill_sim_ros.ros.ticker import HandoffLock, Ticker
+
+
+def test_a_callback_gets_the_lock_from_a_ticker_that_never_sleeps():
+    lock = HandoffLock()
+
+    def busy() -> float:
+        with lock.background():
+            time.sleep(0.002)           # one "batch" with the lock held
+        return 0.0
+
+    ticker = Ticker(busy, lambda exc: False)
+    ticker.start()
+    try:
+        waits = []
+        for _ in range(20):
+            start = time.monotonic()
+            with lock.urgent():
+                waits.append(time.monotonic() - start)
+        assert max(waits) < 0.5, waits
+    finally:
+        ticker.stop()
+
+
+def test_wake_calls_work_now_and_stop_joins():
+    calls = []
+    woken = threading.Event()
+
+    def work() -> None:
+        calls.append(time.monotonic())
+        if len(calls) == 2:
+            woken.set()
+        return None                      # idle until woken
+
+    ticker = Ticker(work, lambda exc: False)
+    ticker.start()
+    time.sleep(0.05)
+    assert len(calls) == 1
+    ticker.wake()
+    assert woken.wait(1.0)
+    ticker.stop()
+    assert not ticker._thread.is_alive()
+    ticker.stop()                        # idempotent
+
+
+def test_an_error_goes_to_on_error_and_false_ends_the_loop():
+    errors = []
+
+    def work() -> float:
+        raise RuntimeError("boom")
+
+    ticker = Ticker(work, lambda exc: errors.append(exc) or False)
+    ticker.start()
+    ticker._thread.join(1.0)
+    assert not ticker._thread.is_alive()
+    assert [str(e) for e in errors] == ["boom"]
