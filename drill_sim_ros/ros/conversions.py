@@ -6,15 +6,14 @@ for the one or few rows of a tick; :func:`telemetry_rows` is the column-wise num
 it must agree with bit for bit (the same IEEE operations in the same order).
 :class:`SampleMessages` holds every message of one sample, all with the same (simulated)
 stamp, in two forms: the CDR bytes to publish, packed straight from the row into fixed-layout
-templates (rclpy publishes bytes without converting or serializing them, which costs markedly
-less CPU per message), and preallocated message objects, refilled in place, for the recorder.
+templates (:mod:`drill_sim_ros.ros.cdr`; rclpy publishes bytes without converting or
+serializing them), and preallocated message objects, refilled in place, for the recorder.
 Tests check the bytes against rclpy's serializer (they differ only in alignment padding,
 which rclpy leaves uninitialized and the templates zero, so lockstep bytes are reproducible).
 """
 
 from __future__ import annotations
 
-import struct
 from array import array
 
 import numpy as np
@@ -27,6 +26,15 @@ from drill_sim_ros import topics
 from drill_sim_ros.model import kernel as k
 from drill_sim_ros.model.params import RPM_PER_RAD_S, Scales
 from drill_sim_ros.model.simulator import Samples
+from drill_sim_ros.ros.cdr import (
+    CDR_HEADER,
+    CLOCK_CDR,
+    FLOAT64_CDR,
+    UINT8_CDR,
+    JointStateFrame,
+    Pair,
+    TelemetryFrame,
+)
 
 F = topics.TELEMETRY_INDEX
 N_FIELDS = len(topics.TELEMETRY_FIELDS)
@@ -45,15 +53,6 @@ _ANGLES = [F["bit_angle_rad"], F["surface_angle_rad"]]
 FLOAT64_FIELDS = ((topics.BIT_WOB, F["wob_n"]), (topics.BIT_TOB, F["tob_nm"]),
                   (topics.BIT_ROP, F["rop_m_s"]), (topics.BIT_RPM, F["bit_rpm"]),
                   (topics.BIT_DEPTH_OF_CUT, F["depth_of_cut_m"]))
-
-
-CDR_HEADER = b"\x00\x01\x00\x00"     # encapsulation: plain CDR, little endian
-FLOAT64_CDR = struct.Struct("<4sd")    # std_msgs/Float64
-UINT8_CDR = struct.Struct("<4sB3x")    # std_msgs/UInt8, padded to 4 bytes
-CLOCK_CDR = struct.Struct("<4siI")     # rosgraph_msgs/Clock (builtin_interfaces/Time)
-STAMP_CDR = struct.Struct("<iI")
-PAIR_CDR = struct.Struct("<2d")
-ROW_CDR = struct.Struct(f"<{N_FIELDS}d")
 
 
 def field_scales(scales: Scales) -> np.ndarray:
@@ -132,84 +131,6 @@ def _joint_state(names: tuple[str, ...], when: Time) -> JointState:
     return msg
 
 
-class CdrBuffer:
-    """Plain little-endian CDR, written field by field with zeroed alignment padding.
-
-    Only what the fixed-layout templates below need; alignment counts from the end of the
-    4-byte encapsulation header, as in rclpy's (Fast-CDR's) serialization.
-    """
-
-    def __init__(self) -> None:
-        self.data = bytearray(CDR_HEADER)
-
-    def _align(self, size: int) -> None:
-        self.data += bytes(-(len(self.data) - len(CDR_HEADER)) % size)
-
-    def uint32(self, value: int) -> int:
-        """Append one uint32; returns its offset."""
-        self._align(4)
-        self.data += struct.pack("<I", value)
-        return len(self.data) - 4
-
-    def string(self, text: str) -> None:
-        raw = text.encode() + b"\x00"
-        self.uint32(len(raw))
-        self.data += raw
-
-    def doubles(self, count: int) -> int:
-        """A sequence of ``count`` zeros; returns the offset of its first element."""
-        self.uint32(count)
-        self._align(8)
-        self.data += bytes(8 * count)
-        return len(self.data) - 8 * count
-
-
-class JointStateFrame:
-    """CDR bytes of a sensor_msgs/JointState with fixed joint names and an empty frame_id;
-    the stamp and the two values of position, velocity and effort are patched in."""
-
-    def __init__(self, names: tuple[str, ...]) -> None:
-        cdr = CdrBuffer()
-        self._stamp_at = cdr.uint32(0)           # header.stamp.sec, then .nanosec
-        cdr.uint32(0)
-        cdr.string("")                            # header.frame_id
-        cdr.uint32(len(names))
-        for name in names:
-            cdr.string(name)
-        self._position_at, self._velocity_at, self._effort_at = (
-            cdr.doubles(len(names)) for _ in range(3))
-        self._buffer = cdr.data
-
-    def pack(self, sec: int, nanosec: int, position: Pair, velocity: Pair,
-             effort: Pair) -> bytes:
-        STAMP_CDR.pack_into(self._buffer, self._stamp_at, sec, nanosec)
-        PAIR_CDR.pack_into(self._buffer, self._position_at, *position)
-        PAIR_CDR.pack_into(self._buffer, self._velocity_at, *velocity)
-        PAIR_CDR.pack_into(self._buffer, self._effort_at, *effort)
-        return bytes(self._buffer)
-
-
-class TelemetryFrame:
-    """CDR bytes of the std_msgs/Float64MultiArray of one row: one dimension, the row."""
-
-    def __init__(self, dim: MultiArrayDimension) -> None:
-        cdr = CdrBuffer()
-        cdr.uint32(1)                             # layout.dim: one MultiArrayDimension
-        cdr.string(dim.label)
-        cdr.uint32(dim.size)
-        cdr.uint32(dim.stride)
-        cdr.uint32(0)                             # layout.data_offset
-        self._row_at = cdr.doubles(N_FIELDS)
-        self._buffer = cdr.data
-
-    def pack(self, row: list[float]) -> bytes:
-        ROW_CDR.pack_into(self._buffer, self._row_at, *row)
-        return bytes(self._buffer)
-
-
-Pair = tuple[float, float]
-
-
 def bit_joints(v: list[float]) -> tuple[Pair, Pair, Pair]:
     """Position, velocity, effort of ``bit_rotation`` and ``bit_axial`` (see topics.py)."""
     return ((v[F["bit_angle_rad"]], v[F["bit_depth_m"]]),
@@ -250,7 +171,7 @@ class SampleMessages:
         self._clock = Clock(clock=self._when)
         self._bit_frame = JointStateFrame(topics.BIT_JOINTS)
         self._surface_frame = JointStateFrame(topics.SURFACE_JOINTS)
-        self._telemetry_frame = TelemetryFrame(dim)
+        self._telemetry_frame = TelemetryFrame(dim, N_FIELDS)
         scalar_topics = [topic for topic, _ in FLOAT64_FIELDS]
         self._listed = [*zip(scalar_topics, [m for _, m in self._scalars], strict=True),
                         (topics.BIT_MODE, self._mode), (topics.BIT_JOINT_STATES, self._bit),
