@@ -142,7 +142,8 @@ class SimNode(Node):
         try:
             from drill_sim_ros.archive.inprocess import InProcessRecorder
             Path(path).parent.mkdir(parents=True, exist_ok=True)
-            recorder = InProcessRecorder(path, node_name=topics.NODE_NAME)
+            recorder = InProcessRecorder(path, node_name=topics.NODE_NAME,
+                                         metadata=self._run_metadata())
             for topic in self._pubs:
                 recorder.add_topic(topic, topics.MSG_TYPES[topic], self._qos(topic))
         except Exception as exc:  # recording is optional: keep simulating
@@ -150,6 +151,14 @@ class SimNode(Node):
             return None
         self.get_logger().info(f"recording to {path}")
         return recorder
+
+    def _run_metadata(self) -> dict[str, str]:
+        """What a recording needs to be read back alone (mcap_to_rerun takes the preset)."""
+        sc = self._preset.scales
+        return {"preset": self._preset.name, "publish_rate_hz": str(self._values[
+            "publish_rate_hz"]), "dtau": repr(self._session.dtau),
+            "t_star_s": repr(sc.time_s), "l_star_m": repr(sc.length_m),
+            "force_unit_n": repr(sc.force_n), "torque_unit_nm": repr(sc.torque_nm)}
 
     def _start_run_limit(self, run_seconds: float) -> Any:
         if run_seconds <= 0:
@@ -395,8 +404,11 @@ class SimNode(Node):
         if self._recorder is not None:
             recorder, self._recorder = self._recorder, None
             recorder.close()
-            self.get_logger().info(f"recording closed: {recorder.written} messages written, "
-                                   f"{recorder.dropped} dropped")
+            # after Ctrl-C the context is gone: log without the node (no /rosout publisher)
+            logger = self.get_logger() if self.context.ok() else \
+                rclpy.logging.get_logger(topics.NODE_NAME)
+            logger.info(f"recording closed: {recorder.written} messages written, "
+                        f"{recorder.dropped} dropped")
 
     def destroy_node(self) -> None:
         self.close()

@@ -14,6 +14,7 @@ import pytest
 from std_srvs.srv import Trigger
 
 from drill_sim_ros import topics
+from drill_sim_ros.viz.mcap_telemetry import recorded_preset
 from tests.archive.helpers import (
     counts_mcap_ros2,
     counts_rosbags,
@@ -59,6 +60,7 @@ def test_lockstep_in_process_recording_is_exact(tmp_path) -> None:
         assert stop(sim, signal.SIGINT) == 0, (tmp_path / "sim.log").read_text()
     _check(path)
     assert "0 dropped" in (tmp_path / "sim.log").read_text()
+    assert recorded_preset(path) == "field_8p5in_shale"     # the default preset
 
 
 def _recorder_ready(node) -> bool:
