@@ -24,6 +24,7 @@ from drill_sim_ros.model.errors import DrillSimError
 from drill_sim_ros.model.params import UNIT_SCALES, DimensionlessParams, Scales
 from drill_sim_ros.model.presets import Preset, available_presets, load_preset
 from drill_sim_ros.model.simulator import SimConfig, Simulator
+from drill_sim_ros.terminal import StatusLine
 
 GROUPS = ("n", "psi", "beta", "lam", "w0", "omega0")
 TRACE_COLUMNS = ("tau", "omega", "v", "wob", "tob", "depth_of_cut", "surface_torque", "mode")
@@ -134,25 +135,20 @@ def _tau_end(args: argparse.Namespace, scales: Scales, physical: bool) -> float:
 class Progress:
     """A one-line progress bar on stderr (only when asked or on a terminal)."""
 
-    def __init__(self, total: int, enabled: bool, stream: TextIO = sys.stderr) -> None:
-        self.total, self.enabled, self.stream = total, enabled, stream
+    def __init__(self, total: int, enabled: bool) -> None:
+        self.total = total
+        self.line = StatusLine(force=enabled) if enabled else StatusLine()
         self.start = time.perf_counter()
 
     def update(self, done: int) -> None:
-        if not self.enabled:
-            return
         frac = done / self.total if self.total else 1.0
         elapsed = time.perf_counter() - self.start
         eta = elapsed * (1.0 - frac) / frac if frac > 0 else math.inf
-        bar = "#" * int(30 * frac)
-        self.stream.write(f"\r[{bar:<30}] {100 * frac:5.1f}%  {done:,}/{self.total:,} steps  "
-                          f"eta {eta:5.1f} s ")
-        self.stream.flush()
+        self.line.show(f"[{'#' * int(30 * frac):<30}] {100 * frac:5.1f}%  "
+                       f"{done:,}/{self.total:,} steps  eta {eta:5.1f} s")
 
     def close(self) -> None:
-        if self.enabled:
-            self.stream.write("\n")
-            self.stream.flush()
+        self.line.close()
 
 
 def _chunks(total: int, size: int) -> Iterator[int]:

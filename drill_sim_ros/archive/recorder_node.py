@@ -27,7 +27,7 @@ from drill_sim_ros.archive.errors import ArchiveError
 from drill_sim_ros.archive.qos import qos_profiles_yaml, subscription_qos
 from drill_sim_ros.archive.ros_types import message_class
 from drill_sim_ros.archive.rotation import RotatingWriter
-from drill_sim_ros.archive.status import StatusLine
+from drill_sim_ros.terminal import StatusLine
 
 _log = logging.getLogger(__name__)
 
@@ -118,14 +118,14 @@ def _status_text(files: RotatingWriter, sink: BackgroundWriter, node: McapRecord
 
 def _spin(node: McapRecorder, files: RotatingWriter, sink: BackgroundWriter) -> None:
     status = StatusLine()
-    if status.enabled:
+    if status.active:
         node.create_timer(STATUS_PERIOD_S, lambda: status.show(_status_text(files, sink, node)))
     try:
         rclpy.spin(node)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:
-        status.end()
+        status.close()
 
 
 def main(args: list[str] | None = None) -> int:

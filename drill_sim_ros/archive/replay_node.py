@@ -33,7 +33,7 @@ from drill_sim_ros.archive.pacing import Pacer
 from drill_sim_ros.archive.qos import replay_qos
 from drill_sim_ros.archive.reader import ArchiveReader, RecordedChannel
 from drill_sim_ros.archive.ros_types import message_class
-from drill_sim_ros.archive.status import StatusLine
+from drill_sim_ros.terminal import StatusLine
 
 _log = logging.getLogger(__name__)
 
@@ -126,7 +126,7 @@ class Progress:
                         f"({100 * done / total:5.1f} %)  {sent} msgs  x{self._rate:g}")
 
     def end(self) -> None:
-        self._line.end()
+        self._line.close()
 
 
 def play_once(reader: ArchiveReader, replayer: Replayer, pacer: Pacer, options: argparse.Namespace,
