@@ -58,3 +58,19 @@ def test_readable_summary() -> None:
     result = drill_sim("run", "--tau-end", "20")
     assert result.returncode == 0, result.stderr
     assert "kappa" in result.stdout and "first stick" in result.stdout
+
+
+def test_sweep_prints_one_json_line_per_value() -> None:
+    result = drill_sim("sweep", "--params", "fig11", "--vary", "omega0", "--values", "3,6",
+                       "--tau-end", "20")
+    assert result.returncode == 0, result.stderr
+    lines = [json.loads(line) for line in result.stdout.splitlines()]
+    assert [d["params"]["omega0"] for d in lines] == [3.0, 6.0]
+    assert all(d["params"]["psi"] == 63.0 for d in lines)      # the rest from the preset
+
+
+def test_info_and_presets() -> None:
+    info = drill_sim("info", "fig5_8a")
+    assert info.returncode == 0 and "critical delay" in info.stdout
+    listing = drill_sim("presets")
+    assert "field_8p5in_shale" in listing.stdout and "fig10" in listing.stdout
