@@ -63,6 +63,13 @@ class InProcessRecorder:
             return
         self._writer.put(topic, serialize_message(message), log_time_ns)
 
+    def write_serialized(self, topic: str, data: bytes, log_time_ns: int) -> None:
+        """Queue bytes already in CDR (what the publisher sent); never blocks."""
+        if topic not in self._topics:
+            self._unknown_topic_drops += 1
+            return
+        self._writer.put(topic, data, log_time_ns)
+
     @property
     def dropped(self) -> int:
         """Messages not recorded: queue overflow, writes after close or to undeclared topics."""

@@ -261,10 +261,9 @@ class SimNode(Node):
         payloads = self._messages.payloads(row, time_ns)     # /clock last: zip may drop it
         for (publish, _, _), payload in zip(outputs, payloads, strict=False):
             publish(payload)
-        if self._recorder is not None:
-            self._messages.fill(row, time_ns)
-            for _, topic, msg in outputs:
-                self._recorder.write(topic, msg, time_ns)
+        if self._recorder is not None:       # the very bytes published, unchanged
+            for (_, topic, _), payload in zip(outputs, payloads, strict=False):
+                self._recorder.write_serialized(topic, payload, time_ns)
 
     # ---- commands ----------------------------------------------------------------------
     def _on_surface_rpm(self, msg: Float64) -> None:
