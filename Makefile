@@ -10,6 +10,8 @@ SYSTEM_PYTHON ?= python3
 export ROS_AUTOMATIC_DISCOVERY_RANGE := LOCALHOST
 ROS_DOMAIN_ID ?= $(shell $(SYSTEM_PYTHON) -c 'import random; print(random.randint(1, 101))')
 export ROS_DOMAIN_ID
+# Fast DDS writer tuning (config/fastdds_localhost.xml); a profile file of your own wins.
+export FASTRTPS_DEFAULT_PROFILES_FILE := $(or $(FASTRTPS_DEFAULT_PROFILES_FILE),$(abspath config/fastdds_localhost.xml))
 # The wheels need this for ament_index lookups (std_msgs share files, type hashes).
 export AMENT_PREFIX_PATH := $(if $(AMENT_PREFIX_PATH),$(AMENT_PREFIX_PATH):$(abspath $(VENV)),$(abspath $(VENV)))
 export NUMBA_CACHE_DIR ?= $(abspath .cache/numba)
