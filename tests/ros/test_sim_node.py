@@ -4,6 +4,7 @@ reset, pause/step, numerical faults and wall-clock pacing (issue 3)."""
 from __future__ import annotations
 
 import math
+import time
 
 import numpy as np
 import pytest
@@ -291,6 +292,18 @@ def test_pause_stops_the_clock_and_step_advances_one_period(ros):
     assert physics.consecutive(rows[:, F["sim_time_s"]], PERIOD_S)
 
 
+def _quiet_for(probe, topic: str, seconds: float):
+    """A predicate: no new message on ``topic`` for ``seconds`` (monotonic clock)."""
+    last = {"count": -1, "since": time.monotonic()}
+
+    def quiet() -> bool:
+        count, now = probe.count(topic), time.monotonic()
+        if count != last["count"]:
+            last["count"], last["since"] = count, now
+        return now - last["since"] >= seconds
+    return quiet
+
+
 def test_free_run_serves_pause_and_commands_while_the_ticker_runs_flat_out(ros):
     start_node(ros, real_time_factor=0.0)
     probe = start_probe(ros, [topics.TELEMETRY])
@@ -299,7 +312,9 @@ def test_free_run_serves_pause_and_commands_while_the_ticker_runs_flat_out(ros):
     assert ros.spin_until(lambda: probe.messages(topics.TELEMETRY)[-1].data[
         F["applied_wob_n"]] == pytest.approx(50e3), 10.0)
     assert ros.call(probe, SetBool, f"{NODE}/pause", SetBool.Request(data=True)).success
-    ros.spin_for(0.3)
+    # Samples published before the pause may still be queued for this (slower) subscriber;
+    # a running free-run sim never goes quiet for 0.5 s, a paused one does.
+    assert ros.spin_until(_quiet_for(probe, topics.TELEMETRY, 0.5), 15.0)
     seen = probe.count(topics.TELEMETRY)
     ros.spin_for(0.3)
     assert probe.count(topics.TELEMETRY) == seen
