@@ -321,7 +321,11 @@ def test_free_run_serves_pause_and_commands_while_the_ticker_runs_flat_out(ros):
     assert ros.call(probe, SetBool, f"{NODE}/pause", SetBool.Request(data=False)).success
     assert ros.spin_until(lambda: probe.count(topics.TELEMETRY) > seen + 200, 10.0)
     rows = physics.telemetry_rows(probe.messages(topics.TELEMETRY))
-    assert physics.consecutive(rows[:, F["sim_time_s"]], PERIOD_S)
+    # In free run a subscriber slower than the sim may miss samples (keep-last 100; the
+    # in-process recording is the lossless path), so check order and the period grid only.
+    times = rows[:, F["sim_time_s"]]
+    assert np.all(np.diff(times) > 0)
+    assert np.allclose(times / PERIOD_S, np.round(times / PERIOD_S), atol=1e-6)
 
 
 def test_numerical_fault_gives_an_error_diagnostic_and_reset_recovers(ros):
