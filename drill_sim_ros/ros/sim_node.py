@@ -403,11 +403,10 @@ class SimNode(Node):
         if self._recorder is not None:
             recorder, self._recorder = self._recorder, None
             recorder.close()
-            # after Ctrl-C the context is gone: log without the node (no /rosout publisher)
-            logger = self.get_logger() if self.context.ok() else \
-                rclpy.logging.get_logger(topics.NODE_NAME)
-            logger.info(f"recording closed: {recorder.written} messages written, "
-                        f"{recorder.dropped} dropped")
+            # after Ctrl-C the context may be gone: a logger of no node has no /rosout publisher
+            rclpy.logging.get_logger("drill_sim_ros").info(
+                f"recording closed: {recorder.written} messages written, "
+                f"{recorder.dropped} dropped")
 
     def destroy_node(self) -> None:
         self.close()
