@@ -62,8 +62,13 @@ test: venv
 lint: venv
 	$(BIN)/ruff check drill_sim_ros tests benchmarks
 
+# Benchmarks print figures (no pass/fail): kernel ns/step, node CPU and real-time factor,
+# MCAP throughput, rerun bridge CPU.
 bench: venv
 	$(PY) benchmarks/bench_kernel.py
+	$(PY) benchmarks/bench_node.py
+	$(PY) benchmarks/bench_mcap.py
+	$(PY) benchmarks/bench_bridge.py
 
 # The ament_python install tree that `ros2 run drill_sim_ros sim_node` uses.
 colcon: venv
