@@ -42,11 +42,10 @@ P_BETA = 1          # beta = mu gamma zeta (eq. 10)
 P_LAM = 2           # bluntness lambda (eq. 24)
 P_PSI = 3           # system number psi (eq. 24)
 P_DT = 4            # time step dtau
-P_NODES = 5         # profile nodes per blade sector
-P_OMEGA_RATE = 6    # max |d OMEGA_S / dtau| (inf = instantaneous)
-P_W_RATE = 7        # max |d W_APP / dtau| (inf = instantaneous)
-P_TAU_AVG = 8       # statistics accumulate for tau >= P_TAU_AVG
-N_PARAMS = 9
+P_OMEGA_RATE = 5    # max |d OMEGA_S / dtau| (inf = instantaneous)
+P_W_RATE = 6        # max |d W_APP / dtau| (inf = instantaneous)
+P_TAU_AVG = 7       # statistics accumulate for tau >= P_TAU_AVG
+N_PARAMS = 8
 
 # ---- surface targets (float64) ----------------------------------------------------------
 I_OMEGA_S = 0       # commanded top-drive speed
@@ -107,8 +106,7 @@ A_OMEGA_MAX = 9
 A_STUCK = 10        # steps stuck within the window
 A_FIRST_STICK = 11  # tau of the first stick (nan if none), whole run
 A_FIRST_BOUNCE = 12  # tau of the first off-bottom step (nan if none), whole run
-A_DOC_OMEGA = 13    # sum of delta * OMEGA (for the mean penetration per revolution)
-N_ACC = 14
+N_ACC = 13
 
 STATUS_OK = 0
 STATUS_NONFINITE = 1
@@ -237,7 +235,7 @@ def _advance(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarr
     head, count, cursor = meta[0], meta[1], meta[2]
     a_count, a_wf, a_tob, a_doc = acc[A_COUNT], acc[A_WF], acc[A_TOB], acc[A_DOC]
     a_wob, a_omega, a_tp, a_v = acc[A_WOB], acc[A_OMEGA], acc[A_T_PIPE], acc[A_V]
-    a_dom, a_stuck = acc[A_DOC_OMEGA], acc[A_STUCK]
+    a_stuck = acc[A_STUCK]
     om_min, om_max = acc[A_OMEGA_MIN], acc[A_OMEGA_MAX]
     first_stick, first_bounce = acc[A_FIRST_STICK], acc[A_FIRST_BOUNCE]
     countdown = _first_countdown(step, every)
@@ -272,7 +270,6 @@ def _advance(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarr
             a_omega += omega
             a_tp += t_pipe
             a_v += v
-            a_dom += doc * omega
             om_min = min(om_min, omega)
             om_max = max(om_max, omega)
             if mode == MODE_STUCK:
@@ -334,7 +331,7 @@ def _advance(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarr
     meta[0], meta[1], meta[2] = head, count, cursor
     acc[A_COUNT], acc[A_WF], acc[A_TOB], acc[A_DOC] = a_count, a_wf, a_tob, a_doc
     acc[A_WOB], acc[A_OMEGA], acc[A_T_PIPE], acc[A_V] = a_wob, a_omega, a_tp, a_v
-    acc[A_DOC_OMEGA], acc[A_STUCK] = a_dom, a_stuck
+    acc[A_STUCK] = a_stuck
     acc[A_OMEGA_MIN], acc[A_OMEGA_MAX] = om_min, om_max
     acc[A_FIRST_STICK], acc[A_FIRST_BOUNCE] = first_stick, first_bounce
     if status == STATUS_OK and not (math.isfinite(u) and math.isfinite(v) and math.isfinite(phi)

@@ -9,7 +9,7 @@ converts to SI.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -75,7 +75,6 @@ class Samples:
     data: np.ndarray
     depth_offset: float = 0.0
     angle_offset: float = 0.0
-    _names: tuple[str, ...] = field(default=(), repr=False)
 
     def __len__(self) -> int:
         return self.data.shape[0]
@@ -125,7 +124,6 @@ class Simulator:
         self._prm[k.P_LAM] = p.lam
         self._prm[k.P_PSI] = p.psi
         self._prm[k.P_DT] = c.dtau
-        self._prm[k.P_NODES] = c.n_nodes
         self._prm[k.P_OMEGA_RATE] = c.omega_rate
         self._prm[k.P_W_RATE] = c.w_rate
         self._prm[k.P_TAU_AVG] = c.tau_avg
