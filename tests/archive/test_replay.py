@@ -135,3 +135,27 @@ def test_truncated_file_replays_its_readable_part_and_exits_nonzero(recording, t
     assert code == 1
     assert sorted(i for i, _ in listener.arrivals) == list(range(readable))
     assert "truncated" in (tmp_path / "replay.log").read_text()
+
+
+def test_start_offset_skips_the_beginning(recording, tmp_path) -> None:
+    offset_s = 0.5
+    first = T0_NS + int(offset_s * 1e9)
+    expected = [i for i, t in enumerate(_log_times()) if t >= first]
+    with ros_node("test_listener") as node:
+        listener = _Listener(node)
+        code = _replay(recording, tmp_path, listener, len(expected), "--rate", "5",
+                       "--start-offset", str(offset_s))
+    assert code == 0, (tmp_path / "replay.log").read_text()
+    assert sorted(i for i, _ in listener.arrivals) == expected
+
+
+def test_loop_replays_again_until_interrupted(recording, tmp_path) -> None:
+    command = ["mcap_replay", str(recording), "--topics", "/drill/test/.*", "--rate", "10",
+               "--loop", "--wait-for-subscribers", "20", "--delay", "0.3"]
+    with ros_node("test_listener") as node:
+        listener = _Listener(node)
+        with running(command, tmp_path / "replay.log") as replay:
+            assert wait_for(lambda: len(listener.arrivals) >= 2 * COUNT + 10, 30)
+            assert stop(replay) == 0, (tmp_path / "replay.log").read_text()
+    counts = [i for i, _ in listener.arrivals]
+    assert counts.count(0) >= 2 and counts.count(COUNT - 1) >= 2     # looped at least twice
