@@ -59,12 +59,15 @@ def running(command: list[str], log_path: Path) -> Iterator[subprocess.Popen]:
 
 def counts_mcap_ros2(path: Path) -> collections.Counter:
     """Messages per topic, each decoded by mcap-ros2-support."""
-    from mcap_ros2.reader import read_ros2_messages
+    from mcap.reader import make_reader
+    from mcap_ros2.decoder import DecoderFactory
 
     counts: collections.Counter = collections.Counter()
-    for message in read_ros2_messages(str(path)):
-        assert message.ros_msg is not None
-        counts[message.channel.topic] += 1
+    with path.open("rb") as stream:
+        reader = make_reader(stream, decoder_factories=[DecoderFactory()])
+        for _, channel, _, decoded in reader.iter_decoded_messages():
+            assert decoded is not None
+            counts[channel.topic] += 1
     return counts
 
 
