@@ -14,7 +14,7 @@ back to the bit/rock/operating quantities for a given drill string and bit.
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, fields, replace
+from dataclasses import dataclass, fields, replace
 from typing import Any
 
 from drill_sim_ros.model.errors import ParameterError
@@ -246,8 +246,3 @@ def dimensionless_from_dict(values: dict[str, Any]) -> DimensionlessParams:
                              f"{sorted(known)}")
     cast = {k: (int(v) if k == "n" else float(v)) for k, v in values.items()}
     return DimensionlessParams(**cast)
-
-
-def as_dict(p: DimensionlessParams | PhysicalParams) -> dict[str, Any]:
-    """Plain-dict view (for JSON and YAML)."""
-    return asdict(p)

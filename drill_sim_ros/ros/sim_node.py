@@ -16,6 +16,7 @@ from __future__ import annotations
 import gc
 import math
 import time
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -268,20 +269,21 @@ class SimNode(Node):
 
     # ---- commands ----------------------------------------------------------------------
     def _on_surface_rpm(self, msg: Float64) -> None:
-        problem = command_problem(msg.data, self._values["limits.max_surface_rpm"], "rev/min")
-        if problem is None:
-            with self._lock.urgent():
-                self._session.set_surface_rpm(msg.data)
-        else:
-            self._reject(topics.CMD_SURFACE_RPM, problem)
+        self._command(topics.CMD_SURFACE_RPM, msg.data, "limits.max_surface_rpm", "rev/min",
+                      self._session.set_surface_rpm)
 
     def _on_wob(self, msg: Float64) -> None:
-        problem = command_problem(msg.data, self._values["limits.max_wob_n"], "N")
-        if problem is None:
-            with self._lock.urgent():
-                self._session.set_wob_n(msg.data)
-        else:
-            self._reject(topics.CMD_WOB, problem)
+        self._command(topics.CMD_WOB, msg.data, "limits.max_wob_n", "N", self._session.set_wob_n)
+
+    def _command(self, topic: str, value: float, limit: str, unit: str,
+                 apply: Callable[[float], None]) -> None:
+        """Apply a setpoint at the next step, or reject it (counted) and keep the last one."""
+        problem = command_problem(value, self._values[limit], unit)
+        if problem is not None:
+            self._reject(topic, problem)
+            return
+        with self._lock.urgent():
+            apply(value)
 
     def _reject(self, topic: str, problem: str) -> None:
         self.rejected_commands += 1

@@ -45,11 +45,6 @@ class PaperUnits:
     def load(cls, name: str) -> PaperUnits:
         return cls.from_preset(load_preset(name))
 
-    @property
-    def torsional_period_s(self) -> float:
-        """2 pi t*: the natural torsional period of the string, in seconds."""
-        return 2.0 * np.pi * self.scales.time_s
-
     def omega(self, rpm: np.ndarray) -> np.ndarray:
         """Bit speed rpm -> omega = Omega t* (eq. 21)."""
         return rpm / RPM_PER_RAD_S * self.scales.time_s

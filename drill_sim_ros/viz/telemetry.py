@@ -64,9 +64,3 @@ class TelemetryBatch:
         """Split where sim time goes backwards (a simulator reset starts a new part)."""
         cuts = np.flatnonzero(np.diff(self.sim_time_s) < 0.0) + 1
         return [TelemetryBatch(part) for part in np.split(self.rows, cuts) if len(part)]
-
-    @staticmethod
-    def concat(batches: Sequence[TelemetryBatch]) -> TelemetryBatch:
-        if not batches:
-            return TelemetryBatch(np.empty((0, N_FIELDS)))
-        return TelemetryBatch(np.concatenate([b.rows for b in batches]))
