@@ -181,7 +181,11 @@ def severity(omega: np.ndarray, omega0: float) -> Severity:
     """SSI = (max - min) / (2 mean) and UTR = (omega0 - min) / omega0 of bit speeds."""
     if omega.size == 0:
         return Severity(math.nan, math.nan, math.nan, math.nan, math.nan)
-    lo, hi, mean = float(omega.min()), float(omega.max()), float(omega.mean())
+    return severity_of(float(omega.min()), float(omega.max()), float(omega.mean()), omega0)
+
+
+def severity_of(lo: float, hi: float, mean: float, omega0: float) -> Severity:
+    """:func:`severity` from the min, max and mean of the bit speed."""
     ssi = (hi - lo) / (2.0 * mean) if mean > 0 else math.inf
     utr = (omega0 - lo) / omega0 if omega0 > 0 else math.nan
     return Severity(ssi, utr, lo, hi, mean)

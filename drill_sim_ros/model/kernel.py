@@ -341,6 +341,7 @@ def _advance(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarr
 
 
 _NO_HISTORY = np.zeros((2, 1))
+_NO_META = np.zeros(3, dtype=np.int64)   # scratch: the profile path ignores what it holds
 
 
 def advance_profile(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarray,
@@ -354,8 +355,7 @@ def advance_profile(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: n
     ``max(old, U_crossing)``. out: shape (rows, N_COLS); a row is written when the global
     step % every == 0. Returns ``(status, rows_written)``.
     """
-    meta = np.zeros(3, dtype=np.int64)
-    return _advance(st, prm, tgt, profile, _NO_HISTORY, meta, acc, out, n_steps, every,
+    return _advance(st, prm, tgt, profile, _NO_HISTORY, _NO_META, acc, out, n_steps, every,
                     False)
 
 

@@ -20,6 +20,7 @@ from drill_sim_ros.model.params import DimensionlessParams
 
 METHODS = ("profile", "exact")
 REBASE_DEPTH = 1.0e4     # rebase U and angles beyond this, to keep differences exact
+REBASE_CHECK_STEPS = 1 << 16   # steps between rebasing checks (U, PHI move far less)
 DEFAULT_NODES = 2048
 
 
@@ -148,6 +149,7 @@ class Simulator:
         self._acc = k.new_accumulators()
         self._depth_offset = 0.0
         self._angle_offset = 0.0
+        self._unchecked_steps = 0
         self._init_profile(triv)
         self._init_history(triv)
         self.fault: str | None = None
@@ -221,17 +223,32 @@ class Simulator:
 
         Raises :class:`NumericalFault` if the state became non-finite (then call reset()).
         """
+        rows = 0 if every <= 0 else max(0, n_steps) // every + 1
+        out = np.empty((rows, k.N_COLS))
+        written = self.advance_into(out, n_steps, every)
+        return Samples(out[:written], self._depth_offset, self._angle_offset)
+
+    def advance_into(self, out: np.ndarray, n_steps: int, every: int) -> int:
+        """:meth:`advance` into the caller's array (rows of ``kernel.C_*`` columns, at least
+        ``n_steps // every + 1``); returns the rows written. Allocates nothing: the node's
+        10 ms tick uses it. The rows hold depth and angles less :attr:`offsets`.
+        """
         if self.fault is not None:
             raise NumericalFault(f"simulator faulted ({self.fault}); call reset()")
         if n_steps < 0:
             raise ParameterError(f"n_steps = {n_steps!r} must be >= 0")
-        rows = 0 if every <= 0 else n_steps // every + 1
-        out = np.empty((rows, k.N_COLS))
+        self._unchecked_steps += n_steps
+        if self._unchecked_steps >= REBASE_CHECK_STEPS:
+            self._rebase()                   # before stepping: the offsets hold for the rows
+            self._unchecked_steps = n_steps
         status, written = self._run(n_steps, every, out)
-        samples = Samples(out[:written], self._depth_offset, self._angle_offset)
         self._check(status)
-        self._rebase()
-        return samples
+        return written
+
+    @property
+    def offsets(self) -> tuple[float, float]:
+        """(depth, angle) to add to the depth and angles of the rows of the last advance."""
+        return self._depth_offset, self._angle_offset
 
     def _run(self, n_steps: int, every: int, out: np.ndarray) -> tuple[int, int]:
         if self.config.method == "profile":
@@ -305,6 +322,11 @@ class Simulator:
     def accumulators(self) -> np.ndarray:
         """Raw statistics (indices ``kernel.A_*``); see :func:`analysis.run_statistics`."""
         return self._acc.copy()
+
+    def restart_extremes(self) -> None:
+        """New running min and max of the bit speed; the sums run on (windowed statistics)."""
+        self._acc[k.A_OMEGA_MIN] = math.inf
+        self._acc[k.A_OMEGA_MAX] = -math.inf
 
     def reset_statistics(self, tau_avg: float | None = None) -> None:
         """Start a new statistics window at ``tau_avg`` (default: now)."""

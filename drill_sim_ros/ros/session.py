@@ -1,23 +1,26 @@
-"""The simulation as the node sees it: SI setpoints in, one SI telemetry row per period out.
+"""The simulation as the node sees it: SI setpoints in, one kernel sample per period out.
 
 ROS-free. A :class:`SimSession` owns the :class:`Simulator`, refines its step so a whole
 number of steps fills one publish period, stamps samples with an integer-nanosecond
-simulated clock that never goes back (not even on reset), and keeps a window of recent bit
-speeds for the stick-slip severity.
+simulated clock that never goes back (not even on reset), and keeps windowed statistics of
+the bit speed for the stick-slip severity.
 """
 
 from __future__ import annotations
 
 import math
+from collections import deque
 from dataclasses import dataclass
 
 import numpy as np
 
 from drill_sim_ros.model import kernel as k
-from drill_sim_ros.model.analysis import Severity, severity
+from drill_sim_ros.model.analysis import Severity, severity_of
 from drill_sim_ros.model.presets import Preset
 from drill_sim_ros.model.simulator import SimConfig, Simulator
-from drill_sim_ros.ros.conversions import NS_PER_S, TelemetryConverter
+from drill_sim_ros.ros.conversions import NS_PER_S
+
+WINDOW_BUCKETS = 20
 
 
 @dataclass(frozen=True)
@@ -63,7 +66,7 @@ def build_simulator(cfg: SessionConfig, period_tau: float, steps: int) -> Simula
 
 
 class SimSession:
-    """Advances whole publish periods and returns SI telemetry rows."""
+    """Advances whole publish periods into a reusable array of kernel samples."""
 
     def __init__(self, cfg: SessionConfig) -> None:
         self.cfg = cfg
@@ -72,14 +75,15 @@ class SimSession:
         period_tau = self.period_ns / NS_PER_S / self.scales.time_s
         self.steps = steps_per_period(period_tau, cfg.dtau_max)
         self.sim = build_simulator(cfg, period_tau, self.steps)
-        self.sim.advance(0)          # load the compiled kernel now, not on the first tick
+        self.samples = np.empty((2, k.N_COLS))   # rows of the last run (grows as needed)
+        self.sim.advance_into(self.samples, 0, self.steps)  # load the compiled kernel now
         self.next_index = 0          # sample counter: stamps = index * period_ns
-        self._converter = TelemetryConverter(self.scales)
-        size = max(2, round(cfg.window_s * cfg.publish_rate_hz))
-        self._omega = [0.0] * size       # ring buffers of the recent window
-        self._stuck = [False] * size
-        self._head = 0                   # where the next sample goes
-        self._filled = 0
+        # The severity window: snapshots of the kernel's running sums at the end of each of
+        # its WINDOW_BUCKETS parts, the extremes restarted after each (no per-sample work).
+        self._bucket_samples = max(1, round(cfg.window_s * cfg.publish_rate_hz
+                                            / WINDOW_BUCKETS))
+        self._snapshots: deque[np.ndarray] = deque(maxlen=WINDOW_BUCKETS + 1)
+        self._bucket_end = self._bucket_samples
 
     @property
     def dtau(self) -> float:
@@ -90,34 +94,38 @@ class SimSession:
         """Stamp of the next sample (the simulated clock)."""
         return self.next_index * self.period_ns
 
-    def run(self, periods: int, submerged_weight_n: float) -> tuple[list[int], list[list[float]]]:
-        """Advance ``periods`` publish periods: (stamps ns, SI rows of ``TELEMETRY_FIELDS``).
-
-        Row i is the state at the start of period i. Raises ``NumericalFault``.
+    def run(self, periods: int) -> tuple[int, int]:
+        """Advance ``periods`` publish periods into :attr:`samples`: (stamp of the first
+        sample in ns, number of samples). Sample i is the state at the start of period i,
+        stamped ``first + i * period_ns``; add :attr:`Simulator.offsets` to its depth and
+        angles. Raises ``NumericalFault``.
         """
-        samples = self.sim.advance(periods * self.steps, every=self.steps)
-        stamps = [(self.next_index + i) * self.period_ns for i in range(len(samples))]
-        self.next_index += len(samples)
-        rows = self._converter.rows(samples, [t / NS_PER_S for t in stamps],
-                                    submerged_weight_n)
-        self._remember(samples.data[:, k.C_OMEGA].tolist(), samples.data[:, k.C_MODE].tolist())
-        return stamps, rows
-
-    def _remember(self, omega: list[float], mode: list[float]) -> None:
-        size = len(self._omega)
-        for value, state in zip(omega[-size:], mode[-size:], strict=True):
-            self._omega[self._head] = value
-            self._stuck[self._head] = state == k.MODE_STUCK
-            self._head = (self._head + 1) % size
-        self._filled = min(size, self._filled + len(omega))
+        if periods + 1 > self.samples.shape[0]:
+            self.samples = np.empty((periods + 1, k.N_COLS))
+        first_ns = self.sim_time_ns
+        count = self.sim.advance_into(self.samples, periods * self.steps, self.steps)
+        self.next_index += count
+        if self.next_index >= self._bucket_end:
+            self._snapshots.append(self.sim.accumulators)
+            self.sim.restart_extremes()
+            self._bucket_end = self.next_index + self._bucket_samples
+        return first_ns, count
 
     def severity(self) -> tuple[Severity, float]:
-        """Stick-slip severity of the recent window and its stick fraction (nan if empty)."""
-        if self._filled == 0:
-            return severity(np.empty(0), 1.0), math.nan
-        omega = np.roll(self._omega, -self._head)[-self._filled:]
-        stuck = np.roll(self._stuck, -self._head)[-self._filled:]
-        return severity(omega, self.sim.targets[0]), float(stuck.mean())
+        """Stick-slip severity of the last ``window_s`` (to within 1/WINDOW_BUCKETS of it),
+        from every step, and its stick fraction (nan before the first step)."""
+        now = self.sim.accumulators
+        full = len(self._snapshots) == self._snapshots.maxlen
+        start = self._snapshots[0] if full else k.new_accumulators()
+        parts = [*list(self._snapshots)[1 if full else 0:], now]
+        steps = now[k.A_COUNT] - start[k.A_COUNT]
+        if steps <= 0:
+            return Severity(math.nan, math.nan, math.nan, math.nan, math.nan), math.nan
+        lo = min(float(p[k.A_OMEGA_MIN]) for p in parts)
+        hi = max(float(p[k.A_OMEGA_MAX]) for p in parts)
+        mean = float(now[k.A_OMEGA] - start[k.A_OMEGA]) / steps
+        stuck = float(now[k.A_STUCK] - start[k.A_STUCK]) / steps
+        return severity_of(lo, hi, mean, self.sim.targets[0]), stuck
 
     def set_surface_rpm(self, rpm: float) -> None:
         self.sim.set_inputs(omega_s=self.scales.omega_from_rpm(rpm))
@@ -128,4 +136,5 @@ class SimSession:
     def reset(self) -> None:
         """Model back to its initial state and setpoints; the simulated clock runs on."""
         self.sim.reset()
-        self._filled = 0
+        self._snapshots.clear()
+        self._bucket_end = self.next_index + self._bucket_samples

@@ -20,6 +20,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import rclpy
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from rcl_interfaces.msg import SetParametersResult
@@ -38,7 +39,8 @@ from drill_sim_ros import topics
 from drill_sim_ros.model.errors import DrillSimError, NumericalFault
 from drill_sim_ros.model.presets import load_preset
 from drill_sim_ros.ros import messages
-from drill_sim_ros.ros.conversions import SampleMessages, stamp
+from drill_sim_ros.ros.conversions import stamp
+from drill_sim_ros.ros.frame import SAMPLE_TOPICS, SampleFrame
 from drill_sim_ros.ros.pacing import Pacer, RateMeter
 from drill_sim_ros.ros.parameters import SPEC_BY_NAME, coerce, declare_all, validate
 from drill_sim_ros.ros.session import SessionConfig, SimSession
@@ -60,9 +62,6 @@ MAX_CATCH_UP = 50            # periods per turn of the ticker when catching up i
 DIAGNOSTICS_PERIOD_S = 1.0
 STATUS_PERIOD_S = 0.25
 WARN_THROTTLE_S = 1.0
-SAMPLE_TOPICS = (topics.BIT_WOB, topics.BIT_TOB, topics.BIT_ROP, topics.BIT_RPM,
-                 topics.BIT_DEPTH_OF_CUT, topics.BIT_MODE, topics.BIT_JOINT_STATES,
-                 topics.SURFACE_JOINT_STATES, topics.TELEMETRY)
 
 
 def session_config(values: dict[str, Any], preset: Any) -> SessionConfig:
@@ -95,7 +94,8 @@ class SimNode(Node):
         self._steady = Clock(clock_type=ClockType.STEADY_TIME)
         self._preset, self._values = declare_all(self, load_preset)
         self._session = SimSession(session_config(self._values, self._preset))
-        self._messages = SampleMessages()
+        self._frames = {with_clock: SampleFrame(self._preset.scales, with_clock)
+                        for with_clock in (False, True)}
         self._lock = HandoffLock()
         self._pacer = Pacer(self._wall_period_ns(1.0))
         self._rate = RateMeter(time.monotonic_ns(), 0.0)
@@ -104,12 +104,12 @@ class SimNode(Node):
         self._paused = False
         self._fault: str | None = None
         self.rejected_commands = 0
-        self._last_row: list[float] | None = None
+        self._last_row: np.ndarray | None = None     # SI, TELEMETRY_FIELDS; lock held
         self._pubs = {t: self.create_publisher(messages.type_of(t), t, self._qos(t),
                                                event_callbacks=QUIET_PUBLISHER)
                       for t in (*SAMPLE_TOPICS, topics.CLOCK, topics.DIAGNOSTICS)}
-        self._outputs = {with_clock: self._sample_outputs(with_clock)
-                         for with_clock in (False, True)}
+        self._publish_raw = {with_clock: [self._pubs[t].handle.publish_raw for t in frame.topics]
+                             for with_clock, frame in self._frames.items()}
         self._recorder = self._open_recorder(self._values["record.path"])
         self.create_subscription(Float64, topics.CMD_SURFACE_RPM, self._on_surface_rpm,
                                  COMMAND_QOS)
@@ -131,11 +131,6 @@ class SimNode(Node):
     @staticmethod
     def _qos(topic: str) -> QoSProfile:
         return CLOCK_QOS if topic in (topics.CLOCK, topics.DIAGNOSTICS) else DATA_QOS
-
-    def _sample_outputs(self, with_clock: bool) -> list[tuple[Any, str, object]]:
-        """``(publish, topic, message)`` of every message of a sample, in publishing order."""
-        return [(self._pubs[topic].publish, topic, msg)
-                for topic, msg in self._messages.messages(with_clock)]
 
     def _open_recorder(self, path: str) -> Any:
         """The in-process MCAP recorder of ``record.path`` (None when off or unavailable)."""
@@ -222,16 +217,20 @@ class SimNode(Node):
 
     def _tick(self) -> float | None:
         """One turn of the ticker thread; the seconds to wait before the next (None: idle)."""
-        with self._lock.background():
+        self._lock.acquire_background()
+        try:
             if self._lockstep or self._paused or self._fault is not None:
                 return None
             if self._rtf <= 0:
                 self._advance(FREE_RUN_BATCH)
                 return 0.0
-            count = self._pacer.due(time.monotonic_ns(), MAX_CATCH_UP)
+            pacer = self._pacer
+            count = pacer.due(time.monotonic_ns(), MAX_CATCH_UP)
             if count > 0 and self._advance(count):
-                self._pacer.complete(count, time.monotonic_ns())
-            return max(0.0, (self._pacer.deadline_ns() - time.monotonic_ns()) * 1e-9)
+                pacer.complete(count, time.monotonic_ns())
+            return max(0.0, (pacer.deadline_ns() - time.monotonic_ns()) * 1e-9)
+        finally:
+            self._lock.release()
 
     def _on_tick_error(self, exc: Exception) -> bool:
         """An unexpected error on the ticker: quiet at shutdown, else a fault until reset."""
@@ -244,28 +243,30 @@ class SimNode(Node):
 
     def _advance(self, periods: int) -> bool:
         """Simulate and publish ``periods`` samples; False on a numerical fault."""
+        session = self._session
         try:
-            stamps, rows = self._session.run(periods, self._values[
-                "model.submerged_string_weight_n"])
+            time_ns, count = session.run(periods)
         except NumericalFault as exc:
             self._fault = str(exc)
             self.get_logger().error(f"numerical fault: {exc}; call ~/reset to recover")
             return False
-        outputs = self._outputs[self._values["publish_clock"]]
-        for time_ns, row in zip(stamps, rows, strict=True):
-            self._publish_sample(row, time_ns, outputs)
-        if rows:
-            self._last_row = rows[-1]
+        with_clock = self._values["publish_clock"]
+        frame, publishers = self._frames[with_clock], self._publish_raw[with_clock]
+        weight_n = self._values["model.submerged_string_weight_n"]
+        offsets = session.sim.offsets
+        for index in range(count):
+            payloads = frame.pack(session.samples, index, offsets, time_ns, weight_n)
+            # The publishers' own handles: Publisher.publish adds a context guard and two
+            # type checks per message; sim_node destroys no publisher while it ticks.
+            for publish, payload in zip(publishers, payloads, strict=True):
+                publish(payload)
+            if self._recorder is not None:       # the very bytes published, unchanged
+                for topic, payload in zip(frame.topics, payloads, strict=True):
+                    self._recorder.write_serialized(topic, payload, time_ns)
+            time_ns += session.period_ns
+        if count:
+            self._last_row = frame.row
         return True
-
-    def _publish_sample(self, row: list[float], time_ns: int,
-                        outputs: list[tuple[Any, str, object]]) -> None:
-        payloads = self._messages.payloads(row, time_ns)     # /clock last: zip may drop it
-        for (publish, _, _), payload in zip(outputs, payloads, strict=False):
-            publish(payload)
-        if self._recorder is not None:       # the very bytes published, unchanged
-            for (_, topic, _), payload in zip(outputs, payloads, strict=False):
-                self._recorder.write_serialized(topic, payload, time_ns)
 
     # ---- commands ----------------------------------------------------------------------
     def _on_surface_rpm(self, msg: Float64) -> None:
@@ -388,7 +389,8 @@ class SimNode(Node):
 
     def _show_status(self) -> None:
         with self._lock.urgent():
-            row, state = self._last_row, self._state_text()
+            row = None if self._last_row is None else self._last_row.tolist()
+            state = self._state_text()
         if self._values["status_line"] and row is not None:
             self._status.show(format_status(row, self._rate.last, state))
 

@@ -93,7 +93,7 @@ def test_rebasing_keeps_large_depths_exact() -> None:
     rows_a = np.concatenate([a.advance(100_000, every=100).data for _ in range(300)])
     assert a.snapshot().depth_offset > 0.0          # rebasing happened
     b = Simulator(p, SimConfig(dtau=2e-4), perturb_v=0.01)
-    rows_b = b.advance(30_000_000, every=100).data  # rebases only once, at the end
+    rows_b = b.advance(30_000_000, every=100).data  # never rebases (only before a run)
     # a missed shift would jump the depth of cut by n * shift ~ 1e4; rounding drifts ~1e-6
     for col in (k.C_DOC, k.C_OMEGA, k.C_V, k.C_WOB):
         spread = np.ptp(rows_b[:, col])

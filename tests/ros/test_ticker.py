@@ -13,8 +13,11 @@ def test_a_callback_gets_the_lock_from_a_ticker_that_never_sleeps():
     lock = HandoffLock()
 
     def busy() -> float:
-        with lock.background():
+        lock.acquire_background()
+        try:
             time.sleep(0.002)           # one "batch" with the lock held
+        finally:
+            lock.release()
         return 0.0
 
     ticker = Ticker(busy, lambda exc: False)

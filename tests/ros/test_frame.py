@@ -1,0 +1,109 @@
+"""The compiled per-sample path: its SI row equals the numpy reference bit for bit, and its
+payloads are what rclpy's serializer makes of messages built field by field from topics.py."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from rclpy.serialization import deserialize_message, serialize_message
+from rosgraph_msgs.msg import Clock
+from sensor_msgs.msg import JointState
+from std_msgs.msg import Float64, Float64MultiArray, MultiArrayDimension, UInt8
+
+from drill_sim_ros import topics
+from drill_sim_ros.model import kernel as k
+from drill_sim_ros.model.params import RPM_PER_RAD_S
+from drill_sim_ros.model.presets import load_preset
+from drill_sim_ros.model.simulator import Samples
+from drill_sim_ros.ros.conversions import telemetry_rows
+from drill_sim_ros.ros.frame import SampleFrame
+
+F = topics.TELEMETRY_INDEX
+OFFSETS, SUBMERGED_N = (1234.0, 2.0 * math.pi * 57), 2.5e6
+TIMES_NS = (0, 10_000_000, 123_456_789_012, 5_000_000_000)
+PADDED = (topics.BIT_MODE, topics.BIT_JOINT_STATES, topics.SURFACE_JOINT_STATES,
+          topics.TELEMETRY)
+
+
+def random_samples(rows: int, seed: int = 3) -> Samples:
+    rng = np.random.default_rng(seed)
+    data = rng.uniform(-50.0, 50.0, (rows, k.N_COLS))
+    data[:, k.C_MODE] = rng.integers(0, 4, rows)
+    data[0, k.C_V] = -0.0
+    return Samples(data, *OFFSETS)
+
+
+def joint_state(names: tuple[str, ...], sec: int, nanosec: int, values: list[float]
+                ) -> JointState:
+    msg = JointState(name=list(names), position=values[0:2], velocity=values[2:4],
+                     effort=values[4:6])
+    msg.header.stamp.sec, msg.header.stamp.nanosec = sec, nanosec
+    return msg
+
+
+def expected_messages(v: np.ndarray, time_ns: int) -> dict[str, object]:
+    """Messages of one SI row as topics.py documents them, built one field at a time."""
+    sec, nanosec = divmod(time_ns, 1_000_000_000)
+    label = ",".join(topics.TELEMETRY_FIELDS)
+    n = len(topics.TELEMETRY_FIELDS)
+    telemetry = Float64MultiArray(data=v.tolist())
+    telemetry.layout.dim = [MultiArrayDimension(label=label, size=n, stride=n)]
+    clock = Clock()
+    clock.clock.sec, clock.clock.nanosec = sec, nanosec
+    return {
+        topics.BIT_WOB: Float64(data=v[F["wob_n"]]), topics.BIT_TOB: Float64(data=v[F["tob_nm"]]),
+        topics.BIT_ROP: Float64(data=v[F["rop_m_s"]]),
+        topics.BIT_RPM: Float64(data=v[F["bit_rpm"]]),
+        topics.BIT_DEPTH_OF_CUT: Float64(data=v[F["depth_of_cut_m"]]),
+        topics.BIT_MODE: UInt8(data=int(v[F["mode"]])),
+        topics.BIT_JOINT_STATES: joint_state(topics.BIT_JOINTS, sec, nanosec, [
+            v[F["bit_angle_rad"]], v[F["bit_depth_m"]], v[F["bit_rpm"]] / RPM_PER_RAD_S,
+            v[F["rop_m_s"]], v[F["tob_nm"]], v[F["wob_n"]]]),
+        topics.SURFACE_JOINT_STATES: joint_state(topics.SURFACE_JOINTS, sec, nanosec, [
+            v[F["surface_angle_rad"]], v[F["bit_depth_m"]],
+            v[F["surface_rpm"]] / RPM_PER_RAD_S, v[F["rop_m_s"]], v[F["surface_torque_nm"]],
+            v[F["hook_load_n"]]]),
+        topics.TELEMETRY: telemetry,
+        topics.CLOCK: clock,
+    }
+
+
+def test_rows_equal_the_numpy_reference_bit_for_bit():
+    preset = load_preset("field_8p5in_shale")
+    samples = random_samples(len(TIMES_NS))
+    reference = telemetry_rows(samples, preset.scales, np.array(TIMES_NS) / 1e9, SUBMERGED_N)
+    frame = SampleFrame(preset.scales, with_clock=False)
+    for i, time_ns in enumerate(TIMES_NS):
+        frame.pack(samples.data, i, OFFSETS, time_ns, SUBMERGED_N)
+        assert frame.row.tobytes() == reference[i].tobytes()
+
+
+@pytest.mark.parametrize("with_clock", [True, False])
+def test_payloads_are_the_serialized_messages_in_publishing_order(with_clock):
+    preset = load_preset("field_8p5in_shale")
+    samples = random_samples(len(TIMES_NS), seed=5)
+    frame = SampleFrame(preset.scales, with_clock)
+    assert frame.topics[-1] == topics.CLOCK if with_clock else topics.CLOCK not in frame.topics
+    for i, time_ns in enumerate(TIMES_NS):
+        payloads = frame.pack(samples.data, i, OFFSETS, time_ns, SUBMERGED_N)
+        expected = expected_messages(frame.row, time_ns)
+        assert len(payloads) == len(frame.topics)
+        for topic, payload in zip(frame.topics, payloads, strict=True):
+            msg = expected[topic]
+            serialized = serialize_message(msg)
+            assert type(payload) is bytes, topic
+            assert len(payload) == len(serialized), topic
+            assert deserialize_message(payload, type(msg)) == msg, topic
+            if topic in PADDED:               # rclpy leaves padding bytes undefined
+                assert all(a == b or a == 0 for a, b in zip(payload, serialized, strict=True))
+            else:
+                assert payload == serialized, topic
+
+
+def test_templates_zero_their_padding():
+    frame = SampleFrame(load_preset("field_8p5in_shale").scales, with_clock=False)
+    payload = frame.pack(np.ones((1, k.N_COLS)), 0, (0.0, 0.0), 0, 0.0)[
+        frame.topics.index(topics.BIT_JOINT_STATES)]
+    assert payload[17:20] == b"\x00\x00\x00"  # frame_id "": length 1 + NUL, then 3 pad bytes
