@@ -11,7 +11,6 @@ from drill_sim_ros.model.analysis import severity
 from drill_sim_ros.model.presets import load_preset
 from drill_sim_ros.ros.session import WINDOW_BUCKETS, SessionConfig, SimSession
 
-
 BUCKET = 5                      # samples per part of the window
 
 
