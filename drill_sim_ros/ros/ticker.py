@@ -81,8 +81,9 @@ class Ticker:
         self._thread.start()
 
     def wake(self) -> None:
-        """Call ``work`` now (the schedule or the state changed)."""
-        os.eventfd_write(self._wake_fd, 1)
+        """Call ``work`` now (the schedule or the state changed); nothing once stopped."""
+        if self._wake_fd >= 0:
+            os.eventfd_write(self._wake_fd, 1)
 
     def stop(self, timeout_s: float = 5.0) -> None:
         """End the loop after the current call and wait for it (idempotent)."""

@@ -52,6 +52,29 @@ def test_wake_calls_work_now_and_stop_joins():
     ticker.stop()
     assert not ticker._thread.is_alive()
     ticker.stop()                        # idempotent
+    ticker.wake()                        # harmless once stopped
+
+
+def test_a_long_wait_ends_at_a_wake_and_a_short_one_at_its_end():
+    calls = []
+
+    def work() -> float:
+        calls.append(time.monotonic())
+        return 30.0 if len(calls) == 1 else 0.005 if len(calls) == 2 else None
+
+    ticker = Ticker(work, lambda exc: False)
+    ticker.start()
+    try:
+        time.sleep(0.1)
+        assert len(calls) == 1               # waiting 30 s
+        ticker.wake()
+        deadline = time.monotonic() + 2.0
+        while len(calls) < 3 and time.monotonic() < deadline:
+            time.sleep(0.001)
+        assert len(calls) == 3               # woken, then a 5 ms sleep, then idle
+        assert calls[2] - calls[1] >= 0.005
+    finally:
+        ticker.stop()
 
 
 def test_an_error_goes_to_on_error_and_false_ends_the_loop():
