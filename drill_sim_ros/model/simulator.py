@@ -241,7 +241,13 @@ class Simulator:
         if self._unchecked_steps >= REBASE_CHECK_STEPS:
             self._rebase()                   # before stepping: the offsets hold for the rows
             self._unchecked_steps = n_steps
-        status, written = self._run(n_steps, every, out)
+        if self._hist is None:               # the profile method (no exact-delay history)
+            status, written = k.advance_profile(self._state, self._prm, self._targets,
+                                                self._profile, self._acc, out, n_steps, every)
+        else:
+            status, written = k.advance_exact(self._state, self._prm, self._targets,
+                                              self._hist, self._meta, self._acc, out, n_steps,
+                                              every)
         self._check(status)
         return written
 
@@ -249,13 +255,6 @@ class Simulator:
     def offsets(self) -> tuple[float, float]:
         """(depth, angle) to add to the depth and angles of the rows of the last advance."""
         return self._depth_offset, self._angle_offset
-
-    def _run(self, n_steps: int, every: int, out: np.ndarray) -> tuple[int, int]:
-        if self.config.method == "profile":
-            return k.advance_profile(self._state, self._prm, self._targets, self._profile,
-                                     self._acc, out, n_steps, every)
-        return k.advance_exact(self._state, self._prm, self._targets, self._hist,
-                               self._meta, self._acc, out, n_steps, every)
 
     def _check(self, status: int) -> None:
         if status == k.STATUS_NONFINITE:

@@ -87,14 +87,14 @@ class SampleFrame:
             end += -(-len(layouts[topic][0].template) // 8) * 8
         self._buffer = np.zeros(-(-end // 8), dtype=np.float64)
         raw = self._buffer.view(np.uint8)
-        self._spans = []
+        self._slices: list[slice] = []
         doubles: list[tuple[int, int, int]] = []
         stamps: list[int] = []
         mode_at = -1
         for topic, start in zip(self.topics, starts, strict=True):
             layout, values = layouts[topic]
             raw[start:start + len(layout.template)] = np.frombuffer(layout.template, np.uint8)
-            self._spans.append((start, start + len(layout.template)))
+            self._slices.append(slice(start, start + len(layout.template)))
             doubles += [((start + at) // 8, F[field], int(rad_s))
                         for at, (field, rad_s) in zip(layout.doubles, values, strict=True)]
             if layout.stamp is not None:
@@ -110,8 +110,7 @@ class SampleFrame:
         angles less ``offsets``) stamped ``time_ns`` of simulated time; fills :attr:`row`."""
         _fill(samples, index, offsets[0], offsets[1], time_ns, submerged_weight_n,
               self._factors, self.row, self._buffer, self._plan)
-        data = self._buffer.tobytes()
-        return [data[a:b] for a, b in self._spans]
+        return list(map(self._buffer.tobytes().__getitem__, self._slices))
 
 
 @njit(cache=True)

@@ -103,7 +103,12 @@ class Ticker:
     def _loop(self) -> None:
         fd, wait = self._wake_fd, [self._wake_fd]
         while not self._stopping:
-            delay = self._call()
+            try:
+                delay = self._work()
+            except Exception as exc:
+                delay = None
+                if not self._on_error(exc):
+                    self._stopping = True
             if self._stopping:
                 return
             if delay is not None and delay <= SHORT_WAIT_S:
@@ -111,11 +116,3 @@ class Ticker:
                     time.sleep(delay)           # a wake meanwhile waits for this tick
             elif select.select(wait, (), (), delay)[0]:
                 os.eventfd_read(fd)             # wakes are counted: read them all at once
-
-    def _call(self) -> float | None:
-        try:
-            return self._work()
-        except Exception as exc:
-            if not self._on_error(exc):
-                self._stopping = True
-            return None
