@@ -49,6 +49,7 @@ class Listener(Node):
         super().__init__("bench_listener")
         self.count = 0
         self.diagnostics: dict[str, str] = {}
+        self.sim_times: list[tuple[float, float]] = []   # (wall s at receipt, sim_time_s)
         qos = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE)
         for topic in PUBLISHED:
             self.create_subscription(type_of(topic), topic, self._on_message, qos)
@@ -60,6 +61,18 @@ class Listener(Node):
 
     def _on_diagnostics(self, msg) -> None:
         self.diagnostics = {kv.key: kv.value for s in msg.status for kv in s.values}
+        if "sim_time_s" in self.diagnostics:
+            self.sim_times.append((time.monotonic(), float(self.diagnostics["sim_time_s"])))
+
+
+def sim_rate(sim_times: list[tuple[float, float]], start: float, end: float) -> float:
+    """Simulated seconds per wall second between the first and last /diagnostics received in
+    [start, end] (the node publishes one per wall second)."""
+    inside = [(wall, sim) for wall, sim in sim_times if start <= wall <= end]
+    if len(inside) < 2:
+        return float("nan")
+    (wall0, sim0), (wall1, sim1) = inside[0], inside[-1]
+    return (sim1 - sim0) / (wall1 - wall0)
 
 
 def spin_for(node: Node, seconds: float) -> None:
@@ -89,7 +102,6 @@ def measure(listener: Listener, preset: str, factor: float, seconds: float) -> d
     try:
         spin_for(listener, 4.0)                       # start-up, JIT cache, discovery
         cpu0, wall0, n0 = cpu_seconds(proc.pid), time.monotonic(), listener.count
-        sim0 = float(listener.diagnostics.get("sim_time_s", "nan"))
         spin_for(listener, seconds)
         cpu1, wall1, n1 = cpu_seconds(proc.pid), time.monotonic(), listener.count
         spin_for(listener, 1.1)                       # the next /diagnostics
@@ -101,7 +113,7 @@ def measure(listener: Listener, preset: str, factor: float, seconds: float) -> d
             "p50_ms": float(diag.get("tick_lateness_p50_ms", "nan")),
             "p99_ms": float(diag.get("tick_lateness_p99_ms", "nan")),
             "overruns": float(diag.get("overruns", "nan")),
-            "sim_rate": (float(diag.get("sim_time_s", "nan")) - sim0) / (wall + 1.1),
+            "sim_rate": sim_rate(listener.sim_times, wall0, wall1),
             "rtf_reported": float(diag.get("real_time_factor_achieved", "nan"))}
 
 
