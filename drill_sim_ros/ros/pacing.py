@@ -51,12 +51,21 @@ class Pacer:
                 self.overruns += 1
             self._done += 1
 
+    def lateness_ns(self) -> list[int]:
+        """A copy of the recent tick lateness, ns (for :func:`lateness_percentiles_ms`)."""
+        return list(self._lateness_ns)
+
     def lateness_percentiles_ms(self, *percents: float) -> tuple[float, ...]:
         """Percentiles of the recent tick lateness in ms (nan before the first tick)."""
-        if not self._lateness_ns:
-            return tuple(math.nan for _ in percents)
-        values = np.percentile(np.fromiter(self._lateness_ns, float), percents) * 1e-6
-        return tuple(float(v) for v in values)
+        return lateness_percentiles_ms(self.lateness_ns(), *percents)
+
+
+def lateness_percentiles_ms(lateness_ns: list[int], *percents: float) -> tuple[float, ...]:
+    """Percentiles of tick lateness values (ns) in ms; nan for none."""
+    if not lateness_ns:
+        return tuple(math.nan for _ in percents)
+    values = np.percentile(np.array(lateness_ns, dtype=float), percents) * 1e-6
+    return tuple(float(v) for v in values)
 
 
 class RateMeter:

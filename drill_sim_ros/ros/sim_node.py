@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import gc
 import math
+import sys
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -31,6 +32,7 @@ from rclpy.impl.implementation_singleton import rclpy_implementation
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.serialization import serialize_message
 from rclpy.task import Future
 from std_msgs.msg import Float64
 from std_srvs.srv import SetBool, Trigger
@@ -41,7 +43,7 @@ from drill_sim_ros.model.presets import load_preset
 from drill_sim_ros.ros import messages
 from drill_sim_ros.ros.conversions import stamp
 from drill_sim_ros.ros.frame import SAMPLE_TOPICS, SampleFrame
-from drill_sim_ros.ros.pacing import Pacer, RateMeter
+from drill_sim_ros.ros.pacing import Pacer, RateMeter, lateness_percentiles_ms
 from drill_sim_ros.ros.parameters import SPEC_BY_NAME, coerce, declare_all, validate
 from drill_sim_ros.ros.session import SessionConfig, SimSession
 from drill_sim_ros.ros.status_line import StatusLine, format_status
@@ -62,6 +64,7 @@ MAX_CATCH_UP = 50            # periods per turn of the ticker when catching up i
 DIAGNOSTICS_PERIOD_S = 1.0
 STATUS_PERIOD_S = 0.25
 WARN_THROTTLE_S = 1.0
+GIL_SWITCH_INTERVAL_S = 0.0005
 
 
 def session_config(values: dict[str, Any], preset: Any) -> SessionConfig:
@@ -332,46 +335,68 @@ class SimNode(Node):
 
     # ---- diagnostics, status, shutdown -------------------------------------------------
     def _publish_diagnostics(self) -> None:
+        """/diagnostics: the figures are read under the lock, the message is built and
+        serialized outside it, so the ticker waits for a copy, not for the formatting."""
         with self._lock.urgent():
             time_ns = max(0, self._session.sim_time_ns - self._session.period_ns)
-            achieved = self._rate.update(time.monotonic_ns(), time_ns * 1e-9)
-            msg = DiagnosticArray(status=[self._node_status(achieved), self._dynamics_status()])
-            msg.header.stamp = stamp(time_ns)
-            self._pubs[topics.DIAGNOSTICS].publish(msg)
+            figures = self._figures(time_ns)
+        msg = DiagnosticArray(status=[self._node_status(figures),
+                                      self._dynamics_status(figures)])
+        msg.header.stamp = stamp(time_ns)
+        payload = serialize_message(msg)
+        self._pubs[topics.DIAGNOSTICS].publish(payload)
+        with self._lock.urgent():
             if self._recorder is not None:
-                self._recorder.write(topics.DIAGNOSTICS, msg, time_ns)
+                self._recorder.write_serialized(topics.DIAGNOSTICS, payload, time_ns)
 
-    def _node_status(self, achieved_rtf: float) -> DiagnosticStatus:
-        p50, p99 = self._pacer.lateness_percentiles_ms(50, 99)
+    def _figures(self, time_ns: int) -> dict[str, Any]:
+        """What /diagnostics reports, copied (call with the lock held)."""
+        sev, stick_fraction = self._session.severity()
+        row = self._last_row
+        return {
+            "state": self._state_text(), "fault": self._fault,
+            "sim_time_s": self._session.sim_time_ns * 1e-9, "rtf": self._rtf,
+            "achieved": self._rate.update(time.monotonic_ns(), time_ns * 1e-9),
+            "overruns": self._pacer.overruns, "lateness_ns": self._pacer.lateness_ns(),
+            "rejected": self.rejected_commands, "dropped": self._recorder_count("dropped"),
+            "written": self._recorder_count("written"), "severity": sev,
+            "stick_fraction": stick_fraction,
+            "mode": "none" if row is None else topics.MODE_NAMES[
+                int(row[topics.TELEMETRY_INDEX["mode"]])],
+            "window_s": self._values["diagnostics.window_s"],
+        }
+
+    @staticmethod
+    def _node_status(f: dict[str, Any]) -> DiagnosticStatus:
+        p50, p99 = lateness_percentiles_ms(f["lateness_ns"], 50, 99)
         values = {
-            "state": self._state_text(),
-            "sim_time_s": f"{self._session.sim_time_ns * 1e-9:.3f}",
-            "real_time_factor_target": f"{self._rtf:g}",
-            "real_time_factor_achieved": f"{achieved_rtf:.4g}",
-            "overruns": str(self._pacer.overruns),
+            "state": f["state"],
+            "sim_time_s": f"{f['sim_time_s']:.3f}",
+            "real_time_factor_target": f"{f['rtf']:g}",
+            "real_time_factor_achieved": f"{f['achieved']:.4g}",
+            "overruns": str(f["overruns"]),
             "tick_lateness_p50_ms": f"{p50:.4g}",
             "tick_lateness_p99_ms": f"{p99:.4g}",
-            "rejected_commands": str(self.rejected_commands),
-            "recorder_dropped": str(self._recorder_count("dropped")),
-            "recorder_written": str(self._recorder_count("written")),
-            "fault": self._fault or "",
+            "rejected_commands": str(f["rejected"]),
+            "recorder_dropped": str(f["dropped"]),
+            "recorder_written": str(f["written"]),
+            "fault": f["fault"] or "",
         }
-        if self._fault is not None:
-            level, message = DiagnosticStatus.ERROR, f"numerical fault: {self._fault}"
-        elif self._pacer.overruns or self._recorder_count("dropped"):
+        if f["fault"] is not None:
+            level, message = DiagnosticStatus.ERROR, f"numerical fault: {f['fault']}"
+        elif f["overruns"] or f["dropped"]:
             level, message = DiagnosticStatus.WARN, "overruns or recorder drops"
         else:
-            level, message = DiagnosticStatus.OK, self._state_text()
+            level, message = DiagnosticStatus.OK, f["state"]
         return messages.status(f"{topics.NODE_NAME}: simulation", level, message, values)
 
-    def _dynamics_status(self) -> DiagnosticStatus:
-        sev, stick_fraction = self._session.severity()
-        mode = topics.MODE_NAMES[int(self._last_row[topics.TELEMETRY_INDEX["mode"]])] \
-            if self._last_row is not None else "none"
-        values = {"mode": mode, "stick_slip_severity": f"{sev.ssi:.4g}",
+    @staticmethod
+    def _dynamics_status(f: dict[str, Any]) -> DiagnosticStatus:
+        sev, stick_fraction = f["severity"], f["stick_fraction"]
+        values = {"mode": f["mode"], "stick_slip_severity": f"{sev.ssi:.4g}",
                   "under_torque_ratio": f"{sev.utr:.4g}",
                   "stick_fraction": f"{stick_fraction:.4g}",
-                  "window_s": f"{self._values['diagnostics.window_s']:g}"}
+                  "window_s": f"{f['window_s']:g}"}
         stick_slip = stick_fraction > 0 or sev.ssi > 0.5
         level = DiagnosticStatus.WARN if stick_slip else DiagnosticStatus.OK
         message = "stick-slip" if stick_slip else "smooth drilling"
@@ -428,6 +453,9 @@ def main(args: list[str] | None = None) -> int:
         # collector, whose full passes over the imported modules stall the ticker ~10-40 ms.
         gc.collect()
         gc.freeze()
+        # A ticker waking while the executor's thread runs Python waits for the GIL until that
+        # thread blocks or the switch interval (5 ms by default) forces a hand-over.
+        sys.setswitchinterval(GIL_SWITCH_INTERVAL_S)
         rclpy.spin_until_future_complete(node, node.finished)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
