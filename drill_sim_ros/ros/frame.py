@@ -73,36 +73,57 @@ def _layouts() -> dict[str, tuple[Layout, list[tuple[str, bool]]]]:
     return out
 
 
+def _starts(lengths: list[int]) -> tuple[list[int], int]:
+    """Where each payload starts (4 past a multiple of 8, so the CDR body's float64 values
+    are 8-aligned) and the buffer size in bytes."""
+    starts, end = [], 4
+    for length in lengths:
+        starts.append(end)
+        end += -(-length // 8) * 8
+    return starts, -(-end // 8) * 8
+
+
+def _aligned(offset: int, size: int) -> int:
+    """``offset`` in units of ``size`` bytes (a layout change that breaks alignment raises)."""
+    if offset % size:
+        raise ValueError(f"payload value at byte {offset} is not {size}-byte aligned")
+    return offset // size
+
+
+def _plan(placed: list[tuple[int, Layout, list[tuple[str, bool]]]]) -> np.ndarray:
+    """The int64 plan of :func:`_fill` for layouts placed at the given buffer offsets."""
+    doubles: list[int] = []
+    stamps: list[int] = []
+    mode_at = -1
+    for start, layout, values in placed:
+        for at, (field, rad_s) in zip(layout.doubles, values, strict=True):
+            doubles += [_aligned(start + at, 8), F[field], int(rad_s)]
+        if layout.stamp is not None:
+            stamps.append(_aligned(start + layout.stamp, 4))
+        if layout.byte is not None:
+            mode_at = start + layout.byte
+    return np.array([len(doubles) // 3, len(stamps), mode_at, *doubles, *stamps],
+                    dtype=np.int64)
+
+
 class SampleFrame:
     """The payloads of one sample (``topics`` order, /clock last if ``with_clock``)."""
 
     def __init__(self, scales: Scales, with_clock: bool) -> None:
         self.topics = (*SAMPLE_TOPICS, topics.CLOCK) if with_clock else SAMPLE_TOPICS
-        layouts = _layouts()
         self._factors = field_scales(scales)
         self.row = np.zeros(N_FIELDS)          # the last SI row, TELEMETRY_FIELDS order
-        starts, end = [], 4
-        for topic in self.topics:
-            starts.append(end)
-            end += -(-len(layouts[topic][0].template) // 8) * 8
-        self._buffer = np.zeros(-(-end // 8), dtype=np.float64)
+        layouts = _layouts()
+        chosen = [layouts[topic] for topic in self.topics]
+        starts, size = _starts([len(layout.template) for layout, _ in chosen])
+        self._buffer = np.zeros(size // 8, dtype=np.float64)
         raw = self._buffer.view(np.uint8)
-        self._slices: list[slice] = []
-        doubles: list[tuple[int, int, int]] = []
-        stamps: list[int] = []
-        mode_at = -1
-        for topic, start in zip(self.topics, starts, strict=True):
-            layout, values = layouts[topic]
-            raw[start:start + len(layout.template)] = np.frombuffer(layout.template, np.uint8)
-            self._slices.append(slice(start, start + len(layout.template)))
-            doubles += [((start + at) // 8, F[field], int(rad_s))
-                        for at, (field, rad_s) in zip(layout.doubles, values, strict=True)]
-            if layout.stamp is not None:
-                stamps.append((start + layout.stamp) // 4)
-            if layout.byte is not None:
-                mode_at = start + layout.byte
-        self._plan = np.array([len(doubles), len(stamps), mode_at,
-                               *[x for d in doubles for x in d], *stamps], dtype=np.int64)
+        self._slices = [slice(start, start + len(layout.template))
+                        for start, (layout, _) in zip(starts, chosen, strict=True)]
+        for part, (layout, _) in zip(self._slices, chosen, strict=True):
+            raw[part] = np.frombuffer(layout.template, np.uint8)
+        self._plan = _plan([(start, layout, values)
+                            for start, (layout, values) in zip(starts, chosen, strict=True)])
 
     def pack(self, samples: np.ndarray, index: int, offsets: tuple[float, float],
              time_ns: int, submerged_weight_n: float) -> list[bytes]:
