@@ -80,9 +80,10 @@ class SimSession:
         self.next_index = 0          # sample counter: stamps = index * period_ns
         # The severity window: snapshots of the kernel's running sums at the end of each of
         # its WINDOW_BUCKETS parts, the extremes restarted after each (no per-sample work).
-        self._bucket_samples = max(1, round(cfg.window_s * cfg.publish_rate_hz
-                                            / WINDOW_BUCKETS))
-        self._snapshots: deque[np.ndarray] = deque(maxlen=WINDOW_BUCKETS + 1)
+        window = max(1, round(cfg.window_s * cfg.publish_rate_hz))     # in samples
+        buckets = min(WINDOW_BUCKETS, window)
+        self._bucket_samples = max(1, round(window / buckets))
+        self._snapshots: deque[np.ndarray] = deque(maxlen=buckets + 1)
         self._bucket_end = self._bucket_samples
 
     @property
@@ -112,8 +113,8 @@ class SimSession:
         return first_ns, count
 
     def severity(self) -> tuple[Severity, float]:
-        """Stick-slip severity of the last ``window_s`` (to within 1/WINDOW_BUCKETS of it),
-        from every step, and its stick fraction (nan before the first step)."""
+        """Stick-slip severity of the last ``window_s`` (to within 1/WINDOW_BUCKETS of it, or
+        one period), from every step, and its stick fraction (nan before the first step)."""
         now = self.sim.accumulators
         full = len(self._snapshots) == self._snapshots.maxlen
         start = self._snapshots[0] if full else k.new_accumulators()
