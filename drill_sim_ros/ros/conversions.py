@@ -24,8 +24,8 @@ SOURCE_COLUMNS = {
     "mode": k.C_MODE, "surface_angle_rad": k.C_PHI_S, "surface_rpm": k.C_OMEGA_S,
     "surface_torque_nm": k.C_T_PIPE, "applied_wob_n": k.C_W_APP,
 }
-_FIELDS = np.array([F[name] for name in SOURCE_COLUMNS])
-_COLUMNS = np.array(list(SOURCE_COLUMNS.values()))
+SOURCE_FIELDS = np.array([F[name] for name in SOURCE_COLUMNS], dtype=np.int64)
+SOURCE_KERNEL_COLUMNS = np.array(list(SOURCE_COLUMNS.values()), dtype=np.int64)
 _DEPTH = F["bit_depth_m"]
 _ANGLES = [F["bit_angle_rad"], F["surface_angle_rad"]]
 
@@ -52,7 +52,7 @@ def telemetry_rows(samples: Samples, scales: Scales, sim_times_s: np.ndarray,
     """
     factors = field_scales(scales)
     out = np.empty((len(samples), N_FIELDS))
-    out[:, _FIELDS] = samples.data[:, _COLUMNS]
+    out[:, SOURCE_FIELDS] = samples.data[:, SOURCE_KERNEL_COLUMNS]
     out[:, _DEPTH] += samples.depth_offset
     out[:, _ANGLES] += samples.angle_offset
     out *= factors

@@ -29,7 +29,13 @@ from drill_sim_ros.ros.cdr import (
     multi_array_layout,
     uint8_layout,
 )
-from drill_sim_ros.ros.conversions import NS_PER_S, SOURCE_COLUMNS, field_scales
+from drill_sim_ros.ros.conversions import (
+    NS_PER_S,
+    SOURCE_COLUMNS,
+    SOURCE_FIELDS,
+    SOURCE_KERNEL_COLUMNS,
+    field_scales,
+)
 
 F = topics.TELEMETRY_INDEX
 N_FIELDS = len(topics.TELEMETRY_FIELDS)
@@ -48,8 +54,7 @@ TELEMETRY_LABEL = ",".join(topics.TELEMETRY_FIELDS)
 
 # The kernel column of each telemetry field it comes from, and what is added before scaling
 # (as telemetry_rows: the rebasing offsets of depth and angles).
-_FIELD = np.array([F[name] for name in SOURCE_COLUMNS], dtype=np.int64)
-_COLUMN = np.array(list(SOURCE_COLUMNS.values()), dtype=np.int64)
+_FIELD, _COLUMN = SOURCE_FIELDS, SOURCE_KERNEL_COLUMNS
 _ADD = np.array([1 if name == "bit_depth_m" else 2 if name.endswith("angle_rad") else 0
                  for name in SOURCE_COLUMNS], dtype=np.int64)
 _TIME, _APPLIED, _HOOK, _MODE = F["sim_time_s"], F["applied_wob_n"], F["hook_load_n"], F["mode"]

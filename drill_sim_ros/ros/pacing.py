@@ -55,10 +55,6 @@ class Pacer:
         """A copy of the recent tick lateness, ns (for :func:`lateness_percentiles_ms`)."""
         return list(self._lateness_ns)
 
-    def lateness_percentiles_ms(self, *percents: float) -> tuple[float, ...]:
-        """Percentiles of the recent tick lateness in ms (nan before the first tick)."""
-        return lateness_percentiles_ms(self.lateness_ns(), *percents)
-
 
 def lateness_percentiles_ms(lateness_ns: list[int], *percents: float) -> tuple[float, ...]:
     """Percentiles of tick lateness values (ns) in ms; nan for none."""
