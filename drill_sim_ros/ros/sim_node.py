@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import gc
 import math
+import signal
 import sys
 import time
 from collections.abc import Callable
@@ -446,6 +447,9 @@ class SimNode(Node):
 def main(args: list[str] | None = None) -> int:
     """Console script ``sim_node`` (``ros2 run drill_sim_ros sim_node``)."""
     rclpy.init(args=args)
+    # A closed terminal (SIGHUP) stops the node like Ctrl-C or SIGTERM, so the recording is
+    # finished instead of cut off without its summary.
+    signal.signal(signal.SIGHUP, lambda *_: rclpy.try_shutdown())
     node = None
     try:
         node = SimNode()

@@ -1,6 +1,6 @@
 """The package as ROS 2 tools see it: colcon builds an install tree, ament_index resolves it the
 way `ros2 run drill_sim_ros sim_node` does, and that executable publishes and stops cleanly on
-SIGINT; SIGTERM also ends a run cleanly with its MCAP recording finished (issue 3)."""
+SIGINT; SIGTERM and SIGHUP also end a run cleanly with its MCAP recording finished (issue 3)."""
 
 from __future__ import annotations
 
@@ -99,14 +99,15 @@ def test_colcon_install_tree_runs_like_ros2_run(tmp_path):
     assert done.returncode == 0, done.stdout
 
 
-def test_sigterm_ends_a_recording_run_cleanly(tmp_path):
+@pytest.mark.parametrize("signum", [signal.SIGTERM, signal.SIGHUP], ids=["SIGTERM", "SIGHUP"])
+def test_sigterm_or_a_closed_terminal_ends_a_recording_run_cleanly(tmp_path, signum):
     from mcap.reader import make_reader
 
     path = tmp_path / "run" / "run.mcap"
     done = run_until_published([str(VENV_BIN / "sim_node"), "--ros-args", "-p",
                                 f"record.path:={path}", "-p", "status_line:=false",
                                 "-p", "real_time_factor:=5"], os.environ.copy(),
-                               signal.SIGTERM)
+                               signum)
     assert done.returncode == 0, done.stdout
     with path.open("rb") as stream:
         summary = make_reader(stream).get_summary()
