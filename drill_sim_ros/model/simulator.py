@@ -233,14 +233,9 @@ class Simulator:
         ``n_steps // every + 1``); returns the rows written. Allocates nothing: the node's
         10 ms tick uses it. The rows hold depth and angles less :attr:`offsets`.
         """
-        if self.fault is not None:
-            raise NumericalFault(f"simulator faulted ({self.fault}); call reset()")
         if n_steps < 0:
             raise ParameterError(f"n_steps = {n_steps!r} must be >= 0")
-        self._unchecked_steps += n_steps
-        if self._unchecked_steps >= REBASE_CHECK_STEPS:
-            self._rebase()                   # before stepping: the offsets hold for the rows
-            self._unchecked_steps = n_steps
+        self.open_run(n_steps)
         if self._hist is None:               # the profile method (no exact-delay history)
             status, written = k.advance_profile(self._state, self._prm, self._targets,
                                                 self._profile, self._acc, out, n_steps, every)
@@ -248,8 +243,40 @@ class Simulator:
             status, written = k.advance_exact(self._state, self._prm, self._targets,
                                               self._hist, self._meta, self._acc, out, n_steps,
                                               every)
-        self._check(status)
+        self.close_run(n_steps, status)
         return written
+
+    # ---- runs stepped by compiled callers (sim_node's tick loop) ------------------------
+    def kernel_arrays(self) -> tuple[np.ndarray, ...]:
+        """The arguments of ``kernel._advance`` before ``out``: state, parameters, targets,
+        profile, history, history meta, accumulators. A compiled caller that steps the
+        simulator itself passes them, with ``exact = self.exact``, between :meth:`open_run`
+        and :meth:`close_run`."""
+        exact = self._hist is not None
+        return (self._state, self._prm, self._targets, self._profile,
+                self._hist if exact else k._NO_HISTORY,
+                self._meta if exact else k._NO_META, self._acc)
+
+    @property
+    def exact(self) -> bool:
+        return self._hist is not None
+
+    def open_run(self, min_steps: int) -> int:
+        """Before a run of at least ``min_steps``: raises after a fault, and rebases when a
+        check is due (never during a run, so :attr:`offsets` hold for all its rows). Returns
+        the steps the run may take before the next check (at least ``min_steps``)."""
+        if self.fault is not None:
+            raise NumericalFault(f"simulator faulted ({self.fault}); call reset()")
+        if self._unchecked_steps + min_steps >= REBASE_CHECK_STEPS:
+            self._rebase()
+            self._unchecked_steps = 0
+        return max(REBASE_CHECK_STEPS - self._unchecked_steps, min_steps)
+
+    def close_run(self, n_steps: int, status: int) -> None:
+        """After a run of ``n_steps`` that ended with kernel ``status``: raises
+        NumericalFault or HistoryOverflow when it failed."""
+        self._unchecked_steps += n_steps
+        self._check(status)
 
     @property
     def offsets(self) -> tuple[float, float]:

@@ -1,17 +1,25 @@
-"""Wall-clock pacing of the simulation, without drift (pure Python, no rclpy).
+"""Wall-clock pacing of the simulation, without drift (numpy/numba, no rclpy).
 
 Tick ``i`` (counted from the last :meth:`Pacer.anchor`) is due at ``anchor_ns + i *
 period_ns`` on the monotonic clock, so after N s of wall time at real-time factor r the
 simulation has published N r seconds to within one period, whatever the jitter: lateness
 never accumulates. A tick published more than one period after its deadline is an overrun.
+
+The schedule lives in an int64 array and a ring of recent lateness values, so that the
+compiled tick loop of :mod:`drill_sim_ros.ros.engine` keeps it with the same functions
+(:func:`due`, :func:`complete`) as :class:`Pacer` does in Python.
 """
 
 from __future__ import annotations
 
 import math
-from collections import deque
 
 import numpy as np
+from numba import njit
+
+# Pacer.state: the anchor (deadline of tick 0, ns), ticks done since, overruns, lateness
+# values recorded (the ring holds the last len(ring) of them), the period (ns)
+P_ANCHOR, P_DONE, P_OVERRUNS, P_RECORDED, P_PERIOD = range(5)
 
 
 class Pacer:
@@ -20,40 +28,72 @@ class Pacer:
     def __init__(self, period_ns: int, lateness_window: int = 2000) -> None:
         if period_ns <= 0:
             raise ValueError(f"period_ns = {period_ns!r} must be > 0")
-        self.period_ns = int(period_ns)
-        self._anchor_ns = 0
-        self._done = 0          # ticks completed since the anchor
-        self.overruns = 0
-        self._lateness_ns: deque[int] = deque(maxlen=lateness_window)
+        self.state = np.zeros(5, dtype=np.int64)
+        self.state[P_PERIOD] = period_ns
+        self.ring = np.zeros(lateness_window, dtype=np.int64)
+
+    @property
+    def period_ns(self) -> int:
+        return int(self.state[P_PERIOD])
+
+    @property
+    def overruns(self) -> int:
+        return int(self.state[P_OVERRUNS])
 
     def anchor(self, first_deadline_ns: int) -> None:
         """Restart the schedule: the next tick is due at ``first_deadline_ns``."""
-        self._anchor_ns = int(first_deadline_ns)
-        self._done = 0
+        self.state[P_ANCHOR] = first_deadline_ns
+        self.state[P_DONE] = 0
 
     def deadline_ns(self, tick: int | None = None) -> int:
         """Deadline of ``tick`` (default: the next one)."""
-        return self._anchor_ns + (self._done if tick is None else tick) * self.period_ns
+        return int(deadline(self.state) if tick is None else
+                   self.state[P_ANCHOR] + tick * self.state[P_PERIOD])
 
     def due(self, now_ns: int, limit: int) -> int:
         """Ticks due at ``now_ns`` and not done yet, at most ``limit``."""
-        behind = now_ns - self._anchor_ns
-        if behind < 0:
-            return 0
-        return min(behind // self.period_ns + 1 - self._done, limit)
+        return int(due(self.state, now_ns, limit))
 
     def complete(self, count: int, now_ns: int) -> None:
         """Record ``count`` ticks published at ``now_ns`` (lateness, overruns)."""
-        for _ in range(count):
-            late = now_ns - self.deadline_ns()
-            self._lateness_ns.append(late)
-            if late > self.period_ns:
-                self.overruns += 1
-            self._done += 1
+        complete(self.state, self.ring, count, now_ns)
 
     def lateness_ns(self) -> list[int]:
         """A copy of the recent tick lateness, ns (for :func:`lateness_percentiles_ms`)."""
-        return list(self._lateness_ns)
+        size = len(self.ring)
+        recorded = int(self.state[P_RECORDED])
+        if recorded <= size:
+            return self.ring[:recorded].tolist()
+        start = recorded % size                    # the oldest value kept
+        return np.concatenate((self.ring[start:], self.ring[:start])).tolist()
+
+
+@njit(cache=True, nogil=True)
+def deadline(state: np.ndarray) -> int:
+    """Deadline of the next tick, ns."""
+    return state[P_ANCHOR] + state[P_DONE] * state[P_PERIOD]
+
+
+@njit(cache=True, nogil=True)
+def due(state: np.ndarray, now_ns: int, limit: int) -> int:
+    """Ticks due at ``now_ns`` and not done yet, at most ``limit``."""
+    behind = now_ns - state[P_ANCHOR]
+    if behind < 0:
+        return 0
+    return min(behind // state[P_PERIOD] + 1 - state[P_DONE], limit)
+
+
+@njit(cache=True, nogil=True)
+def complete(state: np.ndarray, ring: np.ndarray, count: int, now_ns: int) -> None:
+    """Record ``count`` ticks published at ``now_ns``: their lateness into ``ring``, the
+    overruns (more than one period late)."""
+    for _ in range(count):
+        late = now_ns - deadline(state)
+        ring[state[P_RECORDED] % ring.shape[0]] = late
+        state[P_RECORDED] += 1
+        if late > state[P_PERIOD]:
+            state[P_OVERRUNS] += 1
+        state[P_DONE] += 1
 
 
 def lateness_percentiles_ms(lateness_ns: list[int], *percents: float) -> tuple[float, ...]:

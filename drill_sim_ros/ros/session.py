@@ -101,16 +101,30 @@ class SimSession:
         stamped ``first + i * period_ns``; add :attr:`Simulator.offsets` to its depth and
         angles. Raises ``NumericalFault``.
         """
-        if periods + 1 > self.samples.shape[0]:
-            self.samples = np.empty((periods + 1, k.N_COLS))
+        self.reserve(periods)
         first_ns = self.sim_time_ns
         count = self.sim.advance_into(self.samples, periods * self.steps, self.steps)
+        self.advanced(count)
+        return first_ns, count
+
+    def reserve(self, periods: int) -> None:
+        """Room in :attr:`samples` for a run of ``periods``."""
+        if periods + 1 > self.samples.shape[0]:
+            self.samples = np.empty((periods + 1, k.N_COLS))
+
+    def samples_to_snapshot(self) -> int:
+        """Samples a run may advance before the severity window's next snapshot is due
+        (a compiled run stops there; at least 1)."""
+        return max(1, self._bucket_end - self.next_index)
+
+    def advanced(self, count: int) -> None:
+        """Count ``count`` samples advanced (by :meth:`run` or a compiled run of the
+        simulator) and take the severity window's snapshot when it is due."""
         self.next_index += count
         if self.next_index >= self._bucket_end:
             self._snapshots.append(self.sim.accumulators)
             self.sim.restart_extremes()
             self._bucket_end = self.next_index + self._bucket_samples
-        return first_ns, count
 
     def severity(self) -> tuple[Severity, float]:
         """Stick-slip severity of the last ``window_s`` (to within 1/WINDOW_BUCKETS of it, or

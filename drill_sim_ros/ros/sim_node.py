@@ -43,12 +43,13 @@ from drill_sim_ros.model.errors import DrillSimError, NumericalFault
 from drill_sim_ros.model.presets import load_preset
 from drill_sim_ros.ros import messages
 from drill_sim_ros.ros.conversions import stamp
-from drill_sim_ros.ros.frame import SAMPLE_TOPICS, SampleFrame
+from drill_sim_ros.ros.engine import EXIT_WAIT, R_SAMPLES, TickLoop
+from drill_sim_ros.ros.frame import SAMPLE_TOPICS, FramePublisher, SampleFrame
 from drill_sim_ros.ros.pacing import Pacer, RateMeter, lateness_percentiles_ms
 from drill_sim_ros.ros.parameters import SPEC_BY_NAME, coerce, declare_all, validate
 from drill_sim_ros.ros.session import SessionConfig, SimSession
 from drill_sim_ros.ros.status_line import StatusLine, format_status
-from drill_sim_ros.ros.ticker import HandoffLock, Ticker
+from drill_sim_ros.ros.ticker import SHORT_WAIT_S, HandoffLock, Ticker
 
 RCLError = rclpy_implementation.RCLError
 DATA_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=100,
@@ -60,8 +61,9 @@ COMMAND_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=10,
 # Reliable volatile publishers match every subscriber but transient-local ones; without the
 # default QoS-event handlers the executor's wait set is 2 entities per publisher smaller.
 QUIET_PUBLISHER = PublisherEventCallbacks(use_default_callbacks=False)
-FREE_RUN_BATCH = 20          # periods per turn of the ticker when running as fast as possible
-MAX_CATCH_UP = 50            # periods per turn of the ticker when catching up in real time
+FREE_RUN_BATCH = 20          # periods per kernel call when running as fast as possible
+MAX_CATCH_UP = 50            # periods per kernel call when catching up in real time
+MAX_RUN = 1 << 30            # samples per compiled run (the severity window stops it sooner)
 DIAGNOSTICS_PERIOD_S = 1.0
 STATUS_PERIOD_S = 0.25
 WARN_THROTTLE_S = 1.0
@@ -98,22 +100,21 @@ class SimNode(Node):
         self._steady = Clock(clock_type=ClockType.STEADY_TIME)
         self._preset, self._values = declare_all(self, load_preset)
         self._session = SimSession(session_config(self._values, self._preset))
-        self._frames = {with_clock: SampleFrame(self._preset.scales, with_clock)
-                        for with_clock in (False, True)}
         self._lock = HandoffLock()
         self._pacer = Pacer(self._wall_period_ns(1.0))
         self._rate = RateMeter(time.monotonic_ns(), 0.0)
         self._status = StatusLine()
         self.finished = Future()
         self._paused = False
+        self._closing = False
         self._fault: str | None = None
         self.rejected_commands = 0
         self._last_row: np.ndarray | None = None     # SI, TELEMETRY_FIELDS; lock held
         self._pubs = {t: self.create_publisher(messages.type_of(t), t, self._qos(t),
                                                event_callbacks=QUIET_PUBLISHER)
                       for t in (*SAMPLE_TOPICS, topics.CLOCK, topics.DIAGNOSTICS)}
-        self._publish_raw = {with_clock: [self._pubs[t].handle.publish_raw for t in frame.topics]
-                             for with_clock, frame in self._frames.items()}
+        self._frame_publishers = {with_clock: self._frame_publisher(with_clock)
+                            for with_clock in (False, True)}
         self._recorder = self._open_recorder(self._values["record.path"])
         self.create_subscription(Float64, topics.CMD_SURFACE_RPM, self._on_surface_rpm,
                                  COMMAND_QOS)
@@ -122,6 +123,8 @@ class SimNode(Node):
         self.create_service(SetBool, "~/pause", self._on_pause)
         self.create_service(Trigger, "~/step", self._on_step)
         self._ticker = Ticker(self._tick, self._on_tick_error, name="drill_sim_ticker")
+        self._lock.on_request = self._ticker.wake     # the compiled loop waits on its eventfd
+        self._loop = self._tick_loop()
         self._first_spin = self.create_timer(0.0, self._start_ticker, clock=self._steady)
         self.create_timer(DIAGNOSTICS_PERIOD_S, self._publish_diagnostics, clock=self._steady)
         if self._status.active:
@@ -132,6 +135,25 @@ class SimNode(Node):
         self._log_start()
 
     # ---- set-up ------------------------------------------------------------------------
+    def _tick_loop(self) -> TickLoop | None:
+        """The compiled tick loop, or None (then the ticker runs the Python path) where rcl's
+        publish call or the C library's clocks cannot be bound."""
+        if not all(p.compiled for p in self._frame_publishers.values()):
+            return None
+        try:
+            loop = TickLoop(self._lock.requests, self._ticker.wake_fd, MAX_CATCH_UP,
+                            FREE_RUN_BATCH, round(SHORT_WAIT_S * 1e9))
+        except (OSError, AttributeError) as exc:
+            self.get_logger().warning(f"ticking in Python: {exc}")
+            return None
+        # load the compiled loop now (a run of no samples), not on the first tick
+        loop.run(self._session, self._frame_publishers[False], self._pacer, 0, 0.0)
+        return loop
+
+    def _frame_publisher(self, with_clock: bool) -> FramePublisher:
+        frame = SampleFrame(self._preset.scales, with_clock)
+        return FramePublisher(frame, [self._pubs[topic] for topic in frame.topics])
+
     @staticmethod
     def _qos(topic: str) -> QoSProfile:
         return CLOCK_QOS if topic in (topics.CLOCK, topics.DIAGNOSTICS) else DATA_QOS
@@ -223,8 +245,10 @@ class SimNode(Node):
         """One turn of the ticker thread; the seconds to wait before the next (None: idle)."""
         self._lock.acquire_background()
         try:
-            if self._lockstep or self._paused or self._fault is not None:
+            if self._closing or self._lockstep or self._paused or self._fault is not None:
                 return None
+            if self._loop is not None:
+                return self._run_loop()
             if self._rtf <= 0:
                 self._advance(FREE_RUN_BATCH)
                 return 0.0
@@ -235,6 +259,26 @@ class SimNode(Node):
             return max(0.0, (pacer.deadline_ns() - time.monotonic_ns()) * 1e-9)
         finally:
             self._lock.release()
+
+    def _run_loop(self) -> float | None:
+        """Hand the ticker to the compiled loop until Python has work (lock held)."""
+        publisher = self._frame_publishers[self._values["publish_clock"]]
+        time_ns = self._session.sim_time_ns
+        try:
+            reason = self._loop.run(
+                self._session, publisher, None if self._rtf <= 0 else self._pacer,
+                MAX_RUN if self._recorder is None else 1,
+                self._values["model.submerged_string_weight_n"])
+        except NumericalFault as exc:
+            self._on_fault(exc)
+            return None
+        if self._loop.result[R_SAMPLES] > 0:
+            self._last_row = publisher.frame.row
+            if self._recorder is not None:
+                self._record(publisher.frame, time_ns)
+        if reason == EXIT_WAIT:
+            return max(0.0, (self._pacer.deadline_ns() - time.monotonic_ns()) * 1e-9)
+        return 0.0
 
     def _on_tick_error(self, exc: Exception) -> bool:
         """An unexpected error on the ticker: quiet at shutdown, else a fault until reset."""
@@ -251,26 +295,33 @@ class SimNode(Node):
         try:
             time_ns, count = session.run(periods)
         except NumericalFault as exc:
-            self._fault = str(exc)
-            self.get_logger().error(f"numerical fault: {exc}; call ~/reset to recover")
+            self._on_fault(exc)
             return False
-        with_clock = self._values["publish_clock"]
-        frame, publishers = self._frames[with_clock], self._publish_raw[with_clock]
+        # One compiled call fills and publishes the samples through rcl (FramePublisher);
+        # sim_node destroys no publisher while it ticks.
+        publisher = self._frame_publishers[self._values["publish_clock"]]
         weight_n = self._values["model.submerged_string_weight_n"]
-        offsets = session.sim.offsets
-        for index in range(count):
-            payloads = frame.pack(session.samples, index, offsets, time_ns, weight_n)
-            # The publishers' own handles: Publisher.publish adds a context guard and two
-            # type checks per message; sim_node destroys no publisher while it ticks.
-            for publish, payload in zip(publishers, payloads, strict=True):
-                publish(payload)
-            if self._recorder is not None:       # the very bytes published, unchanged
-                for topic, payload in zip(frame.topics, payloads, strict=True):
-                    self._recorder.write_serialized(topic, payload, time_ns)
-            time_ns += session.period_ns
+        offsets, period_ns = session.sim.offsets, session.period_ns
+        if self._recorder is None:
+            publisher.publish(session.samples, 0, count, offsets, time_ns, period_ns, weight_n)
+        else:
+            for index in range(count):
+                publisher.publish(session.samples, index, 1, offsets, time_ns, period_ns,
+                                  weight_n)
+                self._record(publisher.frame, time_ns)
+                time_ns += period_ns
         if count:
-            self._last_row = frame.row
+            self._last_row = publisher.frame.row
         return True
+
+    def _record(self, frame: SampleFrame, time_ns: int) -> None:
+        """The very bytes just published, unchanged (recorder on, lock held)."""
+        for topic, payload in zip(frame.topics, frame.payloads(), strict=True):
+            self._recorder.write_serialized(topic, payload, time_ns)
+
+    def _on_fault(self, exc: NumericalFault) -> None:
+        self._fault = str(exc)
+        self.get_logger().error(f"numerical fault: {exc}; call ~/reset to recover")
 
     # ---- commands ----------------------------------------------------------------------
     def _on_surface_rpm(self, msg: Float64) -> None:
@@ -287,8 +338,9 @@ class SimNode(Node):
         if problem is not None:
             self._reject(topic, problem)
             return
-        with self._lock.urgent():
-            apply(value)
+        # No lock: a setpoint is one float64 store into the kernel's targets, which the
+        # ticker's next step reads (the compiled loop holds the lock through its sleeps).
+        apply(value)
 
     def _reject(self, topic: str, problem: str) -> None:
         self.rejected_commands += 1
@@ -429,6 +481,8 @@ class SimNode(Node):
 
     def close(self) -> None:
         """Stop the ticker, then finish the recording and the status line (idempotent)."""
+        with self._lock.urgent():
+            self._closing = True
         self._ticker.stop()
         self._status.close()
         if self._recorder is not None:

@@ -1,4 +1,4 @@
-"""The sim node's tick thread and the lock it shares with the executor (pure Python, no rclpy).
+"""The sim node's tick thread and the lock it shares with the executor (no rclpy).
 
 The executor used to run the tick as an rcl timer, and rebuilt its wait set on every wake-up
 (about 1 ms of CPU per 10 ms tick). A :class:`Ticker` instead calls its ``work`` function on
@@ -17,6 +17,8 @@ import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 
+import numpy as np
+
 _log = logging.getLogger(__name__)
 # Waits up to this long are a plain sleep, which costs less than select() (about 15 us of CPU
 # per wake-up here); a wake() during one takes effect when it ends.
@@ -29,16 +31,26 @@ class HandoffLock:
     Callbacks take it with :meth:`urgent`, the ticker with :meth:`acquire_background`. A callback
     holds the gate while it waits, and the ticker passes the gate before each acquisition, so
     a callback waits for at most the batch in progress, however fast the ticker loops.
+    While a callback waits, ``requests[0]`` is 1, and ``on_request`` was called once:
+    compiled code that holds the lock without the GIL (:mod:`drill_sim_ros.ros.engine`) reads
+    the flag, and is woken by ``on_request``, to know when to hand over.
     """
 
-    def __init__(self) -> None:
+    def __init__(self, on_request: Callable[[], None] = lambda: None) -> None:
         self._lock = threading.Lock()
         self._gate = threading.Lock()
+        self.requests = np.zeros(1, dtype=np.int64)
+        self.on_request = on_request
 
     @contextmanager
     def urgent(self) -> Iterator[None]:
-        with self._gate:
-            self._lock.acquire()
+        with self._gate:                 # one waiter at a time sets and clears the request
+            self.requests[0] = 1
+            self.on_request()
+            try:
+                self._lock.acquire()
+            finally:
+                self.requests[0] = 0
         try:
             yield
         finally:
@@ -79,6 +91,12 @@ class Ticker:
 
     def start(self) -> None:
         self._thread.start()
+
+    @property
+    def wake_fd(self) -> int:
+        """The eventfd that :meth:`wake` writes (-1 once stopped): code that waits for the
+        ticker's work on its own reads it too."""
+        return self._wake_fd
 
     def wake(self) -> None:
         """Call ``work`` now (the schedule or the state changed); nothing once stopped."""
