@@ -114,7 +114,7 @@ class SimNode(Node):
                                                event_callbacks=QUIET_PUBLISHER)
                       for t in (*SAMPLE_TOPICS, topics.CLOCK, topics.DIAGNOSTICS)}
         self._frame_publishers = {with_clock: self._frame_publisher(with_clock)
-                            for with_clock in (False, True)}
+                                  for with_clock in (False, True)}
         self._recorder = self._open_recorder(self._values["record.path"])
         self.create_subscription(Float64, topics.CMD_SURFACE_RPM, self._on_surface_rpm,
                                  COMMAND_QOS)
@@ -298,7 +298,7 @@ class SimNode(Node):
             self._on_fault(exc)
             return False
         # One compiled call fills and publishes the samples through rcl (FramePublisher);
-        # sim_node destroys no publisher while it ticks.
+        # sim_node destroys no publisher while it ticks. (Lockstep, and the Python ticker.)
         publisher = self._frame_publishers[self._values["publish_clock"]]
         weight_n = self._values["model.submerged_string_weight_n"]
         offsets, period_ns = session.sim.offsets, session.period_ns
