@@ -20,13 +20,22 @@ class StatusLine:
 
     def show(self, text: str) -> None:
         if self.active:
-            self._stream.write(f"\r{text}\x1b[K")
-            self._stream.flush()
-            self._shown = True
+            self._shown = self._write(f"\r{text}\x1b[K")
 
     def close(self) -> None:
         """End the line so later output starts on a fresh one (idempotent)."""
         if self._shown:
-            self._stream.write("\n")
-            self._stream.flush()
+            self._write("\n")
             self._shown = False
+
+    def _write(self, text: str) -> bool:
+        """Write and flush; a terminal that has gone away (EIO after a hang-up, a closed
+        stream) turns the line off instead of failing the caller, which may be finishing a
+        recording."""
+        try:
+            self._stream.write(text)
+            self._stream.flush()
+        except (OSError, ValueError):
+            self.active = False
+            return False
+        return True

@@ -481,17 +481,20 @@ class SimNode(Node):
 
     def close(self) -> None:
         """Stop the ticker, then finish the recording and the status line (idempotent)."""
-        with self._lock.urgent():
-            self._closing = True
-        self._ticker.stop()
-        self._status.close()
-        if self._recorder is not None:
-            recorder, self._recorder = self._recorder, None
-            recorder.close()
-            # after Ctrl-C the context may be gone: a logger of no node has no /rosout publisher
-            rclpy.logging.get_logger("drill_sim_ros").info(
-                f"recording closed: {recorder.written} messages written, "
-                f"{recorder.dropped} dropped")
+        try:
+            with self._lock.urgent():
+                self._closing = True
+            self._ticker.stop()
+            self._status.close()
+        finally:                            # whatever failed above, finish the recording
+            if self._recorder is not None:
+                recorder, self._recorder = self._recorder, None
+                recorder.close()
+                # after Ctrl-C the context may be gone: a logger of no node has no /rosout
+                # publisher
+                rclpy.logging.get_logger("drill_sim_ros").info(
+                    f"recording closed: {recorder.written} messages written, "
+                    f"{recorder.dropped} dropped")
 
     def destroy_node(self) -> None:
         self.close()

@@ -4,6 +4,7 @@ SIGINT; SIGTERM and SIGHUP also end a run cleanly with its MCAP recording finish
 
 from __future__ import annotations
 
+import contextlib
 import os
 import shutil
 import signal
@@ -114,3 +115,44 @@ def test_sigterm_or_a_closed_terminal_ends_a_recording_run_cleanly(tmp_path, sig
     assert summary is not None and summary.statistics.message_count >= 20 * 9
     recorded = {channel.topic for channel in summary.channels.values()}
     assert set(topics.MSG_TYPES) - {topics.CMD_WOB, topics.CMD_SURFACE_RPM} <= recorded
+
+
+def test_a_hung_up_terminal_under_the_status_line_still_ends_the_run_cleanly(tmp_path):
+    """`make run` in a terminal that is closed: the status line's writes fail (EIO) while
+    SIGHUP stops the node, and the recording must still be finished."""
+    import pty
+
+    from mcap.reader import make_reader
+
+    path = tmp_path / "run.mcap"
+    master, slave = pty.openpty()
+    command = [str(VENV_BIN / "sim_node"), "--ros-args", "-p", f"record.path:={path}",
+               "-p", "real_time_factor:=5"]
+    os.set_blocking(master, False)
+    shown = bytearray()
+
+    def published_and_shown() -> bool:
+        """The terminal reads what the node writes (else a full pty blocks its writes)."""
+        with contextlib.suppress(BlockingIOError):
+            shown.extend(os.read(master, 1 << 16))
+        return probe.count(topics.TELEMETRY) >= 20 and b"rpm" in shown
+
+    with ros_context() as ros:
+        probe = ros.add(Probe(ros.context, [topics.TELEMETRY]))
+        proc = subprocess.Popen(command, stdin=slave, stdout=slave, stderr=slave)
+        os.close(slave)
+        try:
+            assert ros.spin_until(published_and_shown, 60.0), bytes(shown[-500:])
+            os.close(master)                   # the terminal goes away: writes now fail
+            master = -1
+            proc.send_signal(signal.SIGHUP)
+            assert proc.wait(timeout=20) == 0
+        finally:
+            if master >= 0:
+                os.close(master)
+            if proc.poll() is None:
+                proc.kill()
+                proc.wait()
+    with path.open("rb") as stream:
+        summary = make_reader(stream).get_summary()
+    assert summary is not None and summary.statistics.message_count >= 20 * 9
