@@ -32,6 +32,7 @@ from numba import njit
 from drill_sim_ros.model.kernel import STATUS_OK, _advance
 from drill_sim_ros.ros.frame import FramePublisher, _fill_and_publish
 from drill_sim_ros.ros.pacing import Pacer, complete, deadline, due
+from drill_sim_ros.ros.session import SimSession
 
 # why _run returned (EXIT_WAKE: the eventfd was written, or a lock request is pending)
 EXIT_BUDGET, EXIT_WAKE, EXIT_WAIT, EXIT_FAULT, EXIT_PUBLISH = range(5)
@@ -73,7 +74,7 @@ class TickLoop:
         self._scratch.view(np.int32)[4] = wake_fd
         self.result = np.zeros(6, dtype=np.int64)
 
-    def run(self, session: Any, publisher: FramePublisher, pacer: Pacer | None,
+    def run(self, session: SimSession, publisher: FramePublisher, pacer: Pacer | None,
             max_samples: int, submerged_weight_n: float) -> int:
         """Advance and publish up to ``max_samples`` periods, paced by ``pacer`` (None: as
         fast as possible); returns the ``EXIT_*`` reason. Raises NumericalFault when the
