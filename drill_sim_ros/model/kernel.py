@@ -15,9 +15,9 @@ Absolute variables (so the surface inputs may change at any step):
 The depth of cut (eqs. 6-8, 26-28) is read from the bottom-hole profile: the height
 each angle of one blade sector (2 pi / n) was last cut to, stored on ``n_nodes`` nodes.
 A passing blade lowers the surface to the bit depth when the bit is deeper (max rule), so
-the rock is re-cut correctly after the bit has bounced off bottom. :func:`advance_exact`
-is the reference path: it keeps the exact time history of (PHI, U) and solves eq. (7) for
-the delay by interpolation, as in RGD07 Appendix C.
+the rock is re-cut correctly after the bit has bounced off bottom. :func:`advance` with
+``exact=True`` is the reference path: it keeps the exact time history of (PHI, U) and
+solves eq. (7) for the delay by interpolation, as in RGD07 Appendix C.
 
 Integration is symplectic Euler (RGD07 eq. C.1 with the position update using the new
 velocity). The wearflat contact (eq. 31) is solved implicitly in the new axial velocity,
@@ -211,13 +211,26 @@ def _delayed_depth(hist_phi: np.ndarray, hist_u: np.ndarray, head: int, count: i
 
 
 @njit(cache=True)
-def _advance(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarray,
-             hist: np.ndarray, meta: np.ndarray, acc: np.ndarray, out: np.ndarray,
-             n_steps: int, every: int, exact: bool) -> tuple[int, int]:
-    """The stepping loop; state, statistics and bookkeeping live in locals.
+def advance(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarray,
+            hist: np.ndarray, meta: np.ndarray, acc: np.ndarray, out: np.ndarray,
+            n_steps: int, every: int, exact: bool) -> tuple[int, int]:
+    """Advance ``n_steps``; state, statistics and bookkeeping live in locals.
 
-    Delay (eqs. 6-8, 26-28): ``exact`` solves eq. (7) in the stored (PHI, U) history
-    (RGD07 App. C); otherwise the rock height under the bit is read from ``profile``.
+    Delay (eqs. 6-8, 26-28), two methods:
+
+    - ``exact=False``, the production path: ``profile`` (shape (n_nodes,)) holds the rock
+      height per node of one blade sector (2 pi / n). The bit reads the height left by the
+      previous blade (eq. 6: U(t - t_n) where eq. 7 holds) by linear interpolation in angle,
+      and re-cuts every node it passes to ``max(old, U_crossing)``. ``hist`` and ``meta``
+      are ignored (pass :data:`NO_HISTORY`, :data:`NO_META`).
+    - ``exact=True``, the reference path of RGD07 Appendix C: ``hist`` (shape (2,
+      capacity)) is a ring buffer of (PHI, U) samples and ``meta`` (int64, 3) its head,
+      count and cursor. Eq. (7) PHI(t) - PHI(t - t_n) = 2 pi / n is solved by interpolation
+      in that history and delta = n (U(t) - U(t - t_n)) (eq. 8). Samples are stored only when
+      the angle advances; those older than one sector are forgotten. ``profile`` is ignored.
+
+    out: shape (rows, N_COLS); a row is written when the global step % every == 0.
+    Returns ``(status, rows_written)``.
     """
     n, beta, lam, dt = prm[P_N], prm[P_BETA], prm[P_LAM], prm[P_DT]
     kick = prm[P_PSI] * dt
@@ -340,34 +353,5 @@ def _advance(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarr
     return status, n_rows
 
 
-_NO_HISTORY = np.zeros((2, 1))
-_NO_META = np.zeros(3, dtype=np.int64)   # scratch: the profile path ignores what it holds
-
-
-def advance_profile(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarray,
-                    acc: np.ndarray, out: np.ndarray, n_steps: int,
-                    every: int) -> tuple[int, int]:
-    """Advance ``n_steps`` with the bottom-hole-profile delay (the production path).
-
-    profile: shape (n_nodes,), rock height per node of one blade sector (2 pi / n). The
-    bit reads the height left by the previous blade (eq. 6: U(t - t_n) where eq. 7 holds)
-    by linear interpolation in angle, and re-cuts every node it passes to
-    ``max(old, U_crossing)``. out: shape (rows, N_COLS); a row is written when the global
-    step % every == 0. Returns ``(status, rows_written)``.
-    """
-    return _advance(st, prm, tgt, profile, _NO_HISTORY, _NO_META, acc, out, n_steps, every,
-                    False)
-
-
-def advance_exact(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, hist: np.ndarray,
-                  meta: np.ndarray, acc: np.ndarray, out: np.ndarray, n_steps: int,
-                  every: int) -> tuple[int, int]:
-    """Reference path: the exact time-history delay of RGD07 Appendix C.
-
-    hist: shape (2, capacity) ring buffer of (PHI, U) samples; meta (int64, 3): head,
-    count, cursor. Solves eq. (7) PHI(t) - PHI(t - t_n) = 2 pi / n by interpolation in the
-    stored history and uses delta = n (U(t) - U(t - t_n)) (eq. 8). Samples are stored only
-    when the angle advances; those older than one sector are forgotten.
-    """
-    profile = np.zeros(1)
-    return _advance(st, prm, tgt, profile, hist, meta, acc, out, n_steps, every, True)
+NO_HISTORY = np.zeros((2, 1))             # what the profile path takes for hist and meta
+NO_META = np.zeros(3, dtype=np.int64)

@@ -236,26 +236,21 @@ class Simulator:
         if n_steps < 0:
             raise ParameterError(f"n_steps = {n_steps!r} must be >= 0")
         self.open_run(n_steps)
-        if self._hist is None:               # the profile method (no exact-delay history)
-            status, written = k.advance_profile(self._state, self._prm, self._targets,
-                                                self._profile, self._acc, out, n_steps, every)
-        else:
-            status, written = k.advance_exact(self._state, self._prm, self._targets,
-                                              self._hist, self._meta, self._acc, out, n_steps,
-                                              every)
+        status, written = k.advance(*self.kernel_arrays(), out, n_steps, every, self.exact)
         self.close_run(n_steps, status)
         return written
 
     # ---- runs stepped by compiled callers (sim_node's tick loop) ------------------------
     def kernel_arrays(self) -> tuple[np.ndarray, ...]:
-        """The arguments of ``kernel._advance`` before ``out``: state, parameters, targets,
+        """The arguments of ``kernel.advance`` before ``out``: state, parameters, targets,
         profile, history, history meta, accumulators. A compiled caller that steps the
         simulator itself passes them, with ``exact = self.exact``, between :meth:`open_run`
         and :meth:`close_run`."""
-        exact = self._hist is not None
-        return (self._state, self._prm, self._targets, self._profile,
-                self._hist if exact else k._NO_HISTORY,
-                self._meta if exact else k._NO_META, self._acc)
+        if self._hist is None:               # the profile method (no exact-delay history)
+            return (self._state, self._prm, self._targets, self._profile, k.NO_HISTORY,
+                    k.NO_META, self._acc)
+        return (self._state, self._prm, self._targets, self._profile, self._hist, self._meta,
+                self._acc)
 
     @property
     def exact(self) -> bool:

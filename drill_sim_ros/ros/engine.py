@@ -29,7 +29,7 @@ from typing import Any
 import numpy as np
 from numba import njit
 
-from drill_sim_ros.model.kernel import STATUS_OK, _advance
+from drill_sim_ros.model.kernel import STATUS_OK, advance
 from drill_sim_ros.ros.frame import FramePublisher, _fill_and_publish
 from drill_sim_ros.ros.pacing import Pacer, complete, deadline, due
 from drill_sim_ros.ros.session import SimSession
@@ -148,7 +148,7 @@ def _run(requests: np.ndarray, pace: np.ndarray, ring: np.ndarray, free_run: boo
                     result[R_EXIT] = EXIT_WAKE
                     return
                 continue
-        status, written = _advance(st, prm, tgt, profile, hist, meta, acc, samples,
+        status, written = advance(st, prm, tgt, profile, hist, meta, acc, samples,
                                    count * steps, steps, exact)
         result[R_STEPS] += count * steps
         if status != STATUS_OK:

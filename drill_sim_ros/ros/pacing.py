@@ -45,10 +45,9 @@ class Pacer:
         self.state[P_ANCHOR] = first_deadline_ns
         self.state[P_DONE] = 0
 
-    def deadline_ns(self, tick: int | None = None) -> int:
-        """Deadline of ``tick`` (default: the next one)."""
-        return int(deadline(self.state) if tick is None else
-                   self.state[P_ANCHOR] + tick * self.state[P_PERIOD])
+    def deadline_ns(self) -> int:
+        """Deadline of the next tick."""
+        return int(deadline(self.state))
 
     def due(self, now_ns: int, limit: int) -> int:
         """Ticks due at ``now_ns`` and not done yet, at most ``limit``."""
@@ -58,14 +57,10 @@ class Pacer:
         """Record ``count`` ticks published at ``now_ns`` (lateness, overruns)."""
         complete(self.state, self.ring, count, now_ns)
 
-    def lateness_ns(self) -> list[int]:
-        """A copy of the recent tick lateness, ns (for :func:`lateness_percentiles_ms`)."""
-        size = len(self.ring)
-        recorded = int(self.state[P_RECORDED])
-        if recorded <= size:
-            return self.ring[:recorded].tolist()
-        start = recorded % size                    # the oldest value kept
-        return np.concatenate((self.ring[start:], self.ring[:start])).tolist()
+    def lateness_ns(self) -> np.ndarray:
+        """A copy of the recent tick lateness, ns, in no particular order (for
+        :func:`lateness_percentiles_ms`)."""
+        return self.ring[:min(int(self.state[P_RECORDED]), len(self.ring))].copy()
 
 
 @njit(cache=True, nogil=True)
@@ -96,11 +91,11 @@ def complete(state: np.ndarray, ring: np.ndarray, count: int, now_ns: int) -> No
         state[P_DONE] += 1
 
 
-def lateness_percentiles_ms(lateness_ns: list[int], *percents: float) -> tuple[float, ...]:
+def lateness_percentiles_ms(lateness_ns: np.ndarray, *percents: float) -> tuple[float, ...]:
     """Percentiles of tick lateness values (ns) in ms; nan for none."""
-    if not lateness_ns:
+    if len(lateness_ns) == 0:
         return tuple(math.nan for _ in percents)
-    values = np.percentile(np.array(lateness_ns, dtype=float), percents) * 1e-6
+    values = np.percentile(np.asarray(lateness_ns, dtype=float), percents) * 1e-6
     return tuple(float(v) for v in values)
 
 

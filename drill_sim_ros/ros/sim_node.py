@@ -398,9 +398,8 @@ class SimNode(Node):
         msg.header.stamp = stamp(time_ns)
         payload = serialize_message(msg)
         self._pubs[topics.DIAGNOSTICS].publish(payload)
-        with self._lock.urgent():
-            if self._recorder is not None:
-                self._recorder.write_serialized(topics.DIAGNOSTICS, payload, time_ns)
+        if self._recorder is not None:   # its queue takes producers on any thread, no lock
+            self._recorder.write_serialized(topics.DIAGNOSTICS, payload, time_ns)
 
     def _figures(self, time_ns: int) -> dict[str, Any]:
         """What /diagnostics reports, copied (call with the lock held)."""
