@@ -102,7 +102,12 @@ def measure(listener: Listener, preset: str, factor: float, seconds: float) -> d
     """Run one node; CPU %, message rate and its diagnostics over a steady window."""
     proc = start_node(preset, factor)
     try:
-        spin_for(listener, 4.0)                       # start-up, JIT cache, discovery
+        # start-up (numba compiles on a cold cache: tens of seconds), discovery, then 3 s
+        first = listener.count
+        end = time.monotonic() + 120.0
+        while listener.count == first and time.monotonic() < end:
+            rclpy.spin_once(listener, timeout_sec=0.05)
+        spin_for(listener, 3.0)
         cpu0, wall0, n0 = cpu_seconds(proc.pid), time.monotonic(), listener.count
         spin_for(listener, seconds)
         cpu1, wall1, n1 = cpu_seconds(proc.pid), time.monotonic(), listener.count
