@@ -26,6 +26,7 @@ from drill_sim_ros.ros.sim_node import DATA_QOS
 from drill_sim_ros.ros.ticker import HandoffLock
 from tests.ros.harness import Probe, Ros, ros_context
 
+pytestmark = pytest.mark.ros
 PRESET = load_preset("field_8p5in_shale")
 SUBMERGED_N = 1.9e6
 SAMPLES = 130                   # two runs of the loop: 100 samples (5 batches of 20), 30
