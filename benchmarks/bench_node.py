@@ -1,9 +1,14 @@
 """sim_node figures with a subscriber on every topic: prints them (no asserts).
 
 (a) real time at 100 Hz: CPU % of one core (process CPU time / wall time, from
-    /proc/<pid>/stat) and the node's tick lateness p50/p99 (from its /diagnostics);
-(b) free run (real_time_factor 0): achieved real-time factor (sim seconds per wall second).
-Targets (issue 3): (a) <= 5 % CPU, p99 <= 2 ms; (b) >= 50x.
+    /proc/<pid>/stat) against the reference measured in the same run: a bare rclpy process
+    whose thread publishes sim_node's own payloads (the same bytes, topics and QoS) every
+    10 ms through ``Publisher.publish``; and the node's tick lateness p50/p99 (its
+    /diagnostics);
+(b) free run (real_time_factor 0): achieved real-time factor (sim seconds per wall second),
+    without and with in-process recording (record.path).
+Targets (issue 10): (a) sim_node <= 1.5x the reference, p99 <= 2 ms; (b) >= 100x, and with
+recording >= a third of that.
 Usage: .venv/bin/python benchmarks/bench_node.py [--seconds 10] [--preset field_8p5in_shale]
 """
 
@@ -15,6 +20,8 @@ import random
 import signal
 import subprocess
 import sys
+import tempfile
+import threading
 import time
 from pathlib import Path
 
@@ -83,10 +90,56 @@ def spin_for(node: Node, seconds: float) -> None:
         rclpy.spin_once(node, timeout_sec=0.05)
 
 
-def start_node(preset: str, factor: float) -> subprocess.Popen:
-    return subprocess.Popen([str(BIN / "sim_node"), "--ros-args", "-p", f"model.preset:={preset}",
-                             "-p", f"real_time_factor:={factor}", "-p", "status_line:=false"],
+def start_node(preset: str, factor: float, record_path: str = "") -> subprocess.Popen:
+    command = [str(BIN / "sim_node"), "--ros-args", "-p", f"model.preset:={preset}",
+               "-p", f"real_time_factor:={factor}", "-p", "status_line:=false"]
+    if record_path:
+        command += ["-p", f"record.path:={record_path}"]
+    return subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+
+
+def start_reference(preset: str) -> subprocess.Popen:
+    return subprocess.Popen([sys.executable, __file__, "--reference-publisher", preset],
                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+
+
+def reference_publisher(preset: str) -> None:
+    """The reference: a thread publishing sim_node's payloads of one block every 10 ms."""
+    from drill_sim_ros.model.presets import load_preset
+    from drill_sim_ros.model.session import SessionConfig, SimSession
+    from drill_sim_ros.ros.frame import SampleFrame
+    from drill_sim_ros.ros.sim_node import CLOCK_QOS, DATA_QOS
+
+    rclpy.init()
+    node = Node("bench_reference")
+    frame = SampleFrame(with_clock=True)
+    pubs = [node.create_publisher(type_of(t), t, CLOCK_QOS if t == topics.CLOCK else DATA_QOS)
+            for t in frame.topics]
+    block = SimSession(SessionConfig(preset=load_preset(preset))).run(100)
+    payloads = frame.pack(block.rows, block.stamps_ns)
+    stop_event = threading.Event()
+
+    def publish_every_10_ms() -> None:
+        deadline = time.monotonic()
+        i = 0
+        while not stop_event.is_set():
+            for pub, payload in zip(pubs, payloads[i % len(payloads)], strict=True):
+                pub.publish(payload)
+            i += 1
+            deadline += 0.01
+            time.sleep(max(0.0, deadline - time.monotonic()))
+
+    thread = threading.Thread(target=publish_every_10_ms, daemon=True)
+    thread.start()
+    try:
+        rclpy.spin(node)
+    except KeyboardInterrupt:
+        pass
+    finally:
+        stop_event.set()
+        thread.join(1.0)
+        node.destroy_node()
+        rclpy.try_shutdown()
 
 
 def stop(proc: subprocess.Popen) -> None:
@@ -98,9 +151,8 @@ def stop(proc: subprocess.Popen) -> None:
         proc.wait()
 
 
-def measure(listener: Listener, preset: str, factor: float, seconds: float) -> dict[str, float]:
-    """Run one node; CPU %, message rate and its diagnostics over a steady window."""
-    proc = start_node(preset, factor)
+def measure(listener: Listener, proc: subprocess.Popen, seconds: float) -> dict[str, float]:
+    """CPU %, message rate and diagnostics of one running process over a steady window."""
     try:
         # start-up (numba compiles on a cold cache: tens of seconds), discovery, then 3 s
         first = listener.count
@@ -128,19 +180,32 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seconds", type=float, default=10.0)
     parser.add_argument("--preset", default="field_8p5in_shale")
+    parser.add_argument("--reference-publisher", metavar="PRESET", help=argparse.SUPPRESS)
     args = parser.parse_args()
+    if args.reference_publisher:
+        reference_publisher(args.reference_publisher)
+        return
     rclpy.init()
     listener = Listener()
     try:
-        rt = measure(listener, args.preset, 1.0, args.seconds)
-        print(f"(a) real time, 100 Hz, {len(PUBLISHED)} topics subscribed: "
-              f"CPU {rt['cpu_percent']:.1f} % of one core; tick lateness p50 "
-              f"{rt['p50_ms']:.3f} ms, p99 {rt['p99_ms']:.3f} ms; overruns {rt['overruns']:g}; "
-              f"{rt['received_per_s']:.0f} msg/s received")
-        free = measure(listener, args.preset, 0.0, args.seconds)
+        ref = measure(listener, start_reference(args.preset), args.seconds)
+        rt = measure(listener, start_node(args.preset, 1.0), args.seconds)
+        print(f"(a) real time, 100 Hz, {len(PUBLISHED)} topics subscribed: sim_node CPU "
+              f"{rt['cpu_percent']:.1f} % of one core, reference publisher "
+              f"{ref['cpu_percent']:.1f} %: ratio {rt['cpu_percent'] / ref['cpu_percent']:.2f}x"
+              f"; tick lateness p50 {rt['p50_ms']:.3f} ms, p99 {rt['p99_ms']:.3f} ms; "
+              f"overruns {rt['overruns']:g}; {rt['received_per_s']:.0f} msg/s received "
+              f"(reference {ref['received_per_s']:.0f})")
+        free = measure(listener, start_node(args.preset, 0.0), args.seconds)
         print(f"(b) free run: achieved real-time factor {free['sim_rate']:.1f}x (mean of the "
               f"node's once-a-second figures; the last {free['rtf_reported']:.1f}x); CPU "
               f"{free['cpu_percent']:.0f} %; {free['received_per_s']:.0f} msg/s received")
+        with tempfile.TemporaryDirectory() as tmp:
+            path = str(Path(tmp) / "free.mcap")
+            rec = measure(listener, start_node(args.preset, 0.0, path), args.seconds)
+        print(f"(c) free run, recording in process: achieved real-time factor "
+              f"{rec['sim_rate']:.1f}x = {rec['sim_rate'] / free['sim_rate']:.2f} of (b); "
+              f"CPU {rec['cpu_percent']:.0f} %")
     finally:
         listener.destroy_node()
         rclpy.try_shutdown()

@@ -18,18 +18,20 @@ from dataclasses import dataclass, fields
 from pathlib import Path
 from typing import Any, TextIO
 
-from drill_sim_ros.model import analysis
+from drill_sim_ros.model import analysis, telemetry
 from drill_sim_ros.model import kernel as k
 from drill_sim_ros.model.errors import DrillSimError
-from drill_sim_ros.model.params import UNIT_SCALES, DimensionlessParams, Scales
+from drill_sim_ros.model.params import GROUPS, UNIT_SCALES, DimensionlessParams, Scales
 from drill_sim_ros.model.presets import Preset, available_presets, load_preset
 from drill_sim_ros.model.simulator import SimConfig, Simulator
 from drill_sim_ros.terminal import StatusLine
 
-GROUPS = ("n", "psi", "beta", "lam", "w0", "omega0")
 TRACE_COLUMNS = ("tau", "omega", "v", "wob", "tob", "depth_of_cut", "surface_torque", "mode")
 TRACE_SI_COLUMNS = ("time_s", "bit_rpm", "rop_m_s", "wob_n", "tob_nm", "depth_of_cut_m",
                     "surface_torque_nm")
+# The telemetry fields behind TRACE_SI_COLUMNS (ROP in m/s, speeds in rev/min).
+TRACE_SI_FIELDS = ("sim_time_s", "bit_rpm", "rop_m_s", "wob_n", "tob_nm", "depth_of_cut_m",
+                   "surface_torque_nm")
 CHUNK_STEPS = 500_000
 
 
@@ -188,7 +190,7 @@ def summarize(spec: RunSpec, sim: Simulator, kernel_seconds: float) -> dict[str,
     stick, bounce = analysis.first_event_tau(acc)
     triv = analysis.trivial_solution(p)
     root = analysis.rightmost_root(p)
-    ssi = (avg.omega_max - avg.omega_min) / (2.0 * avg.mean_omega) if avg.mean_omega else None
+    sev = analysis.severity_of(avg.omega_min, avg.omega_max, avg.mean_omega, p.omega0)
     out: dict[str, Any] = {
         "params": {g: getattr(p, g) for g in GROUPS},
         "tau_end": spec.tau_end, "dtau": spec.dtau, "average_from": spec.average_from,
@@ -199,8 +201,7 @@ def summarize(spec: RunSpec, sim: Simulator, kernel_seconds: float) -> dict[str,
         "mean_wob": avg.mean_wob, "mean_omega": avg.mean_omega,
         "mean_pipe_torque": avg.mean_pipe_torque, "mean_rop": avg.mean_rop,
         "specific_energy": avg.specific_energy, "drilling_strength": avg.drilling_strength,
-        "omega_min": avg.omega_min, "omega_max": avg.omega_max, "ssi": ssi,
-        "utr": (p.omega0 - avg.omega_min) / p.omega0 if p.omega0 else None,
+        "omega_min": avg.omega_min, "omega_max": avg.omega_max, "ssi": sev.ssi, "utr": sev.utr,
         "trivial_torque": triv.torque, "trivial_depth_of_cut": triv.depth_of_cut,
         "trivial_rop": triv.v, "trivial_delay": analysis.trivial_delay(p),
         "critical_delay": analysis.critical_delay(p),
@@ -248,14 +249,16 @@ def _trace_writer(stream: TextIO, spec: RunSpec) -> Any:
 def _write_trace(writer: Any, samples: Any, spec: RunSpec) -> None:
     cols = [samples.column(c) for c in (k.C_TAU, k.C_OMEGA, k.C_V, k.C_WOB, k.C_TOB,
                                         k.C_DOC, k.C_T_PIPE, k.C_MODE)]
-    sc = spec.scales
+    si = None
+    if spec.physical:
+        rows = telemetry.si_rows(samples.data, (samples.depth_offset, samples.angle_offset),
+                                 telemetry.field_scales(spec.scales),
+                                 cols[0] * spec.scales.time_s, 0.0)
+        si = rows[:, [telemetry.TELEMETRY_INDEX[name] for name in TRACE_SI_FIELDS]]
     for i in range(len(samples)):
         row = [f"{c[i]:.10g}" for c in cols[:-1]] + [int(cols[-1][i])]
-        if spec.physical:
-            row += [f"{x:.10g}" for x in (cols[0][i] * sc.time_s, sc.rpm(cols[1][i]),
-                                          sc.rop_m_s(cols[2][i]), sc.wob_n(cols[3][i]),
-                                          sc.tob_nm(cols[4][i]), cols[5][i] * sc.length_m,
-                                          sc.tob_nm(cols[6][i]))]
+        if si is not None:
+            row += [f"{x:.10g}" for x in si[i]]
         writer.writerow(row)
 
 

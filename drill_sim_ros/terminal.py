@@ -6,8 +6,11 @@ The only writer to a stream in library code; silent unless the stream is a TTY (
 
 from __future__ import annotations
 
+import math
 import sys
 from typing import TextIO
+
+from drill_sim_ros.model.telemetry import MODE_NAMES, TELEMETRY_INDEX
 
 
 class StatusLine:
@@ -39,3 +42,19 @@ class StatusLine:
             self.active = False
             return False
         return True
+
+
+M_S_TO_M_H = 3600.0
+
+
+def format_status(row: list[float], achieved_rtf: float, state: str = "") -> str:
+    """sim_node's live line of one telemetry row (``TELEMETRY_FIELDS`` order): sim time,
+    bit rpm, WOB, TOB, ROP, mode, achieved real-time factor, state."""
+    f = TELEMETRY_INDEX
+    mode = int(row[f["mode"]])
+    mode_name = MODE_NAMES[mode] if 0 <= mode < len(MODE_NAMES) else "?"
+    rtf = "  -  " if math.isnan(achieved_rtf) else f"{achieved_rtf:5.2f}"
+    text = (f"t {row[f['sim_time_s']]:9.2f} s | bit {row[f['bit_rpm']]:6.1f} rpm | "
+            f"WOB {row[f['wob_n']] / 1e3:7.2f} kN | TOB {row[f['tob_nm']] / 1e3:6.2f} kN m | "
+            f"ROP {row[f['rop_m_s']] * M_S_TO_M_H:6.2f} m/h | {mode_name:<12} | x{rtf}")
+    return f"{text} | {state}" if state else text

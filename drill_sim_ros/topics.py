@@ -6,6 +6,10 @@ Units are SI unless the name says otherwise (rpm = rev/min).
 
 from __future__ import annotations
 
+from drill_sim_ros.model.telemetry import MODE_NAMES, TELEMETRY_FIELDS, TELEMETRY_INDEX
+
+__all__ = ["MODE_NAMES", "TELEMETRY_FIELDS", "TELEMETRY_INDEX"]   # with the names below
+
 NODE_NAME = "drill_sim"
 
 # ---- published by sim_node -------------------------------------------------------------
@@ -20,6 +24,7 @@ SURFACE_JOINT_STATES = "/drill/surface/joint_states"  # sensor_msgs/JointState (
 TELEMETRY = "/drill/telemetry"                # std_msgs/Float64MultiArray (TELEMETRY_FIELDS)
 DIAGNOSTICS = "/diagnostics"                  # diagnostic_msgs/DiagnosticArray, 1 Hz
 CLOCK = "/clock"                              # rosgraph_msgs/Clock (publish_clock)
+RUN_INFO = "/drill/run_info"                  # std_msgs/String, JSON; latched (transient local)
 
 # ---- subscribed by sim_node ------------------------------------------------------------
 CMD_SURFACE_RPM = "/drill/cmd/surface_rpm"    # std_msgs/Float64, rev/min
@@ -37,6 +42,7 @@ MSG_TYPES: dict[str, str] = {
     TELEMETRY: "std_msgs/msg/Float64MultiArray",
     DIAGNOSTICS: "diagnostic_msgs/msg/DiagnosticArray",
     CLOCK: "rosgraph_msgs/msg/Clock",
+    RUN_INFO: "std_msgs/msg/String",
     CMD_SURFACE_RPM: "std_msgs/msg/Float64",
     CMD_WOB: "std_msgs/msg/Float64",
 }
@@ -49,24 +55,5 @@ SURFACE_JOINTS = ("top_drive", "hook")
 # top_drive: angle rad, speed rad/s, surface (pipe) torque N m
 # hook:      bit depth m, rate of penetration m/s, hook load N
 
-# One flat, atomic record per published sample (layout.dim[0].label lists these names).
-TELEMETRY_FIELDS = (
-    "sim_time_s",
-    "bit_angle_rad",
-    "bit_rpm",
-    "bit_depth_m",
-    "rop_m_s",
-    "wob_n",
-    "tob_nm",
-    "depth_of_cut_m",
-    "wearflat_wob_n",
-    "mode",
-    "surface_angle_rad",
-    "surface_rpm",
-    "surface_torque_nm",
-    "applied_wob_n",
-    "hook_load_n",
-)
-TELEMETRY_INDEX = {name: i for i, name in enumerate(TELEMETRY_FIELDS)}
-
-MODE_NAMES = ("cutting", "lost_contact", "stuck", "off_bottom")
+# /drill/telemetry carries one row of the model's telemetry record per sample, and its
+# layout.dim[0].label lists TELEMETRY_FIELDS (drill_sim_ros.model.telemetry).

@@ -20,13 +20,14 @@ from rclpy.qos import (
     ReliabilityPolicy,
 )
 
+from drill_sim_ros.model.telemetry import NS_PER_S
+
 # Keep up to this many samples per topic in a recorder's or replayer's DDS queue.
 DEFAULT_DEPTH = 1000
-_NS_PER_S = 1_000_000_000
 
 
 def _duration(value: Duration) -> dict[str, int]:
-    sec, nsec = divmod(int(value.nanoseconds), _NS_PER_S)
+    sec, nsec = divmod(int(value.nanoseconds), NS_PER_S)
     return {"sec": sec, "nsec": nsec}
 
 

@@ -20,6 +20,7 @@ from typing import Any
 from drill_sim_ros.model.errors import ParameterError
 
 RPM_PER_RAD_S = 60.0 / (2.0 * math.pi)
+GROUPS = ("n", "psi", "beta", "lam", "w0", "omega0")   # the six groups, eqs. (23)-(24)
 
 
 def _require(name: str, value: float, low: float, high: float = math.inf,

@@ -235,17 +235,14 @@ class Simulator:
         """
         if n_steps < 0:
             raise ParameterError(f"n_steps = {n_steps!r} must be >= 0")
-        self.open_run(n_steps)
-        status, written = k.advance(*self.kernel_arrays(), out, n_steps, every, self.exact)
-        self.close_run(n_steps, status)
+        self._open_run(n_steps)
+        status, written = k.advance(*self._kernel_arrays(), out, n_steps, every, self.exact)
+        self._close_run(n_steps, status)
         return written
 
-    # ---- runs stepped by compiled callers (sim_node's tick loop) ------------------------
-    def kernel_arrays(self) -> tuple[np.ndarray, ...]:
+    def _kernel_arrays(self) -> tuple[np.ndarray, ...]:
         """The arguments of ``kernel.advance`` before ``out``: state, parameters, targets,
-        profile, history, history meta, accumulators. A compiled caller that steps the
-        simulator itself passes them, with ``exact = self.exact``, between :meth:`open_run`
-        and :meth:`close_run`."""
+        profile, history, history meta, accumulators."""
         if self._hist is None:               # the profile method (no exact-delay history)
             return (self._state, self._prm, self._targets, self._profile, k.NO_HISTORY,
                     k.NO_META, self._acc)
@@ -256,18 +253,16 @@ class Simulator:
     def exact(self) -> bool:
         return self._hist is not None
 
-    def open_run(self, min_steps: int) -> int:
-        """Before a run of at least ``min_steps``: raises after a fault, and rebases when a
-        check is due (never during a run, so :attr:`offsets` hold for all its rows). Returns
-        the steps the run may take before the next check (at least ``min_steps``)."""
+    def _open_run(self, n_steps: int) -> None:
+        """Before a run of ``n_steps``: raises after a fault, and rebases when a check is
+        due (never during a run, so :attr:`offsets` hold for all its rows)."""
         if self.fault is not None:
             raise NumericalFault(f"simulator faulted ({self.fault}); call reset()")
-        if self._unchecked_steps + min_steps >= REBASE_CHECK_STEPS:
+        if self._unchecked_steps + n_steps >= REBASE_CHECK_STEPS:
             self._rebase()
             self._unchecked_steps = 0
-        return max(REBASE_CHECK_STEPS - self._unchecked_steps, min_steps)
 
-    def close_run(self, n_steps: int, status: int) -> None:
+    def _close_run(self, n_steps: int, status: int) -> None:
         """After a run of ``n_steps`` that ended with kernel ``status``: raises
         NumericalFault or HistoryOverflow when it failed."""
         self._unchecked_steps += n_steps

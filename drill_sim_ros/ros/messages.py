@@ -2,24 +2,31 @@
 
 from __future__ import annotations
 
-import importlib
-
+from builtin_interfaces.msg import Time
 from diagnostic_msgs.msg import DiagnosticStatus, KeyValue
+from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
 from drill_sim_ros import topics
+from drill_sim_ros.archive.ros_types import message_class
+from drill_sim_ros.model.telemetry import NS_PER_S
 
 HARDWARE_ID = "drill_sim_ros"
-
-
-def message_class(type_name: str) -> type:
-    """The rclpy class of ``pkg/msg/Type``."""
-    package, _, name = type_name.split("/")
-    return getattr(importlib.import_module(f"{package}.msg"), name)
+# /drill/run_info is published once and latched: a late subscriber (a recorder, a bridge)
+# still gets it.
+RUN_INFO_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1,
+                          reliability=ReliabilityPolicy.RELIABLE,
+                          durability=DurabilityPolicy.TRANSIENT_LOCAL)
 
 
 def type_of(topic: str) -> type:
     """The message class of one of the topics in :mod:`drill_sim_ros.topics`."""
     return message_class(topics.MSG_TYPES[topic])
+
+
+def stamp(time_ns: int) -> Time:
+    """builtin_interfaces/Time of an integer nanosecond count."""
+    sec, nanosec = divmod(int(time_ns), NS_PER_S)
+    return Time(sec=sec, nanosec=nanosec)
 
 
 def status(name: str, level: bytes, message: str, values: dict[str, str]) -> DiagnosticStatus:

@@ -3,17 +3,19 @@
 Publishes the bit and surface state at ``publish_rate_hz`` of simulated time (stamps in
 simulated time, one stamp per sample on every topic), /diagnostics at 1 Hz wall and /clock;
 takes surface-rpm and WOB setpoints; serves ~/reset, ~/pause and ~/step (lockstep).
-Pacing follows the monotonic clock without drift (:mod:`drill_sim_ros.ros.pacing`).
+Pacing follows the monotonic clock without drift (:mod:`drill_sim_ros.realtime.pacing`).
 
-Threads: a :class:`~drill_sim_ros.ros.ticker.Ticker` advances and publishes the samples
-(starting with the first spin of the node); the executor's thread runs the commands,
-services, parameter callbacks and 1 Hz timers. Both take the node's :class:`HandoffLock`
-before touching the session, the schedule or the recorder. Lockstep uses no ticker.
+One tick path: the ticker thread (real time, free run) or the ``~/step`` callback (lockstep,
+paused) asks the session for the periods that are due and hands the block to the sinks
+(:mod:`drill_sim_ros.ros.sinks`: publishers and recorder, the same bytes). The executor's
+thread runs the commands, services, parameter callbacks and 1 Hz timers. Both take the
+node's :class:`HandoffLock` before touching the session, the schedule or the recorder.
 """
 
 from __future__ import annotations
 
 import gc
+import json
 import math
 import signal
 import sys
@@ -24,7 +26,6 @@ from typing import Any
 
 import numpy as np
 import rclpy
-from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from rcl_interfaces.msg import SetParametersResult
 from rclpy.clock import Clock, ClockType
 from rclpy.event_handler import PublisherEventCallbacks
@@ -35,21 +36,23 @@ from rclpy.parameter import Parameter
 from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.serialization import serialize_message
 from rclpy.task import Future
-from std_msgs.msg import Float64
+from std_msgs.msg import Float64, String
 from std_srvs.srv import SetBool, Trigger
 
 from drill_sim_ros import topics
 from drill_sim_ros.model.errors import DrillSimError, NumericalFault
 from drill_sim_ros.model.presets import load_preset
+from drill_sim_ros.model.session import SessionConfig, SimSession
+from drill_sim_ros.model.telemetry import MODE_NAMES, TELEMETRY_INDEX
+from drill_sim_ros.realtime.pacing import Pacer, RateMeter
+from drill_sim_ros.realtime.ticker import HandoffLock, Ticker
 from drill_sim_ros.ros import messages
-from drill_sim_ros.ros.conversions import stamp
-from drill_sim_ros.ros.engine import EXIT_WAIT, R_SAMPLES, TickLoop
-from drill_sim_ros.ros.frame import SAMPLE_TOPICS, FramePublisher, SampleFrame
-from drill_sim_ros.ros.pacing import Pacer, RateMeter, lateness_percentiles_ms
+from drill_sim_ros.ros.diagnostics import Figures, diagnostics
+from drill_sim_ros.ros.frame import SAMPLE_TOPICS
+from drill_sim_ros.ros.messages import RUN_INFO_QOS
 from drill_sim_ros.ros.parameters import SPEC_BY_NAME, coerce, declare_all, validate
-from drill_sim_ros.ros.session import SessionConfig, SimSession
-from drill_sim_ros.ros.status_line import StatusLine, format_status
-from drill_sim_ros.ros.ticker import SHORT_WAIT_S, HandoffLock, Ticker
+from drill_sim_ros.ros.sinks import SampleSinks
+from drill_sim_ros.terminal import StatusLine, format_status
 
 RCLError = rclpy_implementation.RCLError
 DATA_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=100,
@@ -61,9 +64,9 @@ COMMAND_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=10,
 # Reliable volatile publishers match every subscriber but transient-local ones; without the
 # default QoS-event handlers the executor's wait set is 2 entities per publisher smaller.
 QUIET_PUBLISHER = PublisherEventCallbacks(use_default_callbacks=False)
-FREE_RUN_BATCH = 20          # periods per kernel call when running as fast as possible
-MAX_CATCH_UP = 50            # periods per kernel call when catching up in real time
-MAX_RUN = 1 << 30            # samples per compiled run (the severity window stops it sooner)
+FREE_RUN_BATCH = 20          # periods per turn when running as fast as possible
+MAX_CATCH_UP = 50            # periods per turn when catching up in real time
+BACKLOG_WAIT_S = 0.005       # free run: wait this long while the recorder catches up
 DIAGNOSTICS_PERIOD_S = 1.0
 STATUS_PERIOD_S = 0.25
 WARN_THROTTLE_S = 1.0
@@ -78,7 +81,8 @@ def session_config(values: dict[str, Any], preset: Any) -> SessionConfig:
         perturb_v=values["model.perturb_v"], applied_wob_n=values["model.applied_wob_n"],
         surface_rpm=values["model.surface_rpm"],
         top_drive_accel_rpm_s=values["limits.top_drive_accel_rpm_s"],
-        wob_rate_n_s=values["limits.wob_rate_n_s"], window_s=values["diagnostics.window_s"])
+        wob_rate_n_s=values["limits.wob_rate_n_s"], window_s=values["diagnostics.window_s"],
+        submerged_weight_n=values["model.submerged_string_weight_n"])
 
 
 def command_problem(value: float, limit: float, unit: str) -> str | None:
@@ -93,18 +97,19 @@ def command_problem(value: float, limit: float, unit: str) -> str | None:
 
 
 class SimNode(Node):
-    """The ``drill_sim`` node; ``finished`` completes when ``run_seconds`` have passed."""
+    """The ``drill_sim`` node; call :meth:`start` before spinning it. ``finished`` completes
+    when ``run_seconds`` have passed."""
 
     def __init__(self, **node_kwargs: Any) -> None:
         super().__init__(topics.NODE_NAME, **node_kwargs)
         self._steady = Clock(clock_type=ClockType.STEADY_TIME)
         self._preset, self._values = declare_all(self, load_preset)
-        self._session = SimSession(session_config(self._values, self._preset))
-        self._lock = HandoffLock()
-        self._pacer = Pacer(self._wall_period_ns(1.0))
-        self._rate = RateMeter(time.monotonic_ns(), 0.0)
-        self._status = StatusLine()
         self.finished = Future()
+        self._lock = HandoffLock()
+        self._status = StatusLine()
+        self._session: SimSession | None = None       # made by start()
+        self._pacer = Pacer(1)
+        self._rate = RateMeter(time.monotonic_ns(), 0.0)
         self._paused = False
         self._closing = False
         self._fault: str | None = None
@@ -113,9 +118,9 @@ class SimNode(Node):
         self._pubs = {t: self.create_publisher(messages.type_of(t), t, self._qos(t),
                                                event_callbacks=QUIET_PUBLISHER)
                       for t in (*SAMPLE_TOPICS, topics.CLOCK, topics.DIAGNOSTICS)}
-        self._frame_publishers = {with_clock: self._frame_publisher(with_clock)
-                                  for with_clock in (False, True)}
-        self._recorder = self._open_recorder(self._values["record.path"])
+        self._pubs[topics.RUN_INFO] = self.create_publisher(
+            messages.type_of(topics.RUN_INFO), topics.RUN_INFO, RUN_INFO_QOS)
+        self._sinks = SampleSinks(self._pubs)
         self.create_subscription(Float64, topics.CMD_SURFACE_RPM, self._on_surface_rpm,
                                  COMMAND_QOS)
         self.create_subscription(Float64, topics.CMD_WOB, self._on_wob, COMMAND_QOS)
@@ -123,39 +128,36 @@ class SimNode(Node):
         self.create_service(SetBool, "~/pause", self._on_pause)
         self.create_service(Trigger, "~/step", self._on_step)
         self._ticker = Ticker(self._tick, self._on_tick_error, name="drill_sim_ticker")
-        self._lock.on_request = self._ticker.wake     # the compiled loop waits on its eventfd
-        self._loop = self._tick_loop()
         self._first_spin = self.create_timer(0.0, self._start_ticker, clock=self._steady)
+        self._first_spin.cancel()                      # start() arms it
         self.create_timer(DIAGNOSTICS_PERIOD_S, self._publish_diagnostics, clock=self._steady)
-        if self._status.active:
-            self.create_timer(STATUS_PERIOD_S, self._show_status, clock=self._steady)
-        self._stop_timer = self._start_run_limit(self._values["run_seconds"])
+        self.create_timer(STATUS_PERIOD_S, self._show_status, clock=self._steady)
+        self._stop_timer = self.create_timer(max(self._values["run_seconds"], 1e-3),
+                                             self._on_run_limit, clock=self._steady)
+        self._stop_timer.cancel()                      # start() arms it when run_seconds > 0
         self.add_on_set_parameters_callback(self._validate_parameters)
         self.add_post_set_parameters_callback(self._apply_parameters)
+
+    # ---- start -------------------------------------------------------------------------
+    def start(self) -> None:
+        """Build (compile, warm up) the session, open the recording, publish what runs; the
+        ticker starts on the first spin. Raises DrillSimError or ValueError on bad settings."""
+        with self._lock.urgent():
+            session = SimSession(session_config(self._values, self._preset))
+            self._session = session
+            self._pacer = Pacer(self._wall_period_ns(self._rtf))
+            self._sinks.emit(session.run(0), False)      # load the packing code now
+            self._sinks.recorder = self._open_recorder(self._values["record.path"])
+            self._publish_run_info()
+        self._first_spin.reset()
+        if self._values["run_seconds"] > 0:
+            self._stop_timer.reset()
         self._log_start()
-
-    # ---- set-up ------------------------------------------------------------------------
-    def _tick_loop(self) -> TickLoop | None:
-        """The compiled tick loop, or None (then the ticker runs the Python path) where rcl's
-        publish call or the C library's clocks cannot be bound."""
-        if not all(p.compiled for p in self._frame_publishers.values()):
-            return None
-        try:
-            loop = TickLoop(self._lock.requests, self._ticker.wake_fd, MAX_CATCH_UP,
-                            FREE_RUN_BATCH, round(SHORT_WAIT_S * 1e9))
-        except (OSError, AttributeError) as exc:
-            self.get_logger().warning(f"ticking in Python: {exc}")
-            return None
-        # load the compiled loop now (a run of no samples), not on the first tick
-        loop.run(self._session, self._frame_publishers[False], self._pacer, 0, 0.0)
-        return loop
-
-    def _frame_publisher(self, with_clock: bool) -> FramePublisher:
-        frame = SampleFrame(self._preset.scales, with_clock)
-        return FramePublisher(frame, [self._pubs[topic] for topic in frame.topics])
 
     @staticmethod
     def _qos(topic: str) -> QoSProfile:
+        if topic == topics.RUN_INFO:
+            return RUN_INFO_QOS
         return CLOCK_QOS if topic in (topics.CLOCK, topics.DIAGNOSTICS) else DATA_QOS
 
     def _open_recorder(self, path: str) -> Any:
@@ -175,18 +177,20 @@ class SimNode(Node):
         self.get_logger().info(f"recording to {path}")
         return recorder
 
-    def _run_metadata(self) -> dict[str, str]:
-        """What a recording needs to be read back alone (mcap_to_rerun takes the preset)."""
-        sc = self._preset.scales
-        return {"preset": self._preset.name, "publish_rate_hz": str(self._values[
-            "publish_rate_hz"]), "dtau": repr(self._session.dtau),
-            "t_star_s": repr(sc.time_s), "l_star_m": repr(sc.length_m),
-            "force_unit_n": repr(sc.force_n), "torque_unit_nm": repr(sc.torque_nm)}
+    def _run_info(self) -> dict[str, Any]:
+        return self._session.run_info()
 
-    def _start_run_limit(self, run_seconds: float) -> Any:
-        if run_seconds <= 0:
-            return None
-        return self.create_timer(run_seconds, self._on_run_limit, clock=self._steady)
+    def _run_metadata(self) -> dict[str, str]:
+        """The MCAP metadata record of a recording: the run info, flat, as strings."""
+        info = self._run_info()
+        flat = {key: value for key, value in info.items() if key != "groups"}
+        return {key: value if isinstance(value, str) else repr(value)
+                for key, value in flat.items()}
+
+    def _publish_run_info(self) -> None:
+        """/drill/run_info, latched: what this node runs, as JSON (lock held)."""
+        payload = serialize_message(String(data=json.dumps(self._run_info())))
+        self._sinks.emit_one(topics.RUN_INFO, payload, self._session.sim_time_ns)
 
     def _log_start(self) -> None:
         s = self._session
@@ -217,10 +221,13 @@ class SimNode(Node):
             for param in params:
                 if param.name in SPEC_BY_NAME:
                     self._values[param.name] = coerce(SPEC_BY_NAME[param.name], param.value)
+            if self._session is None:
+                return
+            self._session.submerged_weight_n = self._values["model.submerged_string_weight_n"]
             if any(p.name in ("real_time_factor", "lockstep") for p in params):
                 self._restart_ticks()
 
-    # ---- pacing ------------------------------------------------------------------------
+    # ---- pacing and the one tick path --------------------------------------------------
     def _wall_period_ns(self, rtf: float) -> int:
         return max(1, round(self._session.period_ns / rtf)) if rtf > 0 else 1
 
@@ -242,14 +249,15 @@ class SimNode(Node):
         self._ticker.wake()
 
     def _tick(self) -> float | None:
-        """One turn of the ticker thread; the seconds to wait before the next (None: idle)."""
+        """One turn of the ticker thread: advance the periods that are due and hand their
+        block to the sinks. Returns the seconds to wait before the next turn (None: idle)."""
         self._lock.acquire_background()
         try:
             if self._closing or self._lockstep or self._paused or self._fault is not None:
                 return None
-            if self._loop is not None:
-                return self._run_loop()
-            if self._rtf <= 0:
+            if self._rtf <= 0:                        # free run
+                if self._sinks.backlogged():
+                    return BACKLOG_WAIT_S
                 self._advance(FREE_RUN_BATCH)
                 return 0.0
             pacer = self._pacer
@@ -260,25 +268,18 @@ class SimNode(Node):
         finally:
             self._lock.release()
 
-    def _run_loop(self) -> float | None:
-        """Hand the ticker to the compiled loop until Python has work (lock held)."""
-        publisher = self._frame_publishers[self._values["publish_clock"]]
-        time_ns = self._session.sim_time_ns
+    def _advance(self, periods: int) -> bool:
+        """Simulate ``periods`` and hand the block to the sinks; False on a numerical fault
+        (call with the lock held)."""
         try:
-            reason = self._loop.run(
-                self._session, publisher, None if self._rtf <= 0 else self._pacer,
-                MAX_RUN if self._recorder is None else 1,
-                self._values["model.submerged_string_weight_n"])
+            block = self._session.run(periods)
         except NumericalFault as exc:
             self._on_fault(exc)
-            return None
-        if self._loop.result[R_SAMPLES] > 0:
-            self._last_row = publisher.frame.row
-            if self._recorder is not None:
-                self._record(publisher.frame, time_ns)
-        if reason == EXIT_WAIT:
-            return max(0.0, (self._pacer.deadline_ns() - time.monotonic_ns()) * 1e-9)
-        return 0.0
+            return False
+        self._sinks.emit(block, self._values["publish_clock"])
+        if len(block):
+            self._last_row = block.rows[-1]
+        return True
 
     def _on_tick_error(self, exc: Exception) -> bool:
         """An unexpected error on the ticker: quiet at shutdown, else a fault until reset."""
@@ -289,36 +290,6 @@ class SimNode(Node):
         self.get_logger().error(f"ticker: {exc!r}; call ~/reset to resume")
         return True
 
-    def _advance(self, periods: int) -> bool:
-        """Simulate and publish ``periods`` samples; False on a numerical fault."""
-        session = self._session
-        try:
-            time_ns, count = session.run(periods)
-        except NumericalFault as exc:
-            self._on_fault(exc)
-            return False
-        # One compiled call fills and publishes the samples through rcl (FramePublisher);
-        # sim_node destroys no publisher while it ticks. (Lockstep, and the Python ticker.)
-        publisher = self._frame_publishers[self._values["publish_clock"]]
-        weight_n = self._values["model.submerged_string_weight_n"]
-        offsets, period_ns = session.sim.offsets, session.period_ns
-        if self._recorder is None:
-            publisher.publish(session.samples, 0, count, offsets, time_ns, period_ns, weight_n)
-        else:
-            for index in range(count):
-                publisher.publish(session.samples, index, 1, offsets, time_ns, period_ns,
-                                  weight_n)
-                self._record(publisher.frame, time_ns)
-                time_ns += period_ns
-        if count:
-            self._last_row = publisher.frame.row
-        return True
-
-    def _record(self, frame: SampleFrame, time_ns: int) -> None:
-        """The very bytes just published, unchanged (recorder on, lock held)."""
-        for topic, payload in zip(frame.topics, frame.payloads(), strict=True):
-            self._recorder.write_serialized(topic, payload, time_ns)
-
     def _on_fault(self, exc: NumericalFault) -> None:
         self._fault = str(exc)
         self.get_logger().error(f"numerical fault: {exc}; call ~/reset to recover")
@@ -326,10 +297,11 @@ class SimNode(Node):
     # ---- commands ----------------------------------------------------------------------
     def _on_surface_rpm(self, msg: Float64) -> None:
         self._command(topics.CMD_SURFACE_RPM, msg.data, "limits.max_surface_rpm", "rev/min",
-                      self._session.set_surface_rpm)
+                      lambda value: self._session.set_surface_rpm(value))
 
     def _on_wob(self, msg: Float64) -> None:
-        self._command(topics.CMD_WOB, msg.data, "limits.max_wob_n", "N", self._session.set_wob_n)
+        self._command(topics.CMD_WOB, msg.data, "limits.max_wob_n", "N",
+                      lambda value: self._session.set_wob_n(value))
 
     def _command(self, topic: str, value: float, limit: str, unit: str,
                  apply: Callable[[float], None]) -> None:
@@ -338,9 +310,8 @@ class SimNode(Node):
         if problem is not None:
             self._reject(topic, problem)
             return
-        # No lock: a setpoint is one float64 store into the kernel's targets, which the
-        # ticker's next step reads (the compiled loop holds the lock through its sleeps).
-        apply(value)
+        with self._lock.urgent():
+            apply(value)
 
     def _reject(self, topic: str, problem: str) -> None:
         self.rejected_commands += 1
@@ -388,74 +359,34 @@ class SimNode(Node):
 
     # ---- diagnostics, status, shutdown -------------------------------------------------
     def _publish_diagnostics(self) -> None:
-        """/diagnostics: the figures are read under the lock, the message is built and
+        """/diagnostics: the figures are copied under the lock, the message is built and
         serialized outside it, so the ticker waits for a copy, not for the formatting."""
+        if self._session is None:
+            return
         with self._lock.urgent():
             time_ns = max(0, self._session.sim_time_ns - self._session.period_ns)
             figures = self._figures(time_ns)
-        msg = DiagnosticArray(status=[self._node_status(figures),
-                                      self._dynamics_status(figures)])
-        msg.header.stamp = stamp(time_ns)
-        payload = serialize_message(msg)
-        self._pubs[topics.DIAGNOSTICS].publish(payload)
-        if self._recorder is not None:   # its queue takes producers on any thread, no lock
-            self._recorder.write_serialized(topics.DIAGNOSTICS, payload, time_ns)
+        payload = serialize_message(diagnostics(figures, time_ns))
+        self._sinks.emit_one(topics.DIAGNOSTICS, payload, time_ns)
 
-    def _figures(self, time_ns: int) -> dict[str, Any]:
+    def _figures(self, time_ns: int) -> Figures:
         """What /diagnostics reports, copied (call with the lock held)."""
         sev, stick_fraction = self._session.severity()
         row = self._last_row
-        return {
-            "state": self._state_text(), "fault": self._fault,
-            "sim_time_s": self._session.sim_time_ns * 1e-9, "rtf": self._rtf,
-            "achieved": self._rate.update(time.monotonic_ns(), time_ns * 1e-9),
-            "overruns": self._pacer.overruns, "lateness_ns": self._pacer.lateness_ns(),
-            "rejected": self.rejected_commands, "dropped": self._recorder_count("dropped"),
-            "written": self._recorder_count("written"), "severity": sev,
-            "stick_fraction": stick_fraction,
-            "mode": "none" if row is None else topics.MODE_NAMES[
-                int(row[topics.TELEMETRY_INDEX["mode"]])],
-            "window_s": self._values["diagnostics.window_s"],
-        }
-
-    @staticmethod
-    def _node_status(f: dict[str, Any]) -> DiagnosticStatus:
-        p50, p99 = lateness_percentiles_ms(f["lateness_ns"], 50, 99)
-        values = {
-            "state": f["state"],
-            "sim_time_s": f"{f['sim_time_s']:.3f}",
-            "real_time_factor_target": f"{f['rtf']:g}",
-            "real_time_factor_achieved": f"{f['achieved']:.4g}",
-            "overruns": str(f["overruns"]),
-            "tick_lateness_p50_ms": f"{p50:.4g}",
-            "tick_lateness_p99_ms": f"{p99:.4g}",
-            "rejected_commands": str(f["rejected"]),
-            "recorder_dropped": str(f["dropped"]),
-            "recorder_written": str(f["written"]),
-            "fault": f["fault"] or "",
-        }
-        if f["fault"] is not None:
-            level, message = DiagnosticStatus.ERROR, f"numerical fault: {f['fault']}"
-        elif f["overruns"] or f["dropped"]:
-            level, message = DiagnosticStatus.WARN, "overruns or recorder drops"
-        else:
-            level, message = DiagnosticStatus.OK, f["state"]
-        return messages.status(f"{topics.NODE_NAME}: simulation", level, message, values)
-
-    @staticmethod
-    def _dynamics_status(f: dict[str, Any]) -> DiagnosticStatus:
-        sev, stick_fraction = f["severity"], f["stick_fraction"]
-        values = {"mode": f["mode"], "stick_slip_severity": f"{sev.ssi:.4g}",
-                  "under_torque_ratio": f"{sev.utr:.4g}",
-                  "stick_fraction": f"{stick_fraction:.4g}",
-                  "window_s": f"{f['window_s']:g}"}
-        stick_slip = stick_fraction > 0 or sev.ssi > 0.5
-        level = DiagnosticStatus.WARN if stick_slip else DiagnosticStatus.OK
-        message = "stick-slip" if stick_slip else "smooth drilling"
-        return messages.status(f"{topics.NODE_NAME}: bit dynamics", level, message, values)
+        return Figures(
+            state=self._state_text(), fault=self._fault,
+            sim_time_s=self._session.sim_time_ns * 1e-9, rtf=self._rtf,
+            achieved=self._rate.update(time.monotonic_ns(), time_ns * 1e-9),
+            overruns=self._pacer.overruns, lateness_ns=self._pacer.lateness_ns(),
+            rejected=self.rejected_commands, dropped=self._recorder_count("dropped"),
+            written=self._recorder_count("written"), severity=sev,
+            stick_fraction=stick_fraction,
+            mode="none" if row is None else MODE_NAMES[int(row[TELEMETRY_INDEX["mode"]])],
+            window_s=self._values["diagnostics.window_s"])
 
     def _recorder_count(self, name: str) -> int:
-        return 0 if self._recorder is None else int(getattr(self._recorder, name))
+        recorder = self._sinks.recorder
+        return 0 if recorder is None else int(getattr(recorder, name))
 
     def _state_text(self) -> str:
         if self._fault is not None:
@@ -465,10 +396,12 @@ class SimNode(Node):
         return "lockstep" if self._lockstep else "running"
 
     def _show_status(self) -> None:
+        if not (self._status.active and self._values["status_line"]):
+            return
         with self._lock.urgent():
             row = None if self._last_row is None else self._last_row.tolist()
             state = self._state_text()
-        if self._values["status_line"] and row is not None:
+        if row is not None:
             self._status.show(format_status(row, self._rate.last, state))
 
     def _on_run_limit(self) -> None:
@@ -486,8 +419,8 @@ class SimNode(Node):
             self._ticker.stop()
             self._status.close()
         finally:                            # whatever failed above, finish the recording
-            if self._recorder is not None:
-                recorder, self._recorder = self._recorder, None
+            recorder, self._sinks.recorder = self._sinks.recorder, None
+            if recorder is not None:
                 recorder.close()
                 # after Ctrl-C the context may be gone: a logger of no node has no /rosout
                 # publisher
@@ -509,6 +442,7 @@ def main(args: list[str] | None = None) -> int:
     node = None
     try:
         node = SimNode()
+        node.start()
         # Everything allocated so far lives for the whole run: keep it out of the cyclic
         # collector, whose full passes over the imported modules stall the ticker ~10-40 ms.
         gc.collect()

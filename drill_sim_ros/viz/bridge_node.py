@@ -9,6 +9,7 @@ gRPC server bound to 127.0.0.1 only. Turns rerun's analytics off first.
 from __future__ import annotations
 
 import argparse
+import json
 import signal
 import sys
 import time
@@ -21,10 +22,11 @@ from rclpy.node import Node
 from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.signals import SignalHandlerOptions
 from rclpy.utilities import remove_ros_args
-from std_msgs.msg import Float64MultiArray
+from std_msgs.msg import Float64MultiArray, String
 
 from drill_sim_ros import topics
 from drill_sim_ros.model.presets import DEFAULT_PRESET
+from drill_sim_ros.ros.messages import RUN_INFO_QOS
 from drill_sim_ros.viz.analytics_off import disable_analytics
 from drill_sim_ros.viz.blueprint import build_blueprint
 from drill_sim_ros.viz.dashboard import Dashboard
@@ -75,6 +77,9 @@ class TelemetryQueue:
 
     def destroy(self) -> None:
         self.node.destroy_node()
+
+
+RUN_INFO_WAIT_S = 3.0        # how long to wait for the sim's /drill/run_info at start
 
 
 class RerunBridge(Node):
@@ -132,8 +137,9 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
     parser.add_argument("--serve", action="store_true",
                         help="host a gRPC server on 127.0.0.1 for viewers to connect to")
     parser.add_argument("--serve-port", type=int, default=DEFAULT_SERVE_PORT)
-    parser.add_argument("--preset", default=DEFAULT_PRESET,
-                        help="model preset of the running sim (scales of the 2D views)")
+    parser.add_argument("--preset", default=None,
+                        help="model preset for the scales of the 2D views (default: what "
+                             f"the sim publishes on {topics.RUN_INFO}, else {DEFAULT_PRESET})")
     parser.add_argument("--window-s", type=float, default=None,
                         help="sliding window for E-S and severity, s (default 20 t*)")
     parser.add_argument("--flush-hz", type=float, default=4.0)
@@ -145,8 +151,30 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
     return args
 
 
+def run_units(preset: str | None, timeout_s: float = RUN_INFO_WAIT_S) -> PaperUnits:
+    """``preset``'s units if given; else those of the running sim's /drill/run_info (waited
+    for up to ``timeout_s``); else the default preset's, with a warning naming it."""
+    if preset:
+        return PaperUnits.load(preset)
+    node = Node("rerun_bridge_run_info")
+    received: list[String] = []
+    node.create_subscription(String, topics.RUN_INFO, received.append, RUN_INFO_QOS)
+    deadline = time.monotonic() + timeout_s
+    try:
+        while not received and time.monotonic() < deadline:
+            rclpy.spin_once(node, timeout_sec=0.1)
+    finally:
+        node.destroy_node()
+    if received:
+        return PaperUnits.from_run_info(json.loads(received[0].data))
+    node.get_logger().warning(
+        f"no {topics.RUN_INFO} within {timeout_s:g} s: the 2D views use the scales of preset "
+        f"{DEFAULT_PRESET!r} (override with --preset)")
+    return PaperUnits.load(DEFAULT_PRESET)
+
+
 def make_dashboard(args: argparse.Namespace) -> Dashboard:
-    units = PaperUnits.load(args.preset)
+    units = run_units(args.preset)
     window = default_window_s(units) if args.window_s is None else args.window_s
     rec = open_recording(build_blueprint(window), save=args.save, connect=args.connect,
                          serve_port=args.serve_port if args.serve else None)
@@ -169,7 +197,8 @@ def main(argv: list[str] | None = None) -> None:
     try:
         dashboard = make_dashboard(args)
         node = RerunBridge(dashboard, args.flush_hz, best_effort=args.best_effort)
-        node.get_logger().info(f"ready: {topics.TELEMETRY} -> rerun (preset {args.preset})")
+        node.get_logger().info(f"ready: {topics.TELEMETRY} -> rerun "
+                               f"(scales of {dashboard.units.preset or 'the run info'})")
         rclpy.spin(node)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass

@@ -5,8 +5,10 @@ Decoding uses ``mcap`` with ``mcap_ros2``'s decoder, independent of the archive 
 
 from __future__ import annotations
 
+import json
 from collections.abc import Iterator
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from mcap.reader import make_reader
@@ -47,6 +49,15 @@ def read_telemetry(path: str | Path, batch_rows: int = 20_000) -> Iterator[Telem
     if not seen:
         raise NoTelemetryError(f"{path}: no {topics.TELEMETRY} messages with "
                                f"{N_FIELDS} fields")
+
+
+def recorded_run_info(path: str | Path) -> dict[str, Any] | None:
+    """What the recorded sim ran (its first /drill/run_info message, JSON), if any."""
+    with open(path, "rb") as stream:
+        reader = make_reader(stream, decoder_factories=[DecoderFactory()])
+        for _, _, _, msg in reader.iter_decoded_messages(topics=[topics.RUN_INFO]):
+            return json.loads(msg.data)
+    return None
 
 
 def recorded_preset(path: str | Path) -> str | None:

@@ -10,12 +10,18 @@ import argparse
 import sys
 from pathlib import Path
 
+from drill_sim_ros import topics
 from drill_sim_ros.model.errors import ParameterError
 from drill_sim_ros.model.presets import DEFAULT_PRESET
 from drill_sim_ros.viz.analytics_off import disable_analytics
 from drill_sim_ros.viz.blueprint import build_blueprint
 from drill_sim_ros.viz.dashboard import Dashboard
-from drill_sim_ros.viz.mcap_telemetry import NoTelemetryError, read_telemetry, recorded_preset
+from drill_sim_ros.viz.mcap_telemetry import (
+    NoTelemetryError,
+    read_telemetry,
+    recorded_preset,
+    recorded_run_info,
+)
 from drill_sim_ros.viz.paper_units import PaperUnits
 from drill_sim_ros.viz.recording import close_recording, open_recording
 from drill_sim_ros.viz.running_stats import default_window_s
@@ -26,8 +32,9 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     parser.add_argument("mcap", type=Path, help="recorded run (ROS 2 MCAP)")
     parser.add_argument("-o", "--output", type=Path, required=True, help="the .rrd to write")
     parser.add_argument("--preset", default=None,
-                        help="model preset for the 2D views' scales (default: the file's "
-                             f"'preset' metadata, else {DEFAULT_PRESET})")
+                        help="model preset for the 2D views' scales (default: the "
+                             "recorded /drill/run_info, else the file's 'preset' metadata, "
+                             f"else {DEFAULT_PRESET})")
     parser.add_argument("--window-s", type=float, default=None,
                         help="sliding window for E-S and severity, s (default 20 t*)")
     return parser.parse_args(argv)
@@ -36,7 +43,7 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
 def convert(mcap: Path, output: Path, preset: str | None = None,
             window_s: float | None = None) -> int:
     """Write ``output`` from ``mcap``; return the number of telemetry samples logged."""
-    units = PaperUnits.load(preset or recorded_preset(mcap) or DEFAULT_PRESET)
+    units = recorded_units(mcap, preset)
     window = default_window_s(units) if window_s is None else window_s
     rec = open_recording(build_blueprint(window), save=output)
     try:
@@ -46,6 +53,20 @@ def convert(mcap: Path, output: Path, preset: str | None = None,
     finally:
         close_recording(rec)
     return dashboard.samples
+
+
+def recorded_units(mcap: Path, preset: str | None) -> PaperUnits:
+    """The scales of the 2D views: ``preset`` if given, else the recorded run info, else
+    the recorded preset name, else the default preset (with a warning naming it)."""
+    if preset:
+        return PaperUnits.load(preset)
+    info = recorded_run_info(mcap)
+    if info is not None:
+        return PaperUnits.from_run_info(info)
+    fallback = recorded_preset(mcap) or DEFAULT_PRESET
+    print(f"mcap_to_rerun: warning: {mcap} has no {topics.RUN_INFO}; the 2D views use the "
+          f"scales of preset {fallback!r} (override with --preset)", file=sys.stderr)
+    return PaperUnits.load(fallback)
 
 
 def main(argv: list[str] | None = None) -> int:

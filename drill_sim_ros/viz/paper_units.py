@@ -8,11 +8,12 @@ run's scales (t*, L*, force and torque units) and beta: they come from a model p
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from drill_sim_ros.model.analysis import trivial_solution
-from drill_sim_ros.model.params import RPM_PER_RAD_S, Scales
+from drill_sim_ros.model.params import RPM_PER_RAD_S, DimensionlessParams, Scales
 from drill_sim_ros.model.presets import Preset, load_preset
 
 
@@ -44,6 +45,19 @@ class PaperUnits:
     @classmethod
     def load(cls, name: str) -> PaperUnits:
         return cls.from_preset(load_preset(name))
+
+    @classmethod
+    def from_run_info(cls, info: dict[str, Any]) -> PaperUnits:
+        """From what sim_node publishes on /drill/run_info: the groups and the scales."""
+        groups = dict(info["groups"])
+        params = DimensionlessParams(**{**groups, "n": int(groups["n"])})
+        scales = Scales(time_s=float(info["t_star_s"]), length_m=float(info["l_star_m"]),
+                        force_n=float(info["force_unit_n"]),
+                        torque_nm=float(info["torque_unit_nm"]))
+        triv = trivial_solution(params)
+        return cls(preset=str(info.get("preset", "")), scales=scales, beta=params.beta,
+                   n=params.n, v0=triv.v, omega0=triv.omega, delta0=triv.depth_of_cut,
+                   w0=triv.wob, t0=triv.torque)
 
     def omega(self, rpm: np.ndarray) -> np.ndarray:
         """Bit speed rpm -> omega = Omega t* (eq. 21)."""

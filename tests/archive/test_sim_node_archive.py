@@ -14,7 +14,8 @@ import pytest
 from std_srvs.srv import Trigger
 
 from drill_sim_ros import topics
-from drill_sim_ros.viz.mcap_telemetry import recorded_preset
+from drill_sim_ros.model.presets import load_preset
+from drill_sim_ros.viz.mcap_telemetry import recorded_preset, recorded_run_info
 from tests.archive.helpers import (
     counts_mcap_ros2,
     counts_rosbags,
@@ -29,7 +30,8 @@ pytestmark = pytest.mark.ros
 
 STEPS = 40
 SAMPLE_TOPICS = [t for t in topics.MSG_TYPES
-                 if t not in (topics.CMD_SURFACE_RPM, topics.CMD_WOB, topics.DIAGNOSTICS)]
+                 if t not in (topics.CMD_SURFACE_RPM, topics.CMD_WOB, topics.DIAGNOSTICS,
+                              topics.RUN_INFO)]
 
 
 def _sim_command(*params: str) -> list[str]:
@@ -50,6 +52,12 @@ def _check(path) -> None:
     counts = counts_mcap_ros2(path)
     assert counts == counts_rosbags(path) == statistics_counts(path)
     assert {t: counts[t] for t in SAMPLE_TOPICS} == dict.fromkeys(SAMPLE_TOPICS, STEPS)
+    assert counts[topics.RUN_INFO] == 1                 # latched: once, even for a late recorder
+    info = recorded_run_info(path)
+    scales = load_preset("field_8p5in_shale").scales
+    assert info["preset"] == "field_8p5in_shale"
+    assert (info["t_star_s"], info["l_star_m"], info["force_unit_n"], info["torque_unit_nm"]) \
+        == (scales.time_s, scales.length_m, scales.force_n, scales.torque_nm)
 
 
 def test_lockstep_in_process_recording_is_exact(tmp_path) -> None:

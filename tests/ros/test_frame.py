@@ -1,9 +1,7 @@
-"""The compiled per-sample path: its SI row equals the numpy reference bit for bit, and its
-payloads are what rclpy's serializer makes of messages built field by field from topics.py."""
+"""The compiled packing of a block: its payloads are what rclpy's serializer makes of
+messages built field by field from topics.py."""
 
 from __future__ import annotations
-
-import math
 
 import numpy as np
 import pytest
@@ -13,26 +11,23 @@ from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64, Float64MultiArray, MultiArrayDimension, UInt8
 
 from drill_sim_ros import topics
-from drill_sim_ros.model import kernel as k
 from drill_sim_ros.model.params import RPM_PER_RAD_S
-from drill_sim_ros.model.presets import load_preset
-from drill_sim_ros.model.simulator import Samples
-from drill_sim_ros.ros.conversions import telemetry_rows
 from drill_sim_ros.ros.frame import SampleFrame
 
 F = topics.TELEMETRY_INDEX
-OFFSETS, SUBMERGED_N = (1234.0, 2.0 * math.pi * 57), 2.5e6
-TIMES_NS = (0, 10_000_000, 123_456_789_012, 5_000_000_000)
+TIMES_NS = np.array([0, 10_000_000, 123_456_789_012, 5_000_000_000], dtype=np.int64)
 PADDED = (topics.BIT_MODE, topics.BIT_JOINT_STATES, topics.SURFACE_JOINT_STATES,
           topics.TELEMETRY)
 
 
-def random_samples(rows: int, seed: int = 3) -> Samples:
+def random_rows(rows: int, seed: int = 3) -> np.ndarray:
+    """SI telemetry rows of any values (a mode of 0..3, a negative zero)."""
     rng = np.random.default_rng(seed)
-    data = rng.uniform(-50.0, 50.0, (rows, k.N_COLS))
-    data[:, k.C_MODE] = rng.integers(0, 4, rows)
-    data[0, k.C_V] = -0.0
-    return Samples(data, *OFFSETS)
+    data = rng.uniform(-5e4, 5e4, (rows, len(topics.TELEMETRY_FIELDS)))
+    data[:, F["mode"]] = rng.integers(0, 4, rows)
+    data[0, F["rop_m_s"]] = -0.0
+    data[:, F["sim_time_s"]] = TIMES_NS[:rows] / 1e9
+    return data
 
 
 def joint_state(names: tuple[str, ...], sec: int, nanosec: int, values: list[float]
@@ -70,25 +65,15 @@ def expected_messages(v: np.ndarray, time_ns: int) -> dict[str, object]:
     }
 
 
-def test_rows_equal_the_numpy_reference_bit_for_bit():
-    preset = load_preset("field_8p5in_shale")
-    samples = random_samples(len(TIMES_NS))
-    reference = telemetry_rows(samples, preset.scales, np.array(TIMES_NS) / 1e9, SUBMERGED_N)
-    frame = SampleFrame(preset.scales, with_clock=False)
-    for i, time_ns in enumerate(TIMES_NS):
-        frame.pack(samples.data, i, OFFSETS, time_ns, SUBMERGED_N)
-        assert frame.row.tobytes() == reference[i].tobytes()
-
-
 @pytest.mark.parametrize("with_clock", [True, False])
 def test_payloads_are_the_serialized_messages_in_publishing_order(with_clock):
-    preset = load_preset("field_8p5in_shale")
-    samples = random_samples(len(TIMES_NS), seed=5)
-    frame = SampleFrame(preset.scales, with_clock)
+    rows = random_rows(len(TIMES_NS), seed=5)
+    frame = SampleFrame(with_clock)
     assert frame.topics[-1] == topics.CLOCK if with_clock else topics.CLOCK not in frame.topics
-    for i, time_ns in enumerate(TIMES_NS):
-        payloads = frame.pack(samples.data, i, OFFSETS, time_ns, SUBMERGED_N)
-        expected = expected_messages(frame.row, time_ns)
+    packed = frame.pack(rows, TIMES_NS)
+    assert len(packed) == len(TIMES_NS)
+    for row, time_ns, payloads in zip(rows, TIMES_NS.tolist(), packed, strict=True):
+        expected = expected_messages(row, time_ns)
         assert len(payloads) == len(frame.topics)
         for topic, payload in zip(frame.topics, payloads, strict=True):
             msg = expected[topic]
@@ -103,7 +88,8 @@ def test_payloads_are_the_serialized_messages_in_publishing_order(with_clock):
 
 
 def test_templates_zero_their_padding():
-    frame = SampleFrame(load_preset("field_8p5in_shale").scales, with_clock=False)
-    payload = frame.pack(np.ones((1, k.N_COLS)), 0, (0.0, 0.0), 0, 0.0)[
+    frame = SampleFrame(with_clock=False)
+    rows = np.ones((1, len(topics.TELEMETRY_FIELDS)))
+    payload = frame.pack(rows, np.zeros(1, dtype=np.int64))[0][
         frame.topics.index(topics.BIT_JOINT_STATES)]
     assert payload[17:20] == b"\x00\x00\x00"  # frame_id "": length 1 + NUL, then 3 pad bytes

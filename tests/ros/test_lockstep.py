@@ -24,8 +24,10 @@ F = topics.TELEMETRY_INDEX
 def lockstep_run() -> dict[str, list[bytes]]:
     """One run in a fresh context: STEPS steps with COMMANDS; serialized messages per topic."""
     with ros_context() as ros:
-        ros.add(SimNode(context=ros.context, parameter_overrides=overrides(
-            lockstep=True, status_line=False)))
+        node = SimNode(context=ros.context, parameter_overrides=overrides(
+            lockstep=True, status_line=False))
+        node.start()
+        ros.add(node)
         probe = ros.add(Probe(ros.context, RECORDED, raw=True))
         pubs = {t: probe.create_publisher(Float64, t, 10) for t in (topics.CMD_WOB,
                                                                       topics.CMD_SURFACE_RPM)}

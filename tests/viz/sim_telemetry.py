@@ -6,6 +6,7 @@ input of the viz tests and of benchmarks/bench_bridge.py.
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import numpy as np
@@ -69,12 +70,18 @@ def telemetry_message(row: np.ndarray) -> dict:
     return {"layout": {"dim": [dim], "data_offset": 0}, "data": [float(v) for v in row]}
 
 
-def write_mcap(path: Path, rows: np.ndarray, metadata: dict[str, str] | None = None) -> None:
-    """One /drill/telemetry message per row, log time = 1e9 ns + sim time."""
+def write_mcap(path: Path, rows: np.ndarray, metadata: dict[str, str] | None = None,
+               run_info: dict | None = None) -> None:
+    """One /drill/telemetry message per row, log time = 1e9 ns + sim time; ``run_info`` as
+    one /drill/run_info message (std_msgs/String, JSON) first."""
     with open(path, "wb") as stream:
         writer = Writer(stream)
         schema = writer.register_msgdef("std_msgs/msg/Float64MultiArray",
                                         FLOAT64_MULTI_ARRAY_DEF)
+        if run_info is not None:
+            string = writer.register_msgdef("std_msgs/msg/String", "string data\n")
+            writer.write_message(topics.RUN_INFO, string, {"data": json.dumps(run_info)},
+                                 log_time=1_000_000_000, publish_time=1_000_000_000)
         for i, row in enumerate(rows):
             stamp = 1_000_000_000 + round(row[0] * 1e9)
             writer.write_message(topics.TELEMETRY, schema, telemetry_message(row),

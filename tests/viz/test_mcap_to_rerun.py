@@ -11,7 +11,8 @@ import pytest
 from mcap.reader import make_reader
 
 from drill_sim_ros import topics
-from drill_sim_ros.model.presets import load_preset
+from drill_sim_ros.model.presets import DEFAULT_PRESET, load_preset
+from drill_sim_ros.viz.mcap_to_rerun import recorded_units
 from tests.viz import expected as ex
 from tests.viz.rrd_read import read_recording, view_origins
 from tests.viz.sim_telemetry import telemetry_rows, write_mcap
@@ -154,3 +155,25 @@ def test_preset_comes_from_the_file_metadata(tmp_path: Path) -> None:
     expected = ex.phase_portrait(rows, load_preset("fig5_8a"))
     np.testing.assert_allclose(read_recording(rrd)["/phase_portrait/trajectory"].points(),
                                expected, rtol=1e-6, atol=1e-6)
+
+
+def test_the_scales_come_from_the_recorded_run_info(tmp_path, capsys):
+    """A recording that says what it ran needs no --preset; one that does not falls back to
+    the default preset, with a warning naming it."""
+    preset = load_preset("fig5_8a")
+    sc = preset.scales
+    groups = {g: float(getattr(preset.params, g)) for g in ("n", "psi", "beta", "lam", "w0",
+                                                              "omega0")}
+    info = {"preset": "fig5_8a", "groups": groups, "t_star_s": sc.time_s,
+            "l_star_m": sc.length_m, "force_unit_n": sc.force_n, "torque_unit_nm": sc.torque_nm}
+    rows = telemetry_rows(preset, 1.0)
+    with_info, without = tmp_path / "with.mcap", tmp_path / "without.mcap"
+    write_mcap(with_info, rows, run_info=info)
+    write_mcap(without, rows)
+    units = recorded_units(with_info, None)
+    assert (units.scales, units.beta, units.n) == (sc, preset.params.beta, preset.params.n)
+    assert capsys.readouterr().err == ""
+    fallback = recorded_units(without, None)
+    assert fallback.preset == DEFAULT_PRESET
+    assert f"no {topics.RUN_INFO}" in capsys.readouterr().err
+    assert recorded_units(with_info, "field_8p5in_shale").preset == "field_8p5in_shale"

@@ -1,4 +1,4 @@
-"""The sim node's tick thread and the lock it shares with the executor (no rclpy).
+"""The sim node's tick thread and the lock it shares with the executor (no ROS).
 
 The executor used to run the tick as an rcl timer, and rebuilt its wait set on every wake-up
 (about 1 ms of CPU per 10 ms tick). A :class:`Ticker` instead calls its ``work`` function on
@@ -9,6 +9,7 @@ threads from touching the simulation at once without letting a busy ticker starv
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import os
 import select
@@ -16,8 +17,6 @@ import threading
 import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-
-import numpy as np
 
 _log = logging.getLogger(__name__)
 # Waits up to this long are a plain sleep, which costs less than select() (about 15 us of CPU
@@ -31,26 +30,16 @@ class HandoffLock:
     Callbacks take it with :meth:`urgent`, the ticker with :meth:`acquire_background`. A callback
     holds the gate while it waits, and the ticker passes the gate before each acquisition, so
     a callback waits for at most the batch in progress, however fast the ticker loops.
-    While a callback waits, ``requests[0]`` is 1, and ``on_request`` was called once:
-    compiled code that holds the lock without the GIL (:mod:`drill_sim_ros.ros.engine`) reads
-    the flag, and is woken by ``on_request``, to know when to hand over.
     """
 
-    def __init__(self, on_request: Callable[[], None] = lambda: None) -> None:
+    def __init__(self) -> None:
         self._lock = threading.Lock()
         self._gate = threading.Lock()
-        self.requests = np.zeros(1, dtype=np.int64)
-        self.on_request = on_request
 
     @contextmanager
     def urgent(self) -> Iterator[None]:
-        with self._gate:                 # one waiter at a time sets and clears the request
-            self.requests[0] = 1
-            self.on_request()
-            try:
-                self._lock.acquire()
-            finally:
-                self.requests[0] = 0
+        with self._gate:                 # one waiter at a time
+            self._lock.acquire()
         try:
             yield
         finally:
@@ -82,26 +71,23 @@ class Ticker:
                  on_error: Callable[[Exception], bool], name: str = "ticker") -> None:
         self._work = work
         self._on_error = on_error
-        # An eventfd, not a threading.Event, for the waits a wake() must cut short: Event.wait
+        # A self-pipe, not a threading.Event, for the waits a wake() must cut short: Event.wait
         # runs a Condition's Python code and allocates a lock on every call (measured: about
         # 1 point of CPU at 100 Hz on a cold cache). Short waits are a plain sleep.
-        self._wake_fd = os.eventfd(0, os.EFD_NONBLOCK | os.EFD_CLOEXEC)
+        self._wake_fd, self._wake_write_fd = os.pipe()
+        os.set_blocking(self._wake_fd, False)
+        os.set_blocking(self._wake_write_fd, False)
         self._stopping = False
         self._thread = threading.Thread(target=self._loop, name=name, daemon=True)
 
     def start(self) -> None:
         self._thread.start()
 
-    @property
-    def wake_fd(self) -> int:
-        """The eventfd that :meth:`wake` writes (-1 once stopped): code that waits for the
-        ticker's work on its own reads it too."""
-        return self._wake_fd
-
     def wake(self) -> None:
         """Call ``work`` now (the schedule or the state changed); nothing once stopped."""
         if self._wake_fd >= 0:
-            os.eventfd_write(self._wake_fd, 1)
+            with contextlib.suppress(OSError):   # full of wakes already, or closed by stop()
+                os.write(self._wake_write_fd, b"w")
 
     def stop(self, timeout_s: float = 5.0) -> None:
         """End the loop after the current call and wait for it (idempotent)."""
@@ -116,6 +102,7 @@ class Ticker:
                 return                   # the thread may still select() on the fd
         if not self._thread.is_alive():
             os.close(self._wake_fd)
+            os.close(self._wake_write_fd)
             self._wake_fd = -1
 
     def _loop(self) -> None:
@@ -133,4 +120,4 @@ class Ticker:
                 if delay > 0:
                     time.sleep(delay)           # a wake meanwhile waits for this tick
             elif select.select(wait, (), (), delay)[0]:
-                os.eventfd_read(fd)             # wakes are counted: read them all at once
+                os.read(fd, 4096)               # all the wakes so far at once

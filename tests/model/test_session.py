@@ -9,7 +9,7 @@ import pytest
 from drill_sim_ros.model import kernel as k
 from drill_sim_ros.model.analysis import severity
 from drill_sim_ros.model.presets import load_preset
-from drill_sim_ros.ros.session import WINDOW_BUCKETS, SessionConfig, SimSession
+from drill_sim_ros.model.session import WINDOW_BUCKETS, SessionConfig, SimSession
 
 BUCKET = 5                      # samples per part of the window
 

@@ -1,9 +1,10 @@
-"""The simulation as the node sees it: SI setpoints in, one kernel sample per period out.
+"""The simulation as a node sees it: SI setpoints in, a block of SI samples per run out.
 
-ROS-free. A :class:`SimSession` owns the :class:`Simulator`, refines its step so a whole
-number of steps fills one publish period, stamps samples with an integer-nanosecond
-simulated clock that never goes back (not even on reset), and keeps windowed statistics of
-the bit speed for the stick-slip severity.
+ROS-free. A :class:`SimSession` owns the :class:`Simulator` and is the only caller of it for
+sim_node. It refines the step so a whole number of steps fills one publish period, stamps
+samples with an integer-nanosecond simulated clock that never goes back (not even on reset),
+converts them to SI telemetry rows (:mod:`drill_sim_ros.model.telemetry`) and keeps windowed
+statistics of the bit speed for the stick-slip severity.
 """
 
 from __future__ import annotations
@@ -16,9 +17,10 @@ import numpy as np
 
 from drill_sim_ros.model import kernel as k
 from drill_sim_ros.model.analysis import Severity, severity_of
+from drill_sim_ros.model.params import GROUPS
 from drill_sim_ros.model.presets import Preset
 from drill_sim_ros.model.simulator import SimConfig, Simulator
-from drill_sim_ros.ros.conversions import NS_PER_S
+from drill_sim_ros.model.telemetry import NS_PER_S, field_scales, si_rows
 
 WINDOW_BUCKETS = 20
 
@@ -37,6 +39,21 @@ class SessionConfig:
     top_drive_accel_rpm_s: float = 0.0   # 0: no limit
     wob_rate_n_s: float = 0.0            # 0: no limit
     window_s: float = 20.0
+    submerged_weight_n: float = 0.0      # for the hook load
+
+
+@dataclass(frozen=True)
+class Block:
+    """Samples of one run: ``rows`` (count, N_FIELDS) SI in ``TELEMETRY_FIELDS`` order,
+    ``stamps_ns`` (count,) their simulated time, ``offsets`` the (depth, angle) rebasing
+    offsets already added to the rows' depth and angles."""
+
+    rows: np.ndarray
+    stamps_ns: np.ndarray
+    offsets: tuple[float, float]
+
+    def __len__(self) -> int:
+        return len(self.stamps_ns)
 
 
 def period_ns(publish_rate_hz: float) -> int:
@@ -75,8 +92,10 @@ class SimSession:
         period_tau = self.period_ns / NS_PER_S / self.scales.time_s
         self.steps = steps_per_period(period_tau, cfg.dtau_max)
         self.sim = build_simulator(cfg, period_tau, self.steps)
-        self.samples = np.empty((2, k.N_COLS))   # rows of the last run (grows as needed)
-        self.sim.advance_into(self.samples, 0, self.steps)  # load the compiled kernel now
+        self.submerged_weight_n = cfg.submerged_weight_n
+        self._factors = field_scales(self.scales)
+        self._samples = np.empty((2, k.N_COLS))   # kernel rows of a run (grows as needed)
+        self.sim.advance_into(self._samples, 0, self.steps)  # load the compiled kernel now
         self.next_index = 0          # sample counter: stamps = index * period_ns
         # The severity window: snapshots of the kernel's running sums at the end of each of
         # its WINDOW_BUCKETS parts, the extremes restarted after each (no per-sample work).
@@ -95,31 +114,24 @@ class SimSession:
         """Stamp of the next sample (the simulated clock)."""
         return self.next_index * self.period_ns
 
-    def run(self, periods: int) -> tuple[int, int]:
-        """Advance ``periods`` publish periods into :attr:`samples`: (stamp of the first
-        sample in ns, number of samples). Sample i is the state at the start of period i,
-        stamped ``first + i * period_ns``; add :attr:`Simulator.offsets` to its depth and
-        angles. Raises ``NumericalFault``.
+    def run(self, periods: int) -> Block:
+        """Advance ``periods`` publish periods: their block of samples. Sample i is the state
+        at the start of period i, stamped ``sim_time_ns + i * period_ns`` (before the run).
+        Raises ``NumericalFault``.
         """
-        self.reserve(periods)
-        first_ns = self.sim_time_ns
-        count = self.sim.advance_into(self.samples, periods * self.steps, self.steps)
-        self.advanced(count)
-        return first_ns, count
+        if periods + 1 > self._samples.shape[0]:
+            self._samples = np.empty((periods + 1, k.N_COLS))
+        first = self.next_index
+        count = self.sim.advance_into(self._samples, periods * self.steps, self.steps)
+        self._advanced(count)
+        stamps_ns = (first + np.arange(count, dtype=np.int64)) * self.period_ns
+        rows = si_rows(self._samples[:count], self.sim.offsets, self._factors,
+                       stamps_ns / NS_PER_S, self.submerged_weight_n)
+        return Block(rows, stamps_ns, self.sim.offsets)
 
-    def reserve(self, periods: int) -> None:
-        """Room in :attr:`samples` for a run of ``periods``."""
-        if periods + 1 > self.samples.shape[0]:
-            self.samples = np.empty((periods + 1, k.N_COLS))
-
-    def samples_to_snapshot(self) -> int:
-        """Samples a run may advance before the severity window's next snapshot is due
-        (a compiled run stops there; at least 1)."""
-        return max(1, self._bucket_end - self.next_index)
-
-    def advanced(self, count: int) -> None:
-        """Count ``count`` samples advanced (by :meth:`run` or a compiled run of the
-        simulator) and take the severity window's snapshot when it is due."""
+    def _advanced(self, count: int) -> None:
+        """Count ``count`` samples advanced and take the severity window's snapshot when it
+        is due."""
         self.next_index += count
         if self.next_index >= self._bucket_end:
             self._snapshots.append(self.sim.accumulators)
@@ -141,6 +153,20 @@ class SimSession:
         mean = float(now[k.A_OMEGA] - start[k.A_OMEGA]) / steps
         stuck = float(now[k.A_STUCK] - start[k.A_STUCK]) / steps
         return severity_of(lo, hi, mean, self.sim.targets[0]), stuck
+
+    def run_info(self) -> dict[str, object]:
+        """What this session runs, for a reader of its samples alone: the preset, the six
+        groups it started with (RGD07 eqs. 23-24), the scales t*, L*, force and torque units
+        (eqs. 19-20) and the sampling."""
+        p, sc = self.sim.params, self.scales
+        return {
+            "preset": self.cfg.preset.name,
+            "groups": {name: getattr(p, name) for name in GROUPS},
+            "t_star_s": sc.time_s, "l_star_m": sc.length_m,
+            "force_unit_n": sc.force_n, "torque_unit_nm": sc.torque_nm,
+            "publish_rate_hz": self.cfg.publish_rate_hz, "period_ns": self.period_ns,
+            "dtau": self.dtau, "steps_per_period": self.steps,
+        }
 
     def set_surface_rpm(self, rpm: float) -> None:
         self.sim.set_inputs(omega_s=self.scales.omega_from_rpm(rpm))

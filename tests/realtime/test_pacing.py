@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import random
 
-from drill_sim_ros.ros.pacing import Pacer, RateMeter, lateness_percentiles_ms
+from drill_sim_ros.realtime.pacing import Pacer, RateMeter, lateness_percentiles_ms
 
 MS = 1_000_000
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 import threading
 import time
 
-from drill_sim_ros.ros.ticker import HandoffLock, Ticker
+from drill_sim_ros.realtime.ticker import HandoffLock, Ticker
 
 
 def test_a_callback_gets_the_lock_from_a_ticker_that_never_sleeps():

@@ -1,0 +1,82 @@
+"""The telemetry record: field names and the one conversion of kernel samples to SI.
+
+ROS-free. A telemetry row holds one sample in :data:`TELEMETRY_FIELDS` order, SI units
+(speeds in rev/min). :func:`si_rows` is the only place where kernel columns (dimensionless,
+RGD07 eqs. 19-24) become SI; sim_node, the recorder and ``drill_sim run --trace`` use it.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from drill_sim_ros.model import kernel as k
+from drill_sim_ros.model.params import RPM_PER_RAD_S, Scales
+
+NS_PER_S = 1_000_000_000
+MODE_NAMES = k.MODE_NAMES
+
+# One flat, atomic record per sample.
+TELEMETRY_FIELDS = (
+    "sim_time_s",
+    "bit_angle_rad",
+    "bit_rpm",
+    "bit_depth_m",
+    "rop_m_s",
+    "wob_n",
+    "tob_nm",
+    "depth_of_cut_m",
+    "wearflat_wob_n",
+    "mode",
+    "surface_angle_rad",
+    "surface_rpm",
+    "surface_torque_nm",
+    "applied_wob_n",
+    "hook_load_n",
+)
+TELEMETRY_INDEX = {name: i for i, name in enumerate(TELEMETRY_FIELDS)}
+N_FIELDS = len(TELEMETRY_FIELDS)
+F = TELEMETRY_INDEX
+
+# Kernel column of each field but sim_time_s and hook_load_n (filled separately).
+SOURCE_COLUMNS = {
+    "bit_angle_rad": k.C_PHI, "bit_rpm": k.C_OMEGA, "bit_depth_m": k.C_U, "rop_m_s": k.C_V,
+    "wob_n": k.C_WOB, "tob_nm": k.C_TOB, "depth_of_cut_m": k.C_DOC, "wearflat_wob_n": k.C_WF,
+    "mode": k.C_MODE, "surface_angle_rad": k.C_PHI_S, "surface_rpm": k.C_OMEGA_S,
+    "surface_torque_nm": k.C_T_PIPE, "applied_wob_n": k.C_W_APP,
+}
+_SOURCE_FIELDS = np.array([F[name] for name in SOURCE_COLUMNS], dtype=np.int64)
+_SOURCE_KERNEL_COLUMNS = np.array(list(SOURCE_COLUMNS.values()), dtype=np.int64)
+_DEPTH = F["bit_depth_m"]
+_ANGLES = [F["bit_angle_rad"], F["surface_angle_rad"]]
+
+
+def field_scales(scales: Scales) -> np.ndarray:
+    """SI factor of each telemetry field (1 for sim time, mode and hook load), shape (F,)."""
+    rpm = RPM_PER_RAD_S / scales.time_s
+    factors = {"bit_rpm": rpm, "surface_rpm": rpm, "bit_depth_m": scales.length_m,
+               "rop_m_s": scales.length_m / scales.time_s, "depth_of_cut_m": scales.length_m,
+               "wob_n": scales.force_n, "wearflat_wob_n": scales.force_n,
+               "applied_wob_n": scales.force_n, "tob_nm": scales.torque_nm,
+               "surface_torque_nm": scales.torque_nm}
+    out = np.ones(N_FIELDS)
+    for name, factor in factors.items():
+        out[F[name]] = factor
+    return out
+
+
+def si_rows(samples: np.ndarray, offsets: tuple[float, float], factors: np.ndarray,
+            sim_times_s: np.ndarray, submerged_weight_n: float) -> np.ndarray:
+    """SI rows, shape (len(samples), N_FIELDS), of kernel samples (``kernel.C_*`` columns).
+
+    Each value is ``(column + rebasing offset) * factor``; ``offsets`` = (depth, angle) as
+    :attr:`Simulator.offsets` gives them; ``factors`` from :func:`field_scales`; the hook
+    load is ``submerged_weight_n`` less the applied WOB.
+    """
+    out = np.empty((samples.shape[0], N_FIELDS))
+    out[:, _SOURCE_FIELDS] = samples[:, _SOURCE_KERNEL_COLUMNS]
+    out[:, _DEPTH] += offsets[0]
+    out[:, _ANGLES] += offsets[1]
+    out *= factors
+    out[:, F["sim_time_s"]] = sim_times_s
+    out[:, F["hook_load_n"]] = submerged_weight_n - out[:, F["applied_wob_n"]]
+    return out

@@ -1,0 +1,52 @@
+"""Where every block of samples goes: the DDS publishers and the in-process recorder.
+
+One path for all of sim_node's ticks (real time, free run, lockstep, paused stepping): the
+block's SI rows are packed into CDR once (:class:`~drill_sim_ros.ros.frame.SampleFrame`),
+each payload is published through rclpy's public ``Publisher.publish(bytes)``, and the very
+same bytes are queued for the recorder, logged at the sample's stamp.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from rclpy.publisher import Publisher
+
+from drill_sim_ros.model.session import Block
+from drill_sim_ros.ros.frame import SampleFrame
+
+# In free run the ticker waits while the recorder has this many messages queued (about 2 s
+# of the writer thread's work), so a run as fast as possible loses nothing.
+RECORDER_HIGH_WATER = 100_000 // 2
+
+
+class SampleSinks:
+    """Publishers by topic, and an optional in-process recorder (``write_serialized``)."""
+
+    def __init__(self, publishers: dict[str, Publisher]) -> None:
+        self._publishers = publishers
+        self._frames = {with_clock: SampleFrame(with_clock) for with_clock in (False, True)}
+        self.recorder: Any = None
+
+    def emit(self, block: Block, with_clock: bool) -> None:
+        """Publish (and record) every sample of ``block``, /clock too if ``with_clock``."""
+        frame = self._frames[with_clock]
+        publishers = [self._publishers[topic] for topic in frame.topics]
+        recorder = self.recorder
+        packed = frame.pack(block.rows, block.stamps_ns)
+        for payloads, time_ns in zip(packed, block.stamps_ns.tolist(), strict=True):
+            for publisher, payload in zip(publishers, payloads, strict=True):
+                publisher.publish(payload)
+            if recorder is not None:
+                for topic, payload in zip(frame.topics, payloads, strict=True):
+                    recorder.write_serialized(topic, payload, time_ns)
+
+    def emit_one(self, topic: str, payload: bytes, time_ns: int) -> None:
+        """Publish (and record) one serialized message, e.g. /diagnostics."""
+        self._publishers[topic].publish(payload)
+        if self.recorder is not None:
+            self.recorder.write_serialized(topic, payload, time_ns)
+
+    def backlogged(self) -> bool:
+        """The recorder is behind by more than :data:`RECORDER_HIGH_WATER` messages."""
+        return self.recorder is not None and self.recorder.backlog > RECORDER_HIGH_WATER
