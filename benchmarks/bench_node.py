@@ -41,7 +41,7 @@ from drill_sim_ros.ros.messages import type_of
 
 BIN = Path(sys.prefix) / "bin"
 TICKS = os.sysconf("SC_CLK_TCK")
-PUBLISHED = [t for t in topics.MSG_TYPES if t not in (topics.CMD_WOB, topics.CMD_SURFACE_RPM)]
+PUBLISHED = [t for t in topics.MSG_TYPES if t not in topics.COMMANDS]
 
 
 def cpu_seconds(pid: int) -> float:

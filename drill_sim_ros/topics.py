@@ -29,6 +29,21 @@ RUN_INFO = "/drill/run_info"                  # std_msgs/String, JSON; latched (
 # ---- subscribed by sim_node ------------------------------------------------------------
 CMD_SURFACE_RPM = "/drill/cmd/surface_rpm"    # std_msgs/Float64, rev/min
 CMD_WOB = "/drill/cmd/wob"                    # std_msgs/Float64, N
+CMD_TOP_DRIVE = "/drill/cmd/top_drive"        # sensor_msgs/JointState (COMMAND_JOINTS)
+# top_drive: velocity = speed setpoint rad/s, effort = motor torque N m (torque mode);
+# hook: effort = applied WOB N. header.stamp: the stamp of the sample the command reacts to.
+COMMAND_JOINTS = ("top_drive", "hook")
+COMMANDS = (CMD_SURFACE_RPM, CMD_WOB, CMD_TOP_DRIVE)
+
+# sim_node names its topics relative to its namespace (`-r __ns:=/rig1` moves them all),
+# except these two, which ROS conventions keep absolute. The names above are those of the
+# root namespace, as a recording of a sim without a namespace holds them.
+ABSOLUTE = (CLOCK, DIAGNOSTICS)
+
+
+def node_relative(topic: str) -> str:
+    """The name sim_node gives ``topic``: relative to its namespace, or absolute."""
+    return topic if topic in ABSOLUTE else topic.lstrip("/")
 
 MSG_TYPES: dict[str, str] = {
     BIT_WOB: "std_msgs/msg/Float64",
@@ -45,6 +60,7 @@ MSG_TYPES: dict[str, str] = {
     RUN_INFO: "std_msgs/msg/String",
     CMD_SURFACE_RPM: "std_msgs/msg/Float64",
     CMD_WOB: "std_msgs/msg/Float64",
+    CMD_TOP_DRIVE: "sensor_msgs/msg/JointState",
 }
 
 # JointState joints: position / velocity / effort

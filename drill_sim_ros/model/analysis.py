@@ -13,6 +13,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from drill_sim_ros.model import kernel as k
 from drill_sim_ros.model.params import DimensionlessParams
@@ -184,9 +185,18 @@ def severity(omega: np.ndarray, omega0: float) -> Severity:
     return severity_of(float(omega.min()), float(omega.max()), float(omega.mean()), omega0)
 
 
+def stick_slip_index(lo: ArrayLike, hi: ArrayLike, mean: ArrayLike) -> np.ndarray:
+    """SSI = (max - min) / (2 mean) of the bit speed, elementwise; nan where mean <= 0
+    (a bit that never turns has no severity)."""
+    lo, hi, mean = np.asarray(lo, float), np.asarray(hi, float), np.asarray(mean, float)
+    out = np.full(np.broadcast(lo, hi, mean).shape, np.nan)
+    np.divide(hi - lo, 2.0 * mean, out=out, where=mean > 0.0)
+    return out
+
+
 def severity_of(lo: float, hi: float, mean: float, omega0: float) -> Severity:
     """:func:`severity` from the min, max and mean of the bit speed."""
-    ssi = (hi - lo) / (2.0 * mean) if mean > 0 else math.inf
+    ssi = float(stick_slip_index(lo, hi, mean))
     utr = (omega0 - lo) / omega0 if omega0 > 0 else math.nan
     return Severity(ssi, utr, lo, hi, mean)
 

@@ -93,6 +93,7 @@ class SimSession:
         self.steps = steps_per_period(period_tau, cfg.dtau_max)
         self.sim = build_simulator(cfg, period_tau, self.steps)
         self.submerged_weight_n = cfg.submerged_weight_n
+        self.command_stamp_ns: int | None = None    # stamp of the command in force, if any
         self._factors = field_scales(self.scales)
         self._samples = np.empty((2, k.N_COLS))   # kernel rows of a run (grows as needed)
         self.sim.advance_into(self._samples, 0, self.steps)  # load the compiled kernel now
@@ -111,22 +112,38 @@ class SimSession:
 
     @property
     def sim_time_ns(self) -> int:
-        """Stamp of the next sample (the simulated clock)."""
+        """Simulated time of the current state (the stamp of its sample)."""
         return self.next_index * self.period_ns
 
+    def current(self) -> Block:
+        """The sample of the current state, stamped :attr:`sim_time_ns` (at start: t = 0, the
+        sample a controller reacts to before the first period)."""
+        self.sim.sample_into(self._samples[0])
+        return self._block(self._samples[:1], self.next_index)
+
     def run(self, periods: int) -> Block:
-        """Advance ``periods`` publish periods: their block of samples. Sample i is the state
-        at the start of period i, stamped ``sim_time_ns + i * period_ns`` (before the run).
-        Raises ``NumericalFault``.
+        """Advance ``periods`` publish periods under the inputs set now (zero-order hold):
+        their block, sample i being the state at the END of period i, stamped
+        ``sim_time_ns + (i + 1) * period_ns`` (before the run). Raises ``NumericalFault``.
         """
+        if periods <= 0:
+            return self._block(self._samples[:0], self.next_index + 1)
         if periods + 1 > self._samples.shape[0]:
             self._samples = np.empty((periods + 1, k.N_COLS))
         first = self.next_index
+        # rows 0..periods-1: the state at the start of each period; row `periods`: the end
         count = self.sim.advance_into(self._samples, periods * self.steps, self.steps)
+        self.sim.sample_into(self._samples[count])
         self._advanced(count)
-        stamps_ns = (first + np.arange(count, dtype=np.int64)) * self.period_ns
-        rows = si_rows(self._samples[:count], self.sim.offsets, self._factors,
-                       stamps_ns / NS_PER_S, self.submerged_weight_n)
+        return self._block(self._samples[1:count + 1], first + 1)
+
+    def _block(self, samples: np.ndarray, first_index: int) -> Block:
+        """SI block of kernel rows, the first stamped ``first_index * period_ns``."""
+        stamps_ns = (first_index + np.arange(samples.shape[0], dtype=np.int64)) * self.period_ns
+        command_s = math.nan if self.command_stamp_ns is None else \
+            self.command_stamp_ns / NS_PER_S
+        rows = si_rows(samples, self.sim.offsets, self._factors, stamps_ns / NS_PER_S,
+                       self.submerged_weight_n, command_s)
         return Block(rows, stamps_ns, self.sim.offsets)
 
     def _advanced(self, count: int) -> None:

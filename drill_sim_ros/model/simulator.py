@@ -240,6 +240,15 @@ class Simulator:
         self._close_run(n_steps, status)
         return written
 
+    def sample_into(self, out: np.ndarray) -> None:
+        """The sample of the current state into ``out`` (one row of ``kernel.C_*`` columns,
+        depth and angles less :attr:`offsets`): what the next step records at its start,
+        read from one step of copies of the state, so the simulator itself does not move."""
+        if self.fault is not None:
+            raise NumericalFault(f"simulator faulted ({self.fault}); call reset()")
+        copies = [array.copy() for array in self._kernel_arrays()]
+        k.advance(*copies, out.reshape(1, k.N_COLS), 1, 1, self.exact)
+
     def _kernel_arrays(self) -> tuple[np.ndarray, ...]:
         """The arguments of ``kernel.advance`` before ``out``: state, parameters, targets,
         profile, history, history meta, accumulators."""

@@ -7,6 +7,8 @@ RGD07 eqs. 19-24) become SI; sim_node, the recorder and ``drill_sim run --trace`
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from drill_sim_ros.model import kernel as k
@@ -32,6 +34,7 @@ TELEMETRY_FIELDS = (
     "surface_torque_nm",
     "applied_wob_n",
     "hook_load_n",
+    "command_stamp_s",      # stamp of the drill/cmd/top_drive command in force (nan: none)
 )
 TELEMETRY_INDEX = {name: i for i, name in enumerate(TELEMETRY_FIELDS)}
 N_FIELDS = len(TELEMETRY_FIELDS)
@@ -65,12 +68,14 @@ def field_scales(scales: Scales) -> np.ndarray:
 
 
 def si_rows(samples: np.ndarray, offsets: tuple[float, float], factors: np.ndarray,
-            sim_times_s: np.ndarray, submerged_weight_n: float) -> np.ndarray:
+            sim_times_s: np.ndarray, submerged_weight_n: float,
+            command_stamp_s: float = math.nan) -> np.ndarray:
     """SI rows, shape (len(samples), N_FIELDS), of kernel samples (``kernel.C_*`` columns).
 
     Each value is ``(column + rebasing offset) * factor``; ``offsets`` = (depth, angle) as
     :attr:`Simulator.offsets` gives them; ``factors`` from :func:`field_scales`; the hook
-    load is ``submerged_weight_n`` less the applied WOB.
+    load is ``submerged_weight_n`` less the applied WOB; ``command_stamp_s`` is the stamp of
+    the command in force over these samples.
     """
     out = np.empty((samples.shape[0], N_FIELDS))
     out[:, _SOURCE_FIELDS] = samples[:, _SOURCE_KERNEL_COLUMNS]
@@ -79,4 +84,5 @@ def si_rows(samples: np.ndarray, offsets: tuple[float, float], factors: np.ndarr
     out *= factors
     out[:, F["sim_time_s"]] = sim_times_s
     out[:, F["hook_load_n"]] = submerged_weight_n - out[:, F["applied_wob_n"]]
+    out[:, F["command_stamp_s"]] = command_stamp_s
     return out

@@ -33,6 +33,7 @@ class Figures:
     overruns: int
     lateness_ns: np.ndarray
     rejected: int
+    saturated: int
     dropped: int
     written: int
     severity: Severity
@@ -59,6 +60,7 @@ def node_status(f: Figures) -> DiagnosticStatus:
         "tick_lateness_p50_ms": f"{p50:.4g}",
         "tick_lateness_p99_ms": f"{p99:.4g}",
         "rejected_commands": str(f.rejected),
+        "saturated_commands": str(f.saturated),
         "recorder_dropped": str(f.dropped),
         "recorder_written": str(f.written),
         "fault": f.fault or "",

@@ -29,6 +29,11 @@ def stamp(time_ns: int) -> Time:
     return Time(sec=sec, nanosec=nanosec)
 
 
+def stamp_ns(time: Time) -> int:
+    """The integer nanoseconds of a builtin_interfaces/Time."""
+    return time.sec * NS_PER_S + time.nanosec
+
+
 def status(name: str, level: bytes, message: str, values: dict[str, str]) -> DiagnosticStatus:
     """A DiagnosticStatus with ``values`` as key/value pairs."""
     return DiagnosticStatus(level=level, name=name, message=message, hardware_id=HARDWARE_ID,

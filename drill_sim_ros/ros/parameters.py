@@ -35,6 +35,7 @@ class ParamSpec:
     low: float | None = None
     high: float | None = None
     read_only: bool = False
+    choices: tuple[str, ...] = ()     # the allowed values of a string (empty: any)
 
     def default_for(self, preset: Preset | None) -> Any:
         return self.default(preset) if callable(self.default) else self.default
@@ -112,6 +113,10 @@ SPECS: tuple[ParamSpec, ...] = (
               "Simulated seconds per wall second; 0 = as fast as possible.", 0.0, 1000.0),
     ParamSpec("lockstep", BOOL, False,
               "Advance only on ~/step (one publish period per call); deterministic."),
+    ParamSpec("lockstep_trigger", STRING, "service",
+              "What advances one period in lockstep: 'service' (a ~/step call) or 'command' "
+              "(each message on drill/cmd/top_drive, applied first).",
+              choices=("service", "command")),
     ParamSpec("run_seconds", DOUBLE, 0.0,
               "Exit cleanly after this many wall seconds; 0 = run until stopped.", 0.0, 1e9,
               read_only=True),
@@ -137,6 +142,8 @@ def descriptor(spec: ParamSpec) -> ParameterDescriptor:
     elif spec.kind == INTEGER:
         desc.integer_range = [IntegerRange(
             from_value=int(spec.low), to_value=int(spec.high), step=1)]
+    if spec.choices:
+        desc.additional_constraints = "one of: " + ", ".join(spec.choices)
     return desc
 
 
@@ -156,6 +163,8 @@ def validate(spec: ParamSpec, value: Any) -> str | None:
         return f"{spec.name} must be true or false, got {value!r}"
     elif spec.kind == STRING and not isinstance(value, str):
         return f"{spec.name} must be a string, got {value!r}"
+    elif spec.choices and value not in spec.choices:
+        return f"{spec.name} = {value!r} is not one of {', '.join(spec.choices)}"
     return None
 
 

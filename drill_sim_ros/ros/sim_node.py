@@ -20,7 +20,6 @@ import math
 import signal
 import sys
 import time
-from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -34,22 +33,24 @@ from rclpy.impl.implementation_singleton import rclpy_implementation
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
-from rclpy.serialization import serialize_message
+from rclpy.serialization import deserialize_message, serialize_message
 from rclpy.task import Future
+from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64, String
 from std_srvs.srv import SetBool, Trigger
 
 from drill_sim_ros import topics
 from drill_sim_ros.model.errors import DrillSimError, NumericalFault
+from drill_sim_ros.model.params import RPM_PER_RAD_S
 from drill_sim_ros.model.presets import load_preset
-from drill_sim_ros.model.session import SessionConfig, SimSession
+from drill_sim_ros.model.session import Block, SessionConfig, SimSession
 from drill_sim_ros.model.telemetry import MODE_NAMES, TELEMETRY_INDEX
 from drill_sim_ros.realtime.pacing import Pacer, RateMeter
 from drill_sim_ros.realtime.ticker import HandoffLock, Ticker
 from drill_sim_ros.ros import messages
 from drill_sim_ros.ros.diagnostics import Figures, diagnostics
 from drill_sim_ros.ros.frame import SAMPLE_TOPICS
-from drill_sim_ros.ros.messages import RUN_INFO_QOS
+from drill_sim_ros.ros.messages import RUN_INFO_QOS, stamp_ns
 from drill_sim_ros.ros.parameters import SPEC_BY_NAME, coerce, declare_all, validate
 from drill_sim_ros.ros.sinks import SampleSinks
 from drill_sim_ros.terminal import StatusLine, format_status
@@ -59,7 +60,8 @@ DATA_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=100,
                       reliability=ReliabilityPolicy.RELIABLE)
 CLOCK_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=10,
                        reliability=ReliabilityPolicy.RELIABLE)
-COMMAND_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=10,
+# Deep enough that a controller driving command-triggered lockstep never loses a command.
+COMMAND_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1000,
                          reliability=ReliabilityPolicy.RELIABLE)
 # Reliable volatile publishers match every subscriber but transient-local ones; without the
 # default QoS-event handlers the executor's wait set is 2 entities per publisher smaller.
@@ -85,15 +87,28 @@ def session_config(values: dict[str, Any], preset: Any) -> SessionConfig:
         submerged_weight_n=values["model.submerged_string_weight_n"])
 
 
-def command_problem(value: float, limit: float, unit: str) -> str | None:
-    """Why a setpoint command is unacceptable (None if it is fine)."""
+def clamp_command(value: float, limit: float, unit: str) -> tuple[float | None, str | None]:
+    """A setpoint command within [0, ``limit``]: (the value to apply, None) when it is inside,
+    (the bound it saturates at, why) when it is finite and beyond, (None, why) when it is not
+    finite (rejected)."""
     if not math.isfinite(value):
-        return f"{value!r} is not finite"
+        return None, f"{value!r} is not finite"
     if value < 0.0:
-        return f"{value:g} {unit} is negative"
+        return 0.0, f"{value:.10g} {unit} is below 0 {unit}"
     if value > limit:
-        return f"{value:g} {unit} exceeds the limit {limit:g} {unit}"
-    return None
+        return limit, f"{value:.10g} {unit} exceeds the limit {limit:.10g} {unit}"
+    return value, None
+
+
+def joint_commands(msg: JointState) -> dict[tuple[str, str], float]:
+    """``{(joint, 'velocity' | 'effort'): value}`` of a drill/cmd/top_drive message; NaN and
+    missing entries are no command."""
+    out: dict[tuple[str, str], float] = {}
+    for i, joint in enumerate(msg.name):
+        for interface, values in (("velocity", msg.velocity), ("effort", msg.effort)):
+            if i < len(values) and not math.isnan(values[i]):
+                out[(joint, interface)] = float(values[i])
+    return out
 
 
 class SimNode(Node):
@@ -114,16 +129,20 @@ class SimNode(Node):
         self._closing = False
         self._fault: str | None = None
         self.rejected_commands = 0
+        self.saturated_commands = 0
         self._last_row: np.ndarray | None = None     # SI, TELEMETRY_FIELDS; lock held
-        self._pubs = {t: self.create_publisher(messages.type_of(t), t, self._qos(t),
-                                               event_callbacks=QUIET_PUBLISHER)
-                      for t in (*SAMPLE_TOPICS, topics.CLOCK, topics.DIAGNOSTICS)}
-        self._pubs[topics.RUN_INFO] = self.create_publisher(
-            messages.type_of(topics.RUN_INFO), topics.RUN_INFO, RUN_INFO_QOS)
+        self._pubs = {t: self.create_publisher(messages.type_of(t), topics.node_relative(t),
+                                               self._qos(t), event_callbacks=QUIET_PUBLISHER)
+                      for t in (*SAMPLE_TOPICS, topics.CLOCK, topics.DIAGNOSTICS,
+                                topics.RUN_INFO)}
         self._sinks = SampleSinks(self._pubs)
-        self.create_subscription(Float64, topics.CMD_SURFACE_RPM, self._on_surface_rpm,
-                                 COMMAND_QOS)
-        self.create_subscription(Float64, topics.CMD_WOB, self._on_wob, COMMAND_QOS)
+        self._command_names: dict[str, str] = {}      # command topic -> its resolved name
+        for topic, callback in ((topics.CMD_SURFACE_RPM, self._on_surface_rpm),
+                                (topics.CMD_WOB, self._on_wob),
+                                (topics.CMD_TOP_DRIVE, self._on_top_drive)):
+            sub = self.create_subscription(messages.type_of(topic), topics.node_relative(topic),
+                                           callback, COMMAND_QOS, raw=True)
+            self._command_names[topic] = sub.topic_name
         self.create_service(Trigger, "~/reset", self._on_reset)
         self.create_service(SetBool, "~/pause", self._on_pause)
         self.create_service(Trigger, "~/step", self._on_step)
@@ -146,9 +165,9 @@ class SimNode(Node):
             session = SimSession(session_config(self._values, self._preset))
             self._session = session
             self._pacer = Pacer(self._wall_period_ns(self._rtf))
-            self._sinks.emit(session.run(0), False)      # load the packing code now
             self._sinks.recorder = self._open_recorder(self._values["record.path"])
             self._publish_run_info()
+            self._emit(session.current())      # t = 0: what a controller first reacts to
         self._first_spin.reset()
         if self._values["run_seconds"] > 0:
             self._stop_timer.reset()
@@ -169,8 +188,11 @@ class SimNode(Node):
             Path(path).parent.mkdir(parents=True, exist_ok=True)
             recorder = InProcessRecorder(path, node_name=topics.NODE_NAME,
                                          metadata=self._run_metadata())
-            for topic in self._pubs:
-                recorder.add_topic(topic, topics.MSG_TYPES[topic], self._qos(topic))
+            for topic, publisher in self._pubs.items():
+                recorder.add_topic(publisher.topic_name, topics.MSG_TYPES[topic],
+                                   self._qos(topic))
+            for topic, name in self._command_names.items():
+                recorder.add_topic(name, topics.MSG_TYPES[topic], COMMAND_QOS)
         except Exception as exc:  # recording is optional: keep simulating
             self.get_logger().error(f"recording to {path!r} is off: {exc}")
             return None
@@ -276,10 +298,14 @@ class SimNode(Node):
         except NumericalFault as exc:
             self._on_fault(exc)
             return False
+        self._emit(block)
+        return True
+
+    def _emit(self, block: Block) -> None:
+        """Hand ``block`` to the sinks (call with the lock held)."""
         self._sinks.emit(block, self._values["publish_clock"])
         if len(block):
             self._last_row = block.rows[-1]
-        return True
 
     def _on_tick_error(self, exc: Exception) -> bool:
         """An unexpected error on the ticker: quiet at shutdown, else a fault until reset."""
@@ -295,29 +321,79 @@ class SimNode(Node):
         self.get_logger().error(f"numerical fault: {exc}; call ~/reset to recover")
 
     # ---- commands ----------------------------------------------------------------------
-    def _on_surface_rpm(self, msg: Float64) -> None:
-        self._command(topics.CMD_SURFACE_RPM, msg.data, "limits.max_surface_rpm", "rev/min",
-                      lambda value: self._session.set_surface_rpm(value))
-
-    def _on_wob(self, msg: Float64) -> None:
-        self._command(topics.CMD_WOB, msg.data, "limits.max_wob_n", "N",
-                      lambda value: self._session.set_wob_n(value))
-
-    def _command(self, topic: str, value: float, limit: str, unit: str,
-                 apply: Callable[[float], None]) -> None:
-        """Apply a setpoint at the next step, or reject it (counted) and keep the last one."""
-        problem = command_problem(value, self._values[limit], unit)
-        if problem is not None:
-            self._reject(topic, problem)
-            return
+    def _on_surface_rpm(self, raw: bytes) -> None:
+        value = deserialize_message(raw, Float64).data
         with self._lock.urgent():
-            apply(value)
+            self._set_surface_rpm(topics.CMD_SURFACE_RPM, value)
+            self._record_command(topics.CMD_SURFACE_RPM, raw)
+
+    def _on_wob(self, raw: bytes) -> None:
+        value = deserialize_message(raw, Float64).data
+        with self._lock.urgent():
+            self._set_wob_n(topics.CMD_WOB, value)
+            self._record_command(topics.CMD_WOB, raw)
+
+    def _on_top_drive(self, raw: bytes) -> None:
+        """drill/cmd/top_drive: apply what it commands and, in command-triggered lockstep,
+        advance exactly one period under it."""
+        msg = deserialize_message(raw, JointState)
+        topic = topics.CMD_TOP_DRIVE
+        with self._lock.urgent():
+            for (joint, interface), value in joint_commands(msg).items():
+                if (joint, interface) == ("top_drive", "velocity"):
+                    self._set_surface_rpm(topic, value * RPM_PER_RAD_S)
+                elif (joint, interface) == ("hook", "effort"):
+                    self._set_wob_n(topic, value)
+                else:
+                    self._reject(topic, f"joint {joint!r} takes no {interface} command "
+                                        "(top_drive: velocity; hook: effort)")
+            self._session.command_stamp_ns = stamp_ns(msg.header.stamp)
+            self._record_command(topic, raw)
+            if self._command_steps():
+                self._advance(1)
+
+    def _command_steps(self) -> bool:
+        """Each drill/cmd/top_drive message advances one period (lock held)."""
+        return (self._lockstep and self._values["lockstep_trigger"] == "command"
+                and self._fault is None and not self._closing)
+
+    def _set_surface_rpm(self, topic: str, rpm: float) -> None:
+        value = self._clamped(topic, rpm, "limits.max_surface_rpm", "rev/min")
+        if value is not None:
+            self._session.set_surface_rpm(value)
+
+    def _set_wob_n(self, topic: str, wob_n: float) -> None:
+        value = self._clamped(topic, wob_n, "limits.max_wob_n", "N")
+        if value is not None:
+            self._session.set_wob_n(value)
+
+    def _clamped(self, topic: str, value: float, limit: str, unit: str) -> float | None:
+        """The setpoint to apply at the next step, clamped to its limits (counted as
+        saturated), or None for a non-finite one (rejected; the last setpoint stays)."""
+        applied, problem = clamp_command(value, self._values[limit], unit)
+        if problem is None:
+            return applied
+        if applied is None:
+            self._reject(topic, problem)
+        else:
+            self.saturated_commands += 1
+            self.get_logger().warning(
+                f"saturated {topic}: {problem}; applying {applied:.10g} {unit} "
+                f"({self.saturated_commands} saturated so far)",
+                throttle_duration_sec=WARN_THROTTLE_S)
+        return applied
 
     def _reject(self, topic: str, problem: str) -> None:
         self.rejected_commands += 1
         self.get_logger().warning(
             f"rejected {topic}: {problem}; the last valid setpoint stays "
             f"({self.rejected_commands} rejected so far)", throttle_duration_sec=WARN_THROTTLE_S)
+
+    def _record_command(self, topic: str, raw: bytes) -> None:
+        """The command as received, logged at the sim time it takes effect (lock held)."""
+        if self._sinks.recorder is not None:
+            self._sinks.recorder.write_serialized(self._command_names[topic], raw,
+                                                  self._session.sim_time_ns)
 
     # ---- services ----------------------------------------------------------------------
     def _on_reset(self, _request: Trigger.Request, response: Trigger.Response
@@ -348,12 +424,15 @@ class SimNode(Node):
                  ) -> Trigger.Response:
         if not (self._lockstep or self._paused):
             response.message = "~/step needs lockstep:=true or a paused simulation"
+        elif self._lockstep and self._values["lockstep_trigger"] == "command":
+            response.message = "lockstep_trigger is 'command': each drill/cmd/top_drive " \
+                               "message advances one period"
         elif self._fault is not None:
             response.message = f"numerical fault ({self._fault}); call ~/reset"
         else:
             with self._lock.urgent():
-                time_ns = self._session.sim_time_ns
                 response.success = self._advance(1)
+                time_ns = self._session.sim_time_ns
             response.message = f"published t = {time_ns * 1e-9:.6f} s"
         return response
 
@@ -364,7 +443,7 @@ class SimNode(Node):
         if self._session is None:
             return
         with self._lock.urgent():
-            time_ns = max(0, self._session.sim_time_ns - self._session.period_ns)
+            time_ns = self._session.sim_time_ns
             figures = self._figures(time_ns)
         payload = serialize_message(diagnostics(figures, time_ns))
         self._sinks.emit_one(topics.DIAGNOSTICS, payload, time_ns)
@@ -378,7 +457,8 @@ class SimNode(Node):
             sim_time_s=self._session.sim_time_ns * 1e-9, rtf=self._rtf,
             achieved=self._rate.update(time.monotonic_ns(), time_ns * 1e-9),
             overruns=self._pacer.overruns, lateness_ns=self._pacer.lateness_ns(),
-            rejected=self.rejected_commands, dropped=self._recorder_count("dropped"),
+            rejected=self.rejected_commands, saturated=self.saturated_commands,
+            dropped=self._recorder_count("dropped"),
             written=self._recorder_count("written"), severity=sev,
             stick_fraction=stick_fraction,
             mode="none" if row is None else MODE_NAMES[int(row[TELEMETRY_INDEX["mode"]])],

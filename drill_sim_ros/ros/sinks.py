@@ -21,7 +21,8 @@ RECORDER_HIGH_WATER = 100_000 // 2
 
 
 class SampleSinks:
-    """Publishers by topic, and an optional in-process recorder (``write_serialized``)."""
+    """Publishers by topic (``topics`` names), and an optional in-process recorder
+    (``write_serialized``), which logs each message under its publisher's resolved name."""
 
     def __init__(self, publishers: dict[str, Publisher]) -> None:
         self._publishers = publishers
@@ -38,14 +39,15 @@ class SampleSinks:
             for publisher, payload in zip(publishers, payloads, strict=True):
                 publisher.publish(payload)
             if recorder is not None:
-                for topic, payload in zip(frame.topics, payloads, strict=True):
-                    recorder.write_serialized(topic, payload, time_ns)
+                for publisher, payload in zip(publishers, payloads, strict=True):
+                    recorder.write_serialized(publisher.topic_name, payload, time_ns)
 
     def emit_one(self, topic: str, payload: bytes, time_ns: int) -> None:
         """Publish (and record) one serialized message, e.g. /diagnostics."""
-        self._publishers[topic].publish(payload)
+        publisher = self._publishers[topic]
+        publisher.publish(payload)
         if self.recorder is not None:
-            self.recorder.write_serialized(topic, payload, time_ns)
+            self.recorder.write_serialized(publisher.topic_name, payload, time_ns)
 
     def backlogged(self) -> bool:
         """The recorder is behind by more than :data:`RECORDER_HIGH_WATER` messages."""

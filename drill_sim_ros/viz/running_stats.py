@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from drill_sim_ros.model.analysis import stick_slip_index
 from drill_sim_ros.topics import MODE_NAMES
 from drill_sim_ros.viz.paper_units import PaperUnits
 from drill_sim_ros.viz.telemetry import TelemetryBatch
@@ -60,8 +61,7 @@ def running_stats(window: SlidingWindow, batch: TelemetryBatch,
                   units: PaperUnits) -> RunningStats:
     """Extend ``window`` with ``batch`` (sim time non-decreasing) and compute the stats."""
     w = window.extend(batch.sim_time_s, _channels(batch))
-    rpm_mean = w.mean(_RPM)
-    ssi = _ratio(w.maximum(_RPM) - w.minimum(_RPM), 2.0 * rpm_mean)
+    ssi = stick_slip_index(w.minimum(_RPM), w.maximum(_RPM), w.mean(_RPM))
     doc = units.depth_of_cut(w.mean(_DOC))
     return RunningStats(
         ssi=ssi,

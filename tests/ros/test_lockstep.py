@@ -54,11 +54,14 @@ def test_same_commands_give_identical_bytes_run_after_run():
     first, second = lockstep_run(), lockstep_run()
     for topic in RECORDED:
         assert first[topic] == second[topic], topic
-    # A command sent before step k acts from the first integration step of period k on:
-    # sample k (the state at the start of period k) still has the old value, k + 1 the new.
+    # A command sent before step k acts over the whole of period k (zero-order hold), and
+    # step k publishes the state at the end of period k, stamped (k + 1) periods: sample k - 1
+    # (the start of period k) still has the old value, sample k the new one.
     rows = [deserialize_message(raw, Float64MultiArray).data for raw in first[topics.TELEMETRY]]
+    assert [row[F["sim_time_s"]] for row in rows] == pytest.approx(
+        [0.01 * (k + 1) for k in range(STEPS)], abs=1e-12)
     applied = [row[F["applied_wob_n"]] for row in rows]
     surface = [row[F["surface_rpm"]] for row in rows]
-    assert applied[10] == applied[0] and applied[11] == pytest.approx(45e3)
-    assert surface[25] == surface[0] and surface[26] == pytest.approx(90.0)
-    assert applied[40] == pytest.approx(45e3) and applied[41] == pytest.approx(70e3)
+    assert applied[9] == applied[0] and applied[10] == pytest.approx(45e3)
+    assert surface[24] == surface[0] and surface[25] == pytest.approx(90.0)
+    assert applied[39] == pytest.approx(45e3) and applied[40] == pytest.approx(70e3)
