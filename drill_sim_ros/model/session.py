@@ -20,7 +20,7 @@ from drill_sim_ros.model.analysis import Severity, severity_of
 from drill_sim_ros.model.params import GROUPS
 from drill_sim_ros.model.presets import Preset
 from drill_sim_ros.model.simulator import SimConfig, Simulator
-from drill_sim_ros.model.telemetry import NS_PER_S, field_scales, si_rows
+from drill_sim_ros.model.telemetry import NO_COMMAND_S, NS_PER_S, field_scales, si_rows
 
 WINDOW_BUCKETS = 20
 
@@ -140,7 +140,7 @@ class SimSession:
     def _block(self, samples: np.ndarray, first_index: int) -> Block:
         """SI block of kernel rows, the first stamped ``first_index * period_ns``."""
         stamps_ns = (first_index + np.arange(samples.shape[0], dtype=np.int64)) * self.period_ns
-        command_s = math.nan if self.command_stamp_ns is None else \
+        command_s = NO_COMMAND_S if self.command_stamp_ns is None else \
             self.command_stamp_ns / NS_PER_S
         rows = si_rows(samples, self.sim.offsets, self._factors, stamps_ns / NS_PER_S,
                        self.submerged_weight_n, command_s)

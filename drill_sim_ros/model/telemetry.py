@@ -7,14 +7,13 @@ RGD07 eqs. 19-24) become SI; sim_node, the recorder and ``drill_sim run --trace`
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from drill_sim_ros.model import kernel as k
 from drill_sim_ros.model.params import RPM_PER_RAD_S, Scales
 
 NS_PER_S = 1_000_000_000
+NO_COMMAND_S = -1.0     # command_stamp_s before the first stamped command (keeps rows finite)
 MODE_NAMES = k.MODE_NAMES
 
 # One flat, atomic record per sample.
@@ -34,7 +33,7 @@ TELEMETRY_FIELDS = (
     "surface_torque_nm",
     "applied_wob_n",
     "hook_load_n",
-    "command_stamp_s",      # stamp of the drill/cmd/top_drive command in force (nan: none)
+    "command_stamp_s",      # stamp of the drill/cmd/top_drive command in force (-1: none)
 )
 TELEMETRY_INDEX = {name: i for i, name in enumerate(TELEMETRY_FIELDS)}
 N_FIELDS = len(TELEMETRY_FIELDS)
@@ -69,7 +68,7 @@ def field_scales(scales: Scales) -> np.ndarray:
 
 def si_rows(samples: np.ndarray, offsets: tuple[float, float], factors: np.ndarray,
             sim_times_s: np.ndarray, submerged_weight_n: float,
-            command_stamp_s: float = math.nan) -> np.ndarray:
+            command_stamp_s: float = NO_COMMAND_S) -> np.ndarray:
     """SI rows, shape (len(samples), N_FIELDS), of kernel samples (``kernel.C_*`` columns).
 
     Each value is ``(column + rebasing offset) * factor``; ``offsets`` = (depth, angle) as
