@@ -194,7 +194,10 @@ def summarize(spec: RunSpec, sim: Simulator, kernel_seconds: float) -> dict[str,
         "tau_end": spec.tau_end, "dtau": spec.dtau, "average_from": spec.average_from,
         "method": spec.method, "nodes": spec.n_nodes,
         "first_stick_tau": stick, "bounce_tau": bounce,
-        "stick_fraction": avg.stick_fraction, "kappa": avg.kappa, "eta": avg.eta,
+        "stick_fraction": avg.stick_fraction, "kappa": avg.kappa,
+        "kappa_from_depth": analysis.kappa_from_depth(avg.mean_depth_of_cut,
+                                                      triv.depth_of_cut, p.lam),
+        "eta": avg.eta,
         "mean_torque": avg.mean_torque, "mean_depth_of_cut": avg.mean_depth_of_cut,
         "mean_wob": avg.mean_wob, "mean_omega": avg.mean_omega,
         "mean_pipe_torque": avg.mean_pipe_torque, "mean_rop": avg.mean_rop,
@@ -276,7 +279,8 @@ def format_summary(d: dict[str, Any]) -> str:
         f"  events      first stick tau={f(d['first_stick_tau'])}  "
         f"first bounce tau={f(d['bounce_tau'])}",
         f"  averages    over tau in [{d['average_from']:g}, {d['tau_end']:g}]",
-        f"    kappa={f(d['kappa'])}  eta={f(d['eta'])}  stick fraction={f(d['stick_fraction'])}",
+        f"    kappa={f(d['kappa'])} (from <delta>, eq. 45a: {f(d['kappa_from_depth'])})  "
+        f"eta={f(d['eta'])}  stick fraction={f(d['stick_fraction'])}",
         f"    <T>={f(d['mean_torque'])} (trivial {f(d['trivial_torque'])})  "
         f"<delta>={f(d['mean_depth_of_cut'])} (trivial {f(d['trivial_depth_of_cut'])})  "
         f"<W>={f(d['mean_wob'])}",

@@ -10,9 +10,10 @@ from pathlib import Path
 
 import pytest
 
-REQUIRED = ("first_stick_tau", "bounce_tau", "stick_fraction", "kappa", "mean_torque",
-            "mean_depth_of_cut", "mean_wob", "omega_min", "omega_max", "trivial_torque",
-            "trivial_depth_of_cut", "critical_delay", "growth_rate", "steps", "kernel_seconds")
+REQUIRED = ("first_stick_tau", "bounce_tau", "stick_fraction", "kappa", "kappa_from_depth",
+            "mean_torque", "mean_depth_of_cut", "mean_wob", "omega_min", "omega_max",
+            "trivial_torque", "trivial_depth_of_cut", "critical_delay", "growth_rate", "steps",
+            "kernel_seconds")
 
 
 def drill_sim(*args: str) -> subprocess.CompletedProcess[str]:

@@ -22,7 +22,9 @@ solves eq. (7) for the delay by interpolation, as in RGD07 Appendix C.
 Integration is symplectic Euler (RGD07 eq. C.1 with the position update using the new
 velocity). The wearflat contact (eq. 31) is solved implicitly in the new axial velocity,
 which yields the set-valued force ``0 <= W_f <= lam`` at ``V = 0`` (eq. 31, last line)
-with no chattering. Stick (eq. 32) freezes the bit; slip happens when the pipe torque
+with no chattering. Stick (eq. 32) freezes the bit; the wearflat then carries what the
+cutting face does not, ``W_f = W_APP - delta_k`` bounded to ``[0, lam]`` (eq. 31 last line,
+eq. 25 left), so ``W = delta + W_f`` holds in every mode. Slip happens when the pipe torque
 reaches the cutting + friction torque (eqs. 14, 33), checked at every step so the
 top-drive speed may vary.
 
@@ -153,6 +155,17 @@ def _wearflat_contact(v: float, w_app: float, doc: float, lam: float,
 
 
 @njit(cache=True, inline="always")
+def _stuck_wearflat(w_app: float, doc: float, lam: float) -> float:
+    """Wearflat force while the bit sticks (eq. 31 last line, eq. 25 left with V = 0).
+
+    The bit is immobile, so the axial balance W = W_APP holds with W = delta_k + W_f
+    (eq. 29): the wearflat carries what the cutting face does not, within its contact law
+    ``0 <= W_f <= lam``.
+    """
+    return min(max(w_app - doc, 0.0), lam)
+
+
+@njit(cache=True, inline="always")
 def _bit_response(v: float, omega: float, t_pipe: float, w_app: float, doc: float,
                   stuck: bool, beta: float, lam: float, kick: float,
                   dt: float) -> tuple[float, float, float, float, float, int, bool]:
@@ -164,7 +177,10 @@ def _bit_response(v: float, omega: float, t_pipe: float, w_app: float, doc: floa
         # Stick (eq. 32): the bit is immobile and the rock reacts the pipe torque and the
         # applied weight, until the pipe torque exceeds the cutting + friction torque
         # delta_k + beta lam (eqs. 14, 33 in the form valid for any top-drive speed).
-        return 0.0, 0.0, lam, w_app, t_pipe, MODE_STUCK, True
+        # The wearflat is in full contact as the paper assumes and carries W_APP - delta_k
+        # (eq. 31, last line), so W = delta_k + W_f (eq. 29) and <U''> = 0 give eq. 44.
+        w_f = _stuck_wearflat(w_app, doc, lam)
+        return 0.0, 0.0, w_f, doc + w_f, t_pipe, MODE_STUCK, True
     if doc >= 0.0:
         v_new, w_f = _wearflat_contact(v, w_app, doc, lam, kick)
         wob = doc + w_f                       # eq. (29): W = delta + W_f
