@@ -1,7 +1,8 @@
 """A second, plain implementation of the RGD07 step (eqs. 25-34, App. C) for the tests.
 
 Written from the equations with the wearflat accounting of the committed behaviour before
-issue 13 (W_f = lam, W = W0 while stuck), a prescribed top-drive speed, no ramps, no
+issue 13 (W_f = lam, W = W0 while stuck), a prescribed constant top-drive speed (the paper's
+kinematic boundary condition: the motor torque equals the string torque), no ramps, no
 rebasing and the bottom-hole profile delay. The dynamics never read W_f while stuck, so
 the production kernel must reproduce every figure of this path to the last digit except
 W_f (and what is derived from it) in stuck samples. Columns follow ``kernel.C_*``.
@@ -87,6 +88,7 @@ def run_reference(state: np.ndarray, profile: np.ndarray, n: float, beta: float,
             r[k.C_PHI_S], r[k.C_OMEGA_S], r[k.C_W_APP] = phi_s, omega0, w0
             r[k.C_WOB], r[k.C_TOB], r[k.C_DOC], r[k.C_WF] = wob, tob, doc, w_f
             r[k.C_T_PIPE], r[k.C_MODE] = torque, mode
+            r[k.C_MOTOR_TORQUE], r[k.C_OMEGA_REF] = torque, omega0   # no drive acceleration
         u_new, phi_new = u + v_new * dt, phi + omega_new * dt      # eq. (C.1)
         dfrac = (phi_new - phi) * (n_nodes / sector)
         f_start = frac
