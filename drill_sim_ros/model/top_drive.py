@@ -108,8 +108,8 @@ class TopDrive:
 
     mode: str = "kinematic"
     inertia_ratio: float = 14.0
-    kp: float = 82.0
-    ki: float = 122.0
+    kp: float = 83.0
+    ki: float = 123.0
     max_torque: float = math.inf
 
     def __post_init__(self) -> None:
@@ -141,8 +141,8 @@ class TopDrivePhysical:
 
     mode: str = "speed"
     inertia_kg_m2: float = 2900.0
-    kp_nm_s: float = 23_000.0
-    ki_nm: float = 46_000.0
+    kp_nm_s: float = 23_200.0
+    ki_nm: float = 46_400.0
     max_torque_nm: float = 50_000.0
 
     def scaled(self, scales: Scales) -> TopDrive:
