@@ -12,7 +12,8 @@ import pytest
 from drill_sim_ros.model import analysis as an
 from drill_sim_ros.model import kernel as k
 from drill_sim_ros.model.params import DimensionlessParams
-from drill_sim_ros.model.presets import load_preset
+from drill_sim_ros.model.errors import ParameterError
+from drill_sim_ros.model.presets import load_preset, preset_from_dict
 from drill_sim_ros.model.simulator import SimConfig, Simulator
 from drill_sim_ros.model.top_drive import TopDrive
 from tests.model.helpers import FIG8A
@@ -192,3 +193,16 @@ def test_si_commands_and_readings_use_the_scales_of_the_field_preset() -> None:
     # J = 2900 kg m^2 referred to I = C t*^2
     assert preset.top_drive.inertia_ratio == pytest.approx(2900.0 / (sc.torque_nm
                                                                       * sc.time_s**2))
+
+
+def test_preset_top_drive_sections_are_validated_and_scaled() -> None:
+    dimless = {"dimensionless": {"w0": 7.0}, "top_drive": {"mode": "speed", "kp": 50.0}}
+    drive = preset_from_dict("x", dimless).top_drive
+    assert (drive.mode, drive.kp) == ("speed", 50.0)
+    assert preset_from_dict("x", {"dimensionless": {}}).top_drive.mode == "kinematic"
+    with pytest.raises(ParameterError, match="inertia_kg_m2"):   # SI key in scaled units
+        preset_from_dict("x", {"dimensionless": {}, "top_drive": {"inertia_kg_m2": 1.0}})
+    with pytest.raises(ParameterError, match=r"top_drive\.mode"):
+        preset_from_dict("x", {"dimensionless": {}, "top_drive": {"mode": "position"}})
+    with pytest.raises(ParameterError, match=r"top_drive\.max_torque"):
+        TopDrive(max_torque=0.0)
