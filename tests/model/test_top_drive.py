@@ -11,8 +11,8 @@ import pytest
 
 from drill_sim_ros.model import analysis as an
 from drill_sim_ros.model import kernel as k
-from drill_sim_ros.model.params import DimensionlessParams
 from drill_sim_ros.model.errors import ParameterError
+from drill_sim_ros.model.params import DimensionlessParams
 from drill_sim_ros.model.presets import load_preset, preset_from_dict
 from drill_sim_ros.model.simulator import SimConfig, Simulator
 from drill_sim_ros.model.top_drive import TopDrive
