@@ -238,7 +238,11 @@ class Simulator:
         speed and its integral at the present motor torque (then ramps to the commanded
         setpoint); entering ``torque`` the present motor torque is held until
         :meth:`set_motor_torque_nm` commands another; entering ``kinematic`` the drive
-        speed goes to the setpoint through the ramp limit of the config."""
+        speed goes to the setpoint through the ramp limit of the config.
+
+        It writes the state, so call it between runs, never while a compiled caller is
+        inside ``kernel.advance`` (which holds the state in locals and writes them back);
+        the commands are single stores into the targets, read when a run starts."""
         index = td.mode_index(mode)
         st, limit = self._state, self._prm[k.P_TD_MAX_TORQUE]
         held = min(max(float(st[k.S_MOTOR_TORQUE]), -limit), limit)
