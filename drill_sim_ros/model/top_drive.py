@@ -130,6 +130,13 @@ class TopDrive:
         """A copy with ``changes`` applied (validated)."""
         return replace(self, **changes)
 
+    def physical(self, scales: Scales) -> TopDrivePhysical:
+        """The same drive in SI (inverse of :meth:`TopDrivePhysical.scaled`)."""
+        c, t_star = scales.torque_nm, scales.time_s
+        return TopDrivePhysical(mode=self.mode, inertia_kg_m2=self.inertia_ratio * c * t_star**2,
+                                kp_nm_s=self.kp * c * t_star, ki_nm=self.ki * c,
+                                max_torque_nm=self.max_torque * c)
+
 
 @dataclass(frozen=True)
 class TopDrivePhysical:
