@@ -233,7 +233,7 @@ class Simulator:
         return td.MODES[int(self._prm[k.P_TD_MODE])]
 
     def set_top_drive_mode(self, mode: str) -> None:
-        """Switch the drive's mode at the next step, without a bump: the drive's speed
+        """Switch the drive's mode at the next run, without a bump: the drive's speed
         carries over; entering ``speed`` the loop's setpoint starts at the present drive
         speed and its integral at the present motor torque (then ramps to the commanded
         setpoint); entering ``torque`` the present motor torque is held until
@@ -244,6 +244,8 @@ class Simulator:
         inside ``kernel.advance`` (which holds the state in locals and writes them back);
         the commands are single stores into the targets, read when a run starts."""
         index = td.mode_index(mode)
+        if index == int(self._prm[k.P_TD_MODE]):
+            return                             # no switch: the loop and the command stay
         st, limit = self._state, self._prm[k.P_TD_MAX_TORQUE]
         held = min(max(float(st[k.S_MOTOR_TORQUE]), -limit), limit)
         if index == td.TD_SPEED:
@@ -252,6 +254,16 @@ class Simulator:
         elif index == td.TD_TORQUE:
             self._targets[k.I_MOTOR_TORQUE] = held
         self._prm[k.P_TD_MODE] = index
+
+    def set_top_drive(self, drive: td.TopDrive) -> None:
+        """New drive parameters (gains, limit, inertia) from the next run, and its mode
+        through :meth:`set_top_drive_mode`; call it between runs, like that."""
+        self.top_drive = drive
+        self._prm[k.P_TD_INERTIA] = drive.inertia_ratio
+        self._prm[k.P_TD_KP] = drive.kp
+        self._prm[k.P_TD_KI] = drive.ki
+        self._prm[k.P_TD_MAX_TORQUE] = drive.max_torque
+        self.set_top_drive_mode(drive.mode)
 
     def set_speed_setpoint_rad_s(self, speed_rad_s: float) -> None:
         """Drive speed setpoint in rad/s (kinematic and speed modes), from the next step."""

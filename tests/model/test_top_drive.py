@@ -132,6 +132,9 @@ def test_the_motor_torque_limit_holds() -> None:
     rows = sim.advance(100, every=1).data
     assert np.all(rows[1:, k.C_MOTOR_TORQUE] == limit)
     assert not sim.set_motor_torque_nm(0.5 * limit)
+    sim.set_top_drive(drive.with_(mode="torque", max_torque=0.25 * limit))   # at runtime
+    rows = sim.advance(100, every=1).data
+    assert np.all(rows[:, k.C_MOTOR_TORQUE] == 0.25 * limit)
 
 
 def _jump(before: np.ndarray, after: np.ndarray, column: int) -> tuple[float, float]:
