@@ -24,6 +24,7 @@ from drill_sim_ros.model.errors import DrillSimError
 from drill_sim_ros.model.params import GROUPS, UNIT_SCALES, DimensionlessParams, Scales
 from drill_sim_ros.model.presets import Preset, available_presets, load_preset
 from drill_sim_ros.model.simulator import SimConfig, Simulator
+from drill_sim_ros.model.top_drive import MODES, TopDrive
 from drill_sim_ros.terminal import StatusLine
 
 TRACE_COLUMNS = ("tau", "omega", "v", "wob", "tob", "depth_of_cut", "surface_torque", "mode")
@@ -49,6 +50,8 @@ class RunSpec:
     perturb_omega: float
     method: str
     n_nodes: int
+    top_drive: TopDrive
+    motor_torque: float | None
 
 
 # ---- argument parsing ---------------------------------------------------------------------
@@ -62,6 +65,18 @@ def _add_model_args(p: argparse.ArgumentParser) -> None:
     g.add_argument("--lam", type=float, help="bluntness lambda (default 5)")
     g.add_argument("--w0", type=float, help="applied weight W0 (default 7)")
     g.add_argument("--omega0", type=float, help="top-drive speed omega0 (default 5)")
+    d = p.add_argument_group("top drive (RGD07 eq. 12 extended; the paper's scaling: torque "
+                             "unit C, time unit t*)")
+    d.add_argument("--top-drive", choices=MODES, help="kinematic: the paper's imposed speed "
+                   "(default of the dimensionless presets); speed: PI speed loop; torque: "
+                   "constant motor torque")
+    d.add_argument("--drive-inertia-ratio", type=float, help="J / I (default 14)")
+    d.add_argument("--drive-kp", type=float, help="speed loop kp_SI / (C t*) (default 83)")
+    d.add_argument("--drive-ki", type=float, help="speed loop ki_SI / C (default 123)")
+    d.add_argument("--drive-max-torque", type=float, help="motor torque limit / C (default: "
+                   "none)")
+    d.add_argument("--motor-torque", type=float, help="torque mode: motor torque / C "
+                   "(default: the trivial torque T0, held)")
     r = p.add_argument_group("run")
     r.add_argument("--tau-end", type=float, default=None,
                    help="end of the run, dimensionless time (default 600)")
@@ -118,7 +133,18 @@ def _resolve(args: argparse.Namespace) -> RunSpec:
                             f"{tau_end!r}]")
     config = SimConfig(dtau=dtau, method=args.method, **({"n_nodes": nodes} if nodes else {}))
     return RunSpec(params, scales, physical, tau_end, config.dtau, average_from,
-                   args.perturb_v, args.perturb_omega, args.method, config.n_nodes)
+                   args.perturb_v, args.perturb_omega, args.method, config.n_nodes,
+                   _top_drive(args, preset.top_drive if preset else TopDrive()),
+                   args.motor_torque)
+
+
+def _top_drive(args: argparse.Namespace, base: TopDrive) -> TopDrive:
+    """The preset's drive with the command line's changes."""
+    changes = {name: value for name, value in (
+        ("mode", args.top_drive), ("inertia_ratio", args.drive_inertia_ratio),
+        ("kp", args.drive_kp), ("ki", args.drive_ki), ("max_torque", args.drive_max_torque))
+        if value is not None}
+    return base.with_(**changes) if changes else base
 
 
 def _tau_end(args: argparse.Namespace, scales: Scales, physical: bool) -> float:
@@ -165,7 +191,10 @@ def simulate(spec: RunSpec, trace: TextIO | None = None, trace_every: int = 100,
     """Run ``spec`` and return the summary dictionary (the ``--json`` object)."""
     sim = Simulator(spec.params, SimConfig(dtau=spec.dtau, n_nodes=spec.n_nodes,
                                            method=spec.method, tau_avg=spec.average_from),
-                    perturb_v=spec.perturb_v, perturb_omega=spec.perturb_omega)
+                    perturb_v=spec.perturb_v, perturb_omega=spec.perturb_omega,
+                    top_drive=spec.top_drive, scales=spec.scales)
+    if spec.motor_torque is not None:
+        sim.set_inputs(motor_torque=spec.motor_torque)
     sim.advance(0, every=1)               # compile (or load from cache) outside the timing
     total = sim.steps_for(spec.tau_end)
     writer = _trace_writer(trace, spec) if trace else None
@@ -195,8 +224,15 @@ def summarize(spec: RunSpec, sim: Simulator, kernel_seconds: float) -> dict[str,
         "params": {g: getattr(p, g) for g in GROUPS},
         "tau_end": spec.tau_end, "dtau": spec.dtau, "average_from": spec.average_from,
         "method": spec.method, "nodes": spec.n_nodes,
+        "top_drive": {"mode": spec.top_drive.mode,
+                      "inertia_ratio": spec.top_drive.inertia_ratio,
+                      "kp": spec.top_drive.kp, "ki": spec.top_drive.ki,
+                      "max_torque": spec.top_drive.max_torque},
         "first_stick_tau": stick, "bounce_tau": bounce,
-        "stick_fraction": avg.stick_fraction, "kappa": avg.kappa, "eta": avg.eta,
+        "stick_fraction": avg.stick_fraction, "kappa": avg.kappa,
+        "kappa_from_depth": analysis.kappa_from_depth(avg.mean_depth_of_cut,
+                                                      triv.depth_of_cut, p.lam),
+        "eta": avg.eta,
         "mean_torque": avg.mean_torque, "mean_depth_of_cut": avg.mean_depth_of_cut,
         "mean_wob": avg.mean_wob, "mean_omega": avg.mean_omega,
         "mean_pipe_torque": avg.mean_pipe_torque, "mean_rop": avg.mean_rop,
@@ -274,12 +310,16 @@ def format_summary(d: dict[str, Any]) -> str:
         f"  numerics    dtau={d['dtau']:g}  tau_end={d['tau_end']:g}  method={d['method']}  "
         f"steps={d['steps']:,}  kernel {f(d['kernel_seconds'], '.3f')} s "
         f"({f(d['ns_per_step'], '.1f')} ns/step)",
+        f"  top drive   {d['top_drive']['mode']}  J/I={f(d['top_drive']['inertia_ratio'])}  "
+        f"kp={f(d['top_drive']['kp'])}  ki={f(d['top_drive']['ki'])}  "
+        f"max torque={f(d['top_drive']['max_torque'])}",
         f"  stability   tau_n0={f(d['trivial_delay'])}  critical={f(d['critical_delay'])}  "
         f"growth rate={f(d['growth_rate'])}  frequency={f(d['growth_frequency'])}",
         f"  events      first stick tau={f(d['first_stick_tau'])}  "
         f"first bounce tau={f(d['bounce_tau'])}",
         f"  averages    over tau in [{d['average_from']:g}, {d['tau_end']:g}]",
-        f"    kappa={f(d['kappa'])}  eta={f(d['eta'])}  stick fraction={f(d['stick_fraction'])}",
+        f"    kappa={f(d['kappa'])} (from <delta>, eq. 45a: {f(d['kappa_from_depth'])})  "
+        f"eta={f(d['eta'])}  stick fraction={f(d['stick_fraction'])}",
         f"    <T>={f(d['mean_torque'])} (trivial {f(d['trivial_torque'])})  "
         f"<delta>={f(d['mean_depth_of_cut'])} (trivial {f(d['trivial_depth_of_cut'])})  "
         f"<W>={f(d['mean_wob'])}",
@@ -336,6 +376,9 @@ def _cmd_info(args: argparse.Namespace) -> int:
     print("  groups  " + "  ".join(f"{g}={getattr(p, g):.4g}" for g in GROUPS))
     for fld in fields(preset.scales):
         print(f"  {fld.name:10s} {getattr(preset.scales, fld.name):.6g}")
+    drive = preset.top_drive
+    print(f"  top drive {drive.mode}: J/I={drive.inertia_ratio:.4g}  kp={drive.kp:.4g}  "
+          f"ki={drive.ki:.4g}  max torque={drive.max_torque:.4g} (units of C, t*)")
     root = analysis.rightmost_root(p)
     print(f"  tau_n0={analysis.trivial_delay(p):.4g}  critical delay="
           f"{analysis.critical_delay(p):.4g}  rightmost root={root.real:.4g}+{root.imag:.4g}i")

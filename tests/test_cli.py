@@ -10,9 +10,10 @@ from pathlib import Path
 
 import pytest
 
-REQUIRED = ("first_stick_tau", "bounce_tau", "stick_fraction", "kappa", "mean_torque",
-            "mean_depth_of_cut", "mean_wob", "omega_min", "omega_max", "trivial_torque",
-            "trivial_depth_of_cut", "critical_delay", "growth_rate", "steps", "kernel_seconds")
+REQUIRED = ("first_stick_tau", "bounce_tau", "stick_fraction", "kappa", "kappa_from_depth",
+            "mean_torque", "mean_depth_of_cut", "mean_wob", "omega_min", "omega_max",
+            "trivial_torque", "trivial_depth_of_cut", "critical_delay", "growth_rate", "steps",
+            "kernel_seconds")
 
 
 def drill_sim(*args: str) -> subprocess.CompletedProcess[str]:
@@ -74,3 +75,22 @@ def test_info_and_presets() -> None:
     assert info.returncode == 0 and "critical delay" in info.stdout
     listing = drill_sim("presets")
     assert "field_8p5in_shale" in listing.stdout and "fig10" in listing.stdout
+
+
+def test_top_drive_options_and_the_field_preset_drive() -> None:
+    field = json.loads(drill_sim("run", "--params", "field_8p5in_shale", "--t-end", "2",
+                                 "--json").stdout)
+    assert field["top_drive"]["mode"] == "speed"               # the field preset's default
+    paper = json.loads(drill_sim("run", "--params", "fig5_8a", "--tau-end", "2",
+                                 "--json").stdout)
+    assert paper["top_drive"]["mode"] == "kinematic"           # the paper's presets
+    result = drill_sim("run", "--params", "fig5_8a", "--tau-end", "2", "--json",
+                       "--top-drive", "torque", "--drive-inertia-ratio", "3",
+                       "--motor-torque", "4", "--drive-max-torque", "10")
+    assert result.returncode == 0, result.stderr
+    drive = json.loads(result.stdout)["top_drive"]
+    assert drive == {"mode": "torque", "inertia_ratio": 3.0, "kp": drive["kp"],
+                     "ki": drive["ki"], "max_torque": 10.0}
+    bad = drill_sim("run", "--tau-end", "1", "--drive-inertia-ratio", "-1")
+    assert bad.returncode == 2
+    assert "'top_drive.inertia_ratio'" in bad.stderr and "Traceback" not in bad.stderr

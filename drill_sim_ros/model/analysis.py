@@ -3,6 +3,7 @@
 * :func:`trivial_solution` - steady drilling, eq. (34) (and eq. 18 when W0 <= lambda);
 * :func:`critical_delay`, :func:`rightmost_root` - linear stability, Appendix B (B.2, B.7);
 * :func:`cycle_averages` - kappa (42), eta (43), the identities (44)-(47), E and S (48);
+* :func:`kappa_from_depth` - kappa from the mean depth of cut (45a);
 * :func:`severity` - stick-slip severity index and under-torque ratio of bit rpm.
 """
 
@@ -144,6 +145,16 @@ def cycle_averages(p: DimensionlessParams, acc: np.ndarray) -> CycleAverages:
         stick_fraction=acc[k.A_STUCK] / count,
         window_steps=int(count),
     )
+
+
+def kappa_from_depth(mean_depth: float, delta0: float, lam: float) -> float:
+    """kappa from the mean depth of cut, eq. (45a) solved: (<delta> - delta0) / lam.
+
+    Beside kappa = 1 - <W_f>/lam (eq. 42) it checks the wearflat accounting: the two agree
+    over whole cycles because <W> = W0 (eq. 44) and W = delta + W_f (eq. 29) hold in every
+    mode, stick included. nan when lam = 0.
+    """
+    return (mean_depth - delta0) / lam if lam > 0 else math.nan
 
 
 def efficiency(p: DimensionlessParams, kappa: float) -> float:

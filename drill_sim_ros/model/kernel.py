@@ -7,9 +7,12 @@ Absolute variables (so the surface inputs may change at any step):
 
 * ``U``  bit depth (down positive), ``V = dU/dtau`` (rate of penetration);
 * ``PHI`` bit angle, ``OMEGA = dPHI/dtau`` (never negative);
-* ``PHI_S`` top-drive angle, driven at ``OMEGA_S``; pipe torque = ``PHI_S - PHI``
+* ``PHI_S`` top-drive angle, turning at ``OMEGA_S``; pipe torque = ``PHI_S - PHI``
   (eq. 25 right: ``phi'' + phi = T0 - T`` with ``phi = PHI - PHI_0`` is
-  ``PHI'' = (PHI_S - PHI) - T``);
+  ``PHI'' = (PHI_S - PHI) - T``). The top drive (:mod:`drill_sim_ros.model.top_drive`)
+  either imposes ``OMEGA_S`` (kinematic, the paper's boundary condition) or is an inertia
+  ``j OMEGA_S' = m - (PHI_S - PHI)`` turned by a motor torque ``m`` (speed loop or torque
+  command), integrated with the bit by the same symplectic Euler step;
 * ``W_APP`` the applied weight (eq. 25 left: ``U'' = psi (W_APP - W)``).
 
 The depth of cut (eqs. 6-8, 26-28) is read from the bottom-hole profile: the height
@@ -22,7 +25,9 @@ solves eq. (7) for the delay by interpolation, as in RGD07 Appendix C.
 Integration is symplectic Euler (RGD07 eq. C.1 with the position update using the new
 velocity). The wearflat contact (eq. 31) is solved implicitly in the new axial velocity,
 which yields the set-valued force ``0 <= W_f <= lam`` at ``V = 0`` (eq. 31, last line)
-with no chattering. Stick (eq. 32) freezes the bit; slip happens when the pipe torque
+with no chattering. Stick (eq. 32) freezes the bit; the wearflat then carries what the
+cutting face does not, ``W_f = W_APP - delta_k`` bounded to ``[0, lam]`` (eq. 31 last line,
+eq. 25 left), so ``W = delta + W_f`` holds in every mode. Slip happens when the pipe torque
 reaches the cutting + friction torque (eqs. 14, 33), checked at every step so the
 top-drive speed may vary.
 
@@ -36,6 +41,16 @@ import math
 import numpy as np
 from numba import njit
 
+from drill_sim_ros.model.top_drive import (
+    TD_KINEMATIC,
+    TD_SPEED,
+    drive_acceleration,
+    kinematic_torque,
+    ramp,
+    speed_loop,
+    torque_command,
+)
+
 # ---- parameter vector (float64) -------------------------------------------------------
 P_N = 0             # number of blades n
 P_BETA = 1          # beta = mu gamma zeta (eq. 10)
@@ -45,12 +60,18 @@ P_DT = 4            # time step dtau
 P_OMEGA_RATE = 5    # max |d OMEGA_S / dtau| (inf = instantaneous)
 P_W_RATE = 6        # max |d W_APP / dtau| (inf = instantaneous)
 P_TAU_AVG = 7       # statistics accumulate for tau >= P_TAU_AVG
-N_PARAMS = 8
+P_TD_MODE = 8       # top-drive mode: top_drive.TD_KINEMATIC | TD_SPEED | TD_TORQUE
+P_TD_INERTIA = 9    # drive inertia ratio j = J / I
+P_TD_KP = 10        # speed loop proportional gain, scaled kp_SI / (C t*)
+P_TD_KI = 11        # speed loop integral gain, scaled ki_SI / C
+P_TD_MAX_TORQUE = 12  # motor torque limit, scaled by C (inf: none)
+N_PARAMS = 13
 
 # ---- surface targets (float64) ----------------------------------------------------------
-I_OMEGA_S = 0       # commanded top-drive speed
+I_OMEGA_S = 0       # commanded top-drive speed (kinematic and speed modes)
 I_W_APP = 1         # commanded applied weight
-N_INPUTS = 2
+I_MOTOR_TORQUE = 2  # commanded motor torque (torque mode)
+N_INPUTS = 3
 
 # ---- state vector (float64) -------------------------------------------------------------
 S_TAU = 0
@@ -66,7 +87,10 @@ S_NODE = 9          # index of the profile node most recently passed
 S_FRAC = 10         # bit position past that node, in node spacings [0, 1)
 S_H_OLD = 11        # that node's height before the current blade re-cut it
 S_STEP = 12         # step counter
-N_STATE = 13
+S_OMEGA_REF = 13    # speed setpoint in force (the ramped I_OMEGA_S)
+S_TD_INTEGRAL = 14  # speed loop integral, torque units
+S_MOTOR_TORQUE = 15  # motor torque of the last step
+N_STATE = 16
 
 # ---- sample columns ---------------------------------------------------------------------
 C_TAU = 0
@@ -83,7 +107,9 @@ C_DOC = 10          # depth of cut delta (negative: clearance above the rock)
 C_WF = 11           # wearflat contact weight W_f
 C_T_PIPE = 12       # pipe (surface) torque PHI_S - PHI
 C_MODE = 13
-N_COLS = 14
+C_MOTOR_TORQUE = 14  # top-drive motor torque over the step
+C_OMEGA_REF = 15    # top-drive speed setpoint in force
+N_COLS = 16
 
 # ---- interaction modes ------------------------------------------------------------------
 MODE_CUTTING = 0    # cutting with full wearflat contact
@@ -124,17 +150,6 @@ def new_accumulators() -> np.ndarray:
 
 
 @njit(cache=True, inline="always")
-def _ramp(current: float, target: float, max_rate: float, dt: float) -> float:
-    """Move ``current`` toward ``target`` by at most ``max_rate * dt``."""
-    step = max_rate * dt
-    if target > current + step:
-        return current + step
-    if target < current - step:
-        return current - step
-    return target
-
-
-@njit(cache=True, inline="always")
 def _wearflat_contact(v: float, w_app: float, doc: float, lam: float,
                       kick: float) -> tuple[float, float]:
     """Axial update with the contact law of eq. (31), implicit in the new velocity.
@@ -153,6 +168,17 @@ def _wearflat_contact(v: float, w_app: float, doc: float, lam: float,
 
 
 @njit(cache=True, inline="always")
+def _stuck_wearflat(w_app: float, doc: float, lam: float) -> float:
+    """Wearflat force while the bit sticks (eq. 31 last line, eq. 25 left with V = 0).
+
+    The bit is immobile, so the axial balance W = W_APP holds with W = delta_k + W_f
+    (eq. 29): the wearflat carries what the cutting face does not, within its contact law
+    ``0 <= W_f <= lam``.
+    """
+    return min(max(w_app - doc, 0.0), lam)
+
+
+@njit(cache=True, inline="always")
 def _bit_response(v: float, omega: float, t_pipe: float, w_app: float, doc: float,
                   stuck: bool, beta: float, lam: float, kick: float,
                   dt: float) -> tuple[float, float, float, float, float, int, bool]:
@@ -164,7 +190,10 @@ def _bit_response(v: float, omega: float, t_pipe: float, w_app: float, doc: floa
         # Stick (eq. 32): the bit is immobile and the rock reacts the pipe torque and the
         # applied weight, until the pipe torque exceeds the cutting + friction torque
         # delta_k + beta lam (eqs. 14, 33 in the form valid for any top-drive speed).
-        return 0.0, 0.0, lam, w_app, t_pipe, MODE_STUCK, True
+        # The wearflat is in full contact as the paper assumes and carries W_APP - delta_k
+        # (eq. 31, last line), so W = delta_k + W_f (eq. 29) and <U''> = 0 give eq. 44.
+        w_f = _stuck_wearflat(w_app, doc, lam)
+        return 0.0, 0.0, w_f, doc + w_f, t_pipe, MODE_STUCK, True
     if doc >= 0.0:
         v_new, w_f = _wearflat_contact(v, w_app, doc, lam, kick)
         wob = doc + w_f                       # eq. (29): W = delta + W_f
@@ -235,9 +264,12 @@ def advance(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarra
     n, beta, lam, dt = prm[P_N], prm[P_BETA], prm[P_LAM], prm[P_DT]
     kick = prm[P_PSI] * dt
     omega_rate, w_rate, tau_avg = prm[P_OMEGA_RATE], prm[P_W_RATE], prm[P_TAU_AVG]
-    tgt_omega, tgt_w = tgt[I_OMEGA_S], tgt[I_W_APP]
+    tgt_omega, tgt_w, tgt_torque = tgt[I_OMEGA_S], tgt[I_W_APP], tgt[I_MOTOR_TORQUE]
+    td_mode, td_j = int(prm[P_TD_MODE]), prm[P_TD_INERTIA]
+    td_kp, td_ki, td_max = prm[P_TD_KP], prm[P_TD_KI], prm[P_TD_MAX_TORQUE]
     u, v, phi, omega = st[S_U], st[S_V], st[S_PHI], st[S_OMEGA]
     phi_s, omega_s, w_app = st[S_PHI_S], st[S_OMEGA_S], st[S_W_APP]
+    omega_ref, integral, motor = st[S_OMEGA_REF], st[S_TD_INTEGRAL], st[S_MOTOR_TORQUE]
     stuck = st[S_STUCK] != 0.0
     step = int(st[S_STEP])
     sector = 2.0 * math.pi / n
@@ -268,7 +300,20 @@ def advance(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarra
         t_pipe = phi_s - phi                  # pipe torque C (PHI_S - PHI), scaled
         v_new, omega_new, w_f, wob, tob, mode, stuck = _bit_response(
             v, omega, t_pipe, w_app, doc, stuck, beta, lam, kick, dt)
-        probe += w_f + tob
+        # ---- top drive (RGD07 eq. 12 extended): its speed at the end of the step
+        if td_mode == TD_KINEMATIC:           # the paper's imposed speed
+            omega_s_next = ramp(omega_s, tgt_omega, omega_rate, dt)
+            omega_ref = omega_s_next
+            motor = kinematic_torque(omega_s, omega_s_next, t_pipe, td_j, dt)
+        else:                                 # an inertia turned by the motor torque
+            omega_ref = ramp(omega_ref, tgt_omega, omega_rate, dt)
+            if td_mode == TD_SPEED:
+                motor, integral = speed_loop(omega_ref, omega_s, integral, td_kp, td_ki,
+                                             td_max, dt)
+            else:
+                motor = torque_command(tgt_torque, td_max)
+            omega_s_next = omega_s + drive_acceleration(motor, t_pipe, td_j) * dt
+        probe += w_f + tob + motor
         # ---- statistics
         if mode == MODE_STUCK and first_stick != first_stick:
             first_stick = tau
@@ -295,6 +340,7 @@ def advance(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarra
                 r[C_PHI_S], r[C_OMEGA_S], r[C_W_APP] = phi_s, omega_s, w_app
                 r[C_WOB], r[C_TOB], r[C_DOC], r[C_WF] = wob, tob, doc, w_f
                 r[C_T_PIPE], r[C_MODE] = t_pipe, mode
+                r[C_MOTOR_TORQUE], r[C_OMEGA_REF] = motor, omega_ref
                 n_rows += 1
             countdown = every - 1
         else:
@@ -331,12 +377,15 @@ def advance(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarra
                 if u_cross > h_old:
                     profile[node] = u_cross
         u, v, phi, omega = u_new, v_new, phi_new, omega_new
-        phi_s += omega_s * dt
-        omega_s = _ramp(omega_s, tgt_omega, omega_rate, dt)
-        w_app = _ramp(w_app, tgt_w, w_rate, dt)
+        # kinematic: the angle advances at the speed the step started with (as before the
+        # drive had inertia, bit for bit); an inertial drive: symplectic Euler like the bit
+        phi_s += (omega_s if td_mode == TD_KINEMATIC else omega_s_next) * dt
+        omega_s = omega_s_next
+        w_app = ramp(w_app, tgt_w, w_rate, dt)
         step += 1
     st[S_U], st[S_V], st[S_PHI], st[S_OMEGA] = u, v, phi, omega
     st[S_PHI_S], st[S_OMEGA_S], st[S_W_APP] = phi_s, omega_s, w_app
+    st[S_OMEGA_REF], st[S_TD_INTEGRAL], st[S_MOTOR_TORQUE] = omega_ref, integral, motor
     st[S_STUCK] = 1.0 if stuck else 0.0
     st[S_STEP] = step
     st[S_TAU] = step * dt

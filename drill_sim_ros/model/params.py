@@ -166,6 +166,17 @@ class Scales:
     def w_from_newton(self, wob_n: float) -> float:
         return wob_n / self.force_n
 
+    def rad_s(self, omega: float) -> float:
+        """Dimensionless angular speed -> rad/s."""
+        return omega / self.time_s
+
+    def omega_from_rad_s(self, rad_s: float) -> float:
+        return rad_s * self.time_s
+
+    def t_from_nm(self, torque_nm: float) -> float:
+        """Torque in N m -> the paper's torque unit C."""
+        return torque_nm / self.torque_nm
+
 
 UNIT_SCALES = Scales(time_s=1.0, length_m=1.0, force_n=1.0, torque_nm=1.0)
 

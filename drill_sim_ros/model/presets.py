@@ -1,15 +1,17 @@
 """Named parameter sets (config/presets/*.yaml): the paper's cases and a field case.
 
 A preset file holds ``description``, either ``dimensionless`` (RGD07 groups; the run is
-then in units of t* and L*) or ``physical`` (SI; see :class:`PhysicalParams`), and optional
-``numerics`` (``dtau``, ``n_nodes``).
+then in units of t* and L*) or ``physical`` (SI; see :class:`PhysicalParams`), optional
+``numerics`` (``dtau``, ``n_nodes``) and an optional ``top_drive`` (SI keys of
+:class:`TopDrivePhysical` in a physical preset, scaled keys of :class:`TopDrive` in a
+dimensionless one; absent: the paper's kinematic drive).
 """
 
 from __future__ import annotations
 
 import os
 import sys
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -25,6 +27,7 @@ from drill_sim_ros.model.params import (
     physical_from_dict,
     scale,
 )
+from drill_sim_ros.model.top_drive import TopDrive, top_drive_from_dict
 
 DEFAULT_PRESET = "field_8p5in_shale"
 PACKAGE = "drill_sim_ros"
@@ -41,6 +44,7 @@ class Preset:
     physical: PhysicalParams | None
     dtau: float
     n_nodes: int | None
+    top_drive: TopDrive = field(default_factory=TopDrive)
 
     @property
     def is_physical(self) -> bool:
@@ -97,10 +101,12 @@ def preset_from_dict(name: str, data: dict[str, Any]) -> Preset:
     else:
         params, scales = dimensionless_from_dict(data["dimensionless"]), UNIT_SCALES
     n_nodes = numerics.get("n_nodes")
+    drive = data.get("top_drive")
+    top_drive = TopDrive() if drive is None else top_drive_from_dict(drive, scales, has_phys)
     return Preset(name=name, description=str(data.get("description", "")).strip(),
                   params=params, scales=scales, physical=physical,
                   dtau=float(numerics.get("dtau", 1e-4)),
-                  n_nodes=None if n_nodes is None else int(n_nodes))
+                  n_nodes=None if n_nodes is None else int(n_nodes), top_drive=top_drive)
 
 
 def load_preset(name_or_path: str = DEFAULT_PRESET) -> Preset:

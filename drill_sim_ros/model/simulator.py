@@ -3,7 +3,8 @@
 The :class:`Simulator` owns the state vector, the bottom-hole profile (bounded memory:
 ``n_nodes`` floats) and the statistics; it validates its inputs once, at the boundary.
 All quantities are dimensionless (RGD07 eqs. 19-24); :mod:`drill_sim_ros.model.params`
-converts to SI.
+converts to SI. The top drive's commands and readings also come in SI (the ``*_rad_s`` and
+``*_nm`` members), through the :class:`Scales` the simulator was given.
 """
 
 from __future__ import annotations
@@ -14,9 +15,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from drill_sim_ros.model import kernel as k
+from drill_sim_ros.model import top_drive as td
 from drill_sim_ros.model.analysis import TrivialSolution, trivial_solution
 from drill_sim_ros.model.errors import HistoryOverflow, NumericalFault, ParameterError
-from drill_sim_ros.model.params import DimensionlessParams
+from drill_sim_ros.model.params import UNIT_SCALES, DimensionlessParams, Scales
 
 METHODS = ("profile", "exact")
 REBASE_DEPTH = 1.0e4     # rebase U and angles beyond this, to keep differences exact
@@ -67,6 +69,7 @@ class Snapshot:
     meta: np.ndarray | None
     depth_offset: float
     angle_offset: float
+    top_drive_mode: float = td.TD_KINEMATIC
 
 
 @dataclass
@@ -102,13 +105,18 @@ class Simulator:
 
     Starts on the trivial solution (eq. 34) of ``params``, with the history before tau = 0
     being the trivial motion, and the velocity perturbations ``perturb_v`` and
-    ``perturb_omega`` added at tau = 0.
+    ``perturb_omega`` added at tau = 0. ``top_drive`` (default: kinematic, the paper's
+    imposed speed) turns the top of the string; ``scales`` (default: unit scales) converts
+    the SI top-drive members.
     """
 
     def __init__(self, params: DimensionlessParams, config: SimConfig | None = None,
-                 perturb_v: float = 0.0, perturb_omega: float = 0.0) -> None:
+                 perturb_v: float = 0.0, perturb_omega: float = 0.0,
+                 top_drive: td.TopDrive | None = None, scales: Scales = UNIT_SCALES) -> None:
         self.params = params
         self.config = config or SimConfig()
+        self.top_drive = top_drive or td.TopDrive()
+        self.scales = scales
         for name, value in (("perturb_v", perturb_v), ("perturb_omega", perturb_omega)):
             if not math.isfinite(value):
                 raise ParameterError(f"parameter '{name}' = {value!r} must be finite")
@@ -128,6 +136,12 @@ class Simulator:
         self._prm[k.P_OMEGA_RATE] = c.omega_rate
         self._prm[k.P_W_RATE] = c.w_rate
         self._prm[k.P_TAU_AVG] = c.tau_avg
+        d = self.top_drive
+        self._prm[k.P_TD_MODE] = td.mode_index(d.mode)
+        self._prm[k.P_TD_INERTIA] = d.inertia_ratio
+        self._prm[k.P_TD_KP] = d.kp
+        self._prm[k.P_TD_KI] = d.ki
+        self._prm[k.P_TD_MAX_TORQUE] = d.max_torque
 
     @property
     def trivial(self) -> TrivialSolution:
@@ -135,7 +149,8 @@ class Simulator:
         return trivial_solution(self.params)
 
     def reset(self) -> None:
-        """Back to tau = 0 on the trivial solution, perturbations re-applied."""
+        """Back to tau = 0 on the trivial solution, perturbations re-applied; the top-drive
+        mode in force stays (it is a setting), its loop restarts on the trivial torque."""
         triv = self.trivial
         p = self.params
         st = np.zeros(k.N_STATE)
@@ -144,8 +159,11 @@ class Simulator:
         st[k.S_PHI_S] = triv.torque           # pipe twist carries the trivial torque
         st[k.S_OMEGA_S] = p.omega0
         st[k.S_W_APP] = p.w0
+        st[k.S_OMEGA_REF] = p.omega0
+        st[k.S_TD_INTEGRAL] = triv.torque     # the loop holds the trivial torque
+        st[k.S_MOTOR_TORQUE] = triv.torque
         self._state = st
-        self._targets = np.array([p.omega0, p.w0])
+        self._targets = np.array([p.omega0, p.w0, triv.torque])
         self._acc = k.new_accumulators()
         self._depth_offset = 0.0
         self._angle_offset = 0.0
@@ -188,20 +206,93 @@ class Simulator:
         self._meta = np.array([count % cap, count, 0], dtype=np.int64)
 
     # ---- inputs -----------------------------------------------------------------------
-    def set_inputs(self, omega_s: float | None = None, w_app: float | None = None) -> None:
-        """Surface setpoints (dimensionless top-drive speed and applied weight).
-
-        They take effect at the next step, through the ramp limits of the config.
+    def set_inputs(self, omega_s: float | None = None, w_app: float | None = None,
+                   motor_torque: float | None = None) -> None:
+        """Surface setpoints (dimensionless top-drive speed, applied weight and the motor
+        torque of the torque mode). They take effect at the next step, the speed and the
+        weight through the ramp limits of the config, the torque within the drive's limit.
         """
         if omega_s is not None:
             self._targets[k.I_OMEGA_S] = _check_input("omega_s", omega_s)
         if w_app is not None:
             self._targets[k.I_W_APP] = _check_input("w_app", w_app)
+        if motor_torque is not None:
+            if not math.isfinite(motor_torque):
+                raise ParameterError(f"input 'motor_torque' = {motor_torque!r} must be finite")
+            self._targets[k.I_MOTOR_TORQUE] = float(motor_torque)
 
     @property
     def targets(self) -> tuple[float, float]:
         """Commanded (omega_s, w_app)."""
         return float(self._targets[0]), float(self._targets[1])
+
+    # ---- the top drive (RGD07 eq. 12 extended; see model.top_drive) ----------------------
+    @property
+    def top_drive_mode(self) -> str:
+        """'kinematic', 'speed' or 'torque'."""
+        return td.MODES[int(self._prm[k.P_TD_MODE])]
+
+    def set_top_drive_mode(self, mode: str) -> None:
+        """Switch the drive's mode at the next run, without a bump: the drive's speed
+        carries over; entering ``speed`` the loop's setpoint starts at the present drive
+        speed and its integral at the present motor torque (then ramps to the commanded
+        setpoint); entering ``torque`` the present motor torque is held until
+        :meth:`set_motor_torque_nm` commands another; entering ``kinematic`` the drive
+        speed goes to the setpoint through the ramp limit of the config.
+
+        It writes the state, so call it between runs, never while a compiled caller is
+        inside ``kernel.advance`` (which holds the state in locals and writes them back);
+        the commands are single stores into the targets, read when a run starts."""
+        index = td.mode_index(mode)
+        if index == int(self._prm[k.P_TD_MODE]):
+            return                             # no switch: the loop and the command stay
+        st, limit = self._state, self._prm[k.P_TD_MAX_TORQUE]
+        held = min(max(float(st[k.S_MOTOR_TORQUE]), -limit), limit)
+        if index == td.TD_SPEED:
+            st[k.S_OMEGA_REF] = st[k.S_OMEGA_S]
+            st[k.S_TD_INTEGRAL] = held
+        elif index == td.TD_TORQUE:
+            self._targets[k.I_MOTOR_TORQUE] = held
+        self._prm[k.P_TD_MODE] = index
+
+    def set_top_drive(self, drive: td.TopDrive) -> None:
+        """New drive parameters (gains, limit, inertia) from the next run, and its mode
+        through :meth:`set_top_drive_mode`; call it between runs, like that."""
+        self.top_drive = drive
+        self._prm[k.P_TD_INERTIA] = drive.inertia_ratio
+        self._prm[k.P_TD_KP] = drive.kp
+        self._prm[k.P_TD_KI] = drive.ki
+        self._prm[k.P_TD_MAX_TORQUE] = drive.max_torque
+        self.set_top_drive_mode(drive.mode)
+
+    def set_speed_setpoint_rad_s(self, speed_rad_s: float) -> None:
+        """Drive speed setpoint in rad/s (kinematic and speed modes), from the next step."""
+        self.set_inputs(omega_s=self.scales.omega_from_rad_s(_check_input("speed_rad_s",
+                                                                          speed_rad_s)))
+
+    def set_motor_torque_nm(self, torque_nm: float) -> bool:
+        """Motor torque command in N m (torque mode), from the next step. The drive applies
+        it within +-max torque; returns True when the command lies beyond that limit."""
+        torque_nm = float(torque_nm)
+        if not math.isfinite(torque_nm):
+            raise ParameterError(f"input 'motor_torque_nm' = {torque_nm!r} must be finite")
+        self._targets[k.I_MOTOR_TORQUE] = self.scales.t_from_nm(torque_nm)
+        return abs(self._targets[k.I_MOTOR_TORQUE]) > self._prm[k.P_TD_MAX_TORQUE]
+
+    @property
+    def drive_speed_rad_s(self) -> float:
+        """The drive's (quill's) speed now, rad/s (the encoder's reading)."""
+        return self.scales.rad_s(float(self._state[k.S_OMEGA_S]))
+
+    @property
+    def motor_torque_nm(self) -> float:
+        """The motor torque of the last step, N m."""
+        return self.scales.tob_nm(float(self._state[k.S_MOTOR_TORQUE]))
+
+    @property
+    def string_torque_nm(self) -> float:
+        """The string torque at the quill now, C (PHI_S - PHI), N m (the torque sub's)."""
+        return self.scales.tob_nm(float(self._state[k.S_PHI_S] - self._state[k.S_PHI]))
 
     # ---- stepping ---------------------------------------------------------------------
     @property
@@ -315,7 +406,7 @@ class Simulator:
         return Snapshot(self._state.copy(), self._targets.copy(), self._profile.copy(),
                         self._acc.copy(), None if self._hist is None else self._hist.copy(),
                         None if self._meta is None else self._meta.copy(),
-                        self._depth_offset, self._angle_offset)
+                        self._depth_offset, self._angle_offset, float(self._prm[k.P_TD_MODE]))
 
     def restore(self, snap: Snapshot) -> None:
         """Resume from a :meth:`snapshot` of a simulator with the same settings."""
@@ -329,6 +420,7 @@ class Simulator:
         self._meta = None if snap.meta is None else snap.meta.copy()
         self._depth_offset = snap.depth_offset
         self._angle_offset = snap.angle_offset
+        self._prm[k.P_TD_MODE] = snap.top_drive_mode
         self.fault = None
 
     @property

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from drill_sim_ros.model import analysis as an
 from drill_sim_ros.model import kernel as k
 from drill_sim_ros.model.params import DimensionlessParams
 from drill_sim_ros.model.simulator import SimConfig, Simulator
@@ -25,8 +26,9 @@ def run(params: DimensionlessParams, tau_end: float, dtau: float = 1e-4,
 
 def advance_to_stick_onset(sim: Simulator, limit_tau: float, chunk: int = 200) -> bool:
     """Step until the bit enters a stick phase (the sample of a step is stuck and the
-    previous was not); stop right at that step. False if ``limit_tau`` passes first."""
-    last_mode = -1.0
+    previous was not); stop right at that step. A stick phase under way when called is
+    not an onset. False if ``limit_tau`` passes first."""
+    last_mode = float(k.MODE_STUCK) if sim.state[k.S_STUCK] else -1.0
     while sim.tau < limit_tau:
         snap = sim.snapshot()
         rows = sim.advance(chunk, every=1).data
@@ -39,3 +41,16 @@ def advance_to_stick_onset(sim: Simulator, limit_tau: float, chunk: int = 200) -
             return True
         last_mode = modes[-1]
     return False
+
+
+def whole_cycle_averages(p: DimensionlessParams, cycles: int, settle_tau: float = 300.0,
+                         dtau: float = 1e-4) -> an.CycleAverages:
+    """Averages over whole stick-slip cycles: from one stick onset to another, after
+    ``settle_tau`` of transient."""
+    sim = Simulator(p, SimConfig(dtau=dtau), perturb_v=0.01)
+    sim.advance(sim.steps_for(settle_tau))
+    assert advance_to_stick_onset(sim, settle_tau + 100.0)
+    sim.reset_statistics()
+    for _ in range(cycles):
+        assert advance_to_stick_onset(sim, sim.tau + 50.0)
+    return an.cycle_averages(p, sim.accumulators)

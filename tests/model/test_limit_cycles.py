@@ -7,8 +7,7 @@ import pytest
 
 from drill_sim_ros.model import analysis as an
 from drill_sim_ros.model.params import DimensionlessParams
-from drill_sim_ros.model.simulator import SimConfig, Simulator
-from tests.model.helpers import FIG8A, FIG8B, advance_to_stick_onset, run
+from tests.model.helpers import FIG8A, FIG8B, run, whole_cycle_averages
 
 
 def test_fig8a_beta_below_one_ends_in_stick_slip() -> None:
@@ -27,18 +26,6 @@ def test_fig8b_beta_above_one_stays_bounded_without_stick() -> None:
     assert an.first_event_tau(sim.accumulators) == (None, None)
     assert avg.omega_min > 0.0 and avg.omega_max < 1.5 * FIG8B.omega0
     assert avg.kappa > 0.0                  # self-excited: intermittent loss of contact
-
-
-def _whole_cycle_averages(p: DimensionlessParams, cycles: int) -> an.CycleAverages:
-    """Averages over whole stick-slip cycles: from one stick onset to another."""
-    sim = Simulator(p, SimConfig(dtau=1e-4), perturb_v=0.01)
-    sim.advance(sim.steps_for(300.0))
-    assert advance_to_stick_onset(sim, 400.0)
-    sim.reset_statistics()
-    for _ in range(cycles):
-        sim.advance(100)                    # leave the current stick phase
-        assert advance_to_stick_onset(sim, sim.tau + 50.0)
-    return an.cycle_averages(p, sim.accumulators)
 
 
 def _identity_errors(p: DimensionlessParams, avg: an.CycleAverages) -> dict[str, float]:
@@ -69,7 +56,7 @@ def test_cycle_identities_without_stick_within_0p1_percent() -> None:
 
 
 def test_cycle_identities_with_stick_within_1_percent() -> None:
-    avg = _whole_cycle_averages(FIG8A, cycles=20)
+    avg = whole_cycle_averages(FIG8A, cycles=20)
     assert avg.stick_fraction > 0.0
     errors = _identity_errors(FIG8A, avg)
     print(errors)
@@ -78,7 +65,7 @@ def test_cycle_identities_with_stick_within_1_percent() -> None:
 
 def test_mean_weight_and_speed_equal_the_surface_inputs_over_whole_cycles() -> None:
     """<U''> = 0 gives <W> = W0; a bounded pipe twist gives <omega> = omega0 (Sec. 5.1)."""
-    avg = _whole_cycle_averages(FIG8A, cycles=20)
+    avg = whole_cycle_averages(FIG8A, cycles=20)
     assert avg.mean_wob == pytest.approx(FIG8A.w0, rel=1e-3)
     assert avg.mean_omega == pytest.approx(FIG8A.omega0, rel=1e-2)
 

@@ -8,6 +8,7 @@ import sys
 
 def test_model_imports_no_adapters() -> None:
     code = ("import sys, drill_sim_ros.model.simulator, drill_sim_ros.model.analysis, "
+            "drill_sim_ros.model.top_drive, drill_sim_ros.model.measurement, "
             "drill_sim_ros.model.presets, drill_sim_ros.cli\n"
             "bad = [m for m in sys.modules if m.split('.')[0] in "
             "('rclpy', 'mcap', 'mcap_ros2', 'rerun', 'rosbags')]\n"

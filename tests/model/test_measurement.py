@@ -1,0 +1,81 @@
+"""Rig sensors: off by default, seeded noise of the asked size, quantisation, whole-sample
+delay, and the same measurements whatever the blocks the samples come in."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from drill_sim_ros.model import kernel as k
+from drill_sim_ros.model.errors import ParameterError
+from drill_sim_ros.model.measurement import SIGNALS, RigSensors, SignalSpec, surface_truth
+from drill_sim_ros.model.presets import load_preset
+from drill_sim_ros.model.simulator import SimConfig, Simulator
+
+
+def _truth(rows: int = 20_000) -> np.ndarray:
+    t = np.arange(rows) * 0.01
+    return np.column_stack([6.0 + np.sin(t), 3000.0 + 500.0 * np.cos(t), 2500.0 + 0.0 * t])
+
+
+def test_perfect_sensors_by_default() -> None:
+    truth = _truth()
+    assert np.array_equal(RigSensors().measure(truth), truth)
+
+
+def test_noise_has_the_asked_size_and_repeats_with_the_seed() -> None:
+    truth = _truth(100_000)
+    specs = {"motor_torque_nm": SignalSpec(noise_std=50.0)}
+    measured = RigSensors(specs, seed=7).measure(truth)
+    error = measured[:, 1] - truth[:, 1]
+    assert error.std() == pytest.approx(50.0, rel=0.02)          # 1/sqrt(2N) = 0.2 %
+    assert abs(error.mean()) < 4 * 50.0 / np.sqrt(error.size)
+    assert np.array_equal(measured[:, [0, 2]], truth[:, [0, 2]])  # the others untouched
+    assert np.array_equal(RigSensors(specs, seed=7).measure(truth), measured)
+    assert not np.array_equal(RigSensors(specs, seed=8).measure(truth), measured)
+
+
+def test_quantisation_rounds_to_the_quantum() -> None:
+    truth = _truth()
+    q = 0.05
+    measured = RigSensors({"drive_speed_rad_s": SignalSpec(quantum=q)}).measure(truth)[:, 0]
+    assert np.allclose(measured / q, np.round(measured / q), rtol=0, atol=1e-9)
+    assert np.max(np.abs(measured - truth[:, 0])) <= q / 2 + 1e-12
+
+
+def test_delay_in_whole_samples() -> None:
+    truth = _truth()
+    measured = RigSensors({"string_torque_nm": SignalSpec(delay_periods=3),
+                           "motor_torque_nm": SignalSpec(delay_periods=1)}).measure(truth)
+    assert np.array_equal(measured[3:, 2], truth[:-3, 2])
+    assert np.array_equal(measured[:3, 2], np.full(3, truth[0, 2]))
+    assert np.array_equal(measured[1:, 1], truth[:-1, 1])
+
+
+def test_blocks_give_the_same_measurements_as_one_call() -> None:
+    truth = _truth(5000)
+    specs = {name: SignalSpec(noise_std=0.1, quantum=0.01, delay_periods=2) for name in SIGNALS}
+    whole = RigSensors(specs, seed=3).measure(truth)
+    sensors = RigSensors(specs, seed=3)
+    parts = [sensors.measure(truth[a:b]) for a, b in ((0, 1), (1, 2), (2, 700), (700, 5000))]
+    assert np.array_equal(np.vstack(parts), whole)
+
+
+def test_surface_truth_of_the_field_preset_in_si() -> None:
+    preset = load_preset("field_8p5in_shale")
+    sim = Simulator(preset.params, SimConfig(dtau=preset.dtau), top_drive=preset.top_drive,
+                    scales=preset.scales)
+    rows = sim.advance(1000, every=100).data
+    truth = surface_truth(rows, preset.scales)
+    assert truth[0, 0] == pytest.approx(2 * np.pi)               # 60 rpm
+    assert truth[0, 2] == pytest.approx(sim.scales.tob_nm(rows[0, k.C_T_PIPE]))
+    assert truth[0, 1] == pytest.approx(truth[0, 2])             # on the trivial solution
+
+
+def test_bad_sensor_settings_are_named() -> None:
+    with pytest.raises(ParameterError, match="noise_std"):
+        SignalSpec(noise_std=-1.0)
+    with pytest.raises(ParameterError, match="delay_periods"):
+        SignalSpec(delay_periods=-2)
+    with pytest.raises(ParameterError, match="hook_load"):
+        RigSensors({"hook_load": SignalSpec()})
