@@ -31,20 +31,21 @@ from rclpy.executors import SingleThreadedExecutor
 from drill_sim_ros import topics
 from drill_sim_ros.model.params import RPM_PER_RAD_S
 from drill_sim_ros.model.presets import load_preset
-from drill_sim_ros.ros.lockstep_driver import LockstepDriver
+from drill_sim_ros.ros.lockstep_driver import Command, LockstepDriver
 
 BIN = Path(sys.prefix) / "bin"
 F = topics.TELEMETRY_INDEX
 PRESET = load_preset("field_8p5in_shale")
 
 
-def damping_policy(row: np.ndarray | None) -> tuple[float | None, float | None]:
-    """A torque-feedback speed reference: the setpoint drops as the surface torque rises."""
+def damping_policy(row: np.ndarray | None) -> Command:
+    """A torque-feedback speed reference: the setpoint drops as the measured string torque
+    rises above its start value (surface signals only)."""
     rpm0 = PRESET.physical.surface_rpm
     if row is None:
-        return rpm0 / RPM_PER_RAD_S, None
-    torque_ratio = row[F["surface_torque_nm"]] / max(abs(row[F["tob_nm"]]), 1.0)
-    return max(0.0, rpm0 * (1.0 - 0.05 * (torque_ratio - 1.0))) / RPM_PER_RAD_S, None
+        return Command(speed_rad_s=rpm0 / RPM_PER_RAD_S)
+    excess_nm = row[F["string_torque_measured_nm"]] - 10_000.0
+    return Command(speed_rad_s=max(0.0, rpm0 - 1e-3 * excess_nm) / RPM_PER_RAD_S)
 
 
 def one_run(periods: int) -> tuple[float, list[bytes]]:

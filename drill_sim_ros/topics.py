@@ -21,6 +21,7 @@ BIT_DEPTH_OF_CUT = "/drill/bit/depth_of_cut"  # std_msgs/Float64, m per revoluti
 BIT_MODE = "/drill/bit/mode"                  # std_msgs/UInt8, see MODE_NAMES
 BIT_JOINT_STATES = "/drill/bit/joint_states"  # sensor_msgs/JointState (BIT_JOINTS)
 SURFACE_JOINT_STATES = "/drill/surface/joint_states"  # sensor_msgs/JointState (SURFACE_JOINTS)
+SURFACE_MEASURED = "/drill/surface/measured"  # sensor_msgs/JointState (MEASURED_JOINTS)
 TELEMETRY = "/drill/telemetry"                # std_msgs/Float64MultiArray (TELEMETRY_FIELDS)
 DIAGNOSTICS = "/diagnostics"                  # diagnostic_msgs/DiagnosticArray, 1 Hz
 CLOCK = "/clock"                              # rosgraph_msgs/Clock (publish_clock)
@@ -54,6 +55,7 @@ MSG_TYPES: dict[str, str] = {
     BIT_MODE: "std_msgs/msg/UInt8",
     BIT_JOINT_STATES: "sensor_msgs/msg/JointState",
     SURFACE_JOINT_STATES: "sensor_msgs/msg/JointState",
+    SURFACE_MEASURED: "sensor_msgs/msg/JointState",
     TELEMETRY: "std_msgs/msg/Float64MultiArray",
     DIAGNOSTICS: "diagnostic_msgs/msg/DiagnosticArray",
     CLOCK: "rosgraph_msgs/msg/Clock",
@@ -70,6 +72,10 @@ BIT_JOINTS = ("bit_rotation", "bit_axial")
 SURFACE_JOINTS = ("top_drive", "hook")
 # top_drive: angle rad, speed rad/s, surface (pipe) torque N m
 # hook:      bit depth m, rate of penetration m/s, hook load N
+# What the rig's surface sensors give (the only signals a controller should read):
+MEASURED_JOINTS = ("top_drive", "quill")
+# top_drive: angle rad, measured speed rad/s (encoder), measured motor torque N m
+# quill:     angle rad, measured speed rad/s, measured string torque N m (torque sub)
 
 # /drill/telemetry carries one row of the model's telemetry record per sample, and its
 # layout.dim[0].label lists TELEMETRY_FIELDS (drill_sim_ros.model.telemetry).

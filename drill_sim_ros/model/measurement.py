@@ -20,9 +20,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from drill_sim_ros.model import kernel as k
 from drill_sim_ros.model.errors import ParameterError
-from drill_sim_ros.model.params import Scales
 
 SIGNALS = ("drive_speed_rad_s", "motor_torque_nm", "string_torque_nm")
 MAX_DELAY_PERIODS = 10_000
@@ -92,13 +90,3 @@ class RigSensors:
         joined = np.concatenate([line, y])
         self._pending[i] = joined[-spec.delay_periods:]
         return joined[:x.size]
-
-
-def surface_truth(rows: np.ndarray, scales: Scales) -> np.ndarray:
-    """The true surface signals of kernel sample rows (``kernel.C_*`` columns), in SI:
-    shape (rows, len(SIGNALS)) in :data:`SIGNALS` order."""
-    out = np.empty((rows.shape[0], len(SIGNALS)))
-    out[:, 0] = scales.rad_s(rows[:, k.C_OMEGA_S])
-    out[:, 1] = scales.tob_nm(rows[:, k.C_MOTOR_TORQUE])
-    out[:, 2] = scales.tob_nm(rows[:, k.C_T_PIPE])
-    return out

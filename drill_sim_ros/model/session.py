@@ -17,10 +17,19 @@ import numpy as np
 
 from drill_sim_ros.model import kernel as k
 from drill_sim_ros.model.analysis import Severity, severity_of
+from drill_sim_ros.model.measurement import RigSensors
 from drill_sim_ros.model.params import GROUPS
 from drill_sim_ros.model.presets import Preset
 from drill_sim_ros.model.simulator import SimConfig, Simulator
-from drill_sim_ros.model.telemetry import NO_COMMAND_S, NS_PER_S, field_scales, si_rows
+from drill_sim_ros.model.telemetry import (
+    MEASURED,
+    NO_COMMAND_S,
+    NS_PER_S,
+    field_scales,
+    si_rows,
+    surface_truth,
+)
+from drill_sim_ros.model.top_drive import TopDrivePhysical
 
 WINDOW_BUCKETS = 20
 
@@ -40,6 +49,8 @@ class SessionConfig:
     wob_rate_n_s: float = 0.0            # 0: no limit
     window_s: float = 20.0
     submerged_weight_n: float = 0.0      # for the hook load
+    top_drive: TopDrivePhysical | None = None   # None: the preset's drive
+    sensors: RigSensors | None = None           # None: perfect surface sensors
 
 
 @dataclass(frozen=True)
@@ -79,7 +90,8 @@ def build_simulator(cfg: SessionConfig, period_tau: float, steps: int) -> Simula
     w_rate = sc.w_from_newton(cfg.wob_rate_n_s) * sc.time_s if cfg.wob_rate_n_s > 0 else math.inf
     config = SimConfig(dtau=period_tau / steps, n_nodes=cfg.n_nodes, omega_rate=omega_rate,
                        w_rate=w_rate)
-    return Simulator(params, config, perturb_v=cfg.perturb_v)
+    drive = cfg.preset.top_drive if cfg.top_drive is None else cfg.top_drive.scaled(sc)
+    return Simulator(params, config, perturb_v=cfg.perturb_v, top_drive=drive, scales=sc)
 
 
 class SimSession:
@@ -94,6 +106,7 @@ class SimSession:
         self.sim = build_simulator(cfg, period_tau, self.steps)
         self.submerged_weight_n = cfg.submerged_weight_n
         self.command_stamp_ns: int | None = None    # stamp of the command in force, if any
+        self.sensors = cfg.sensors or RigSensors()
         self._factors = field_scales(self.scales)
         self._samples = np.empty((2, k.N_COLS))   # kernel rows of a run (grows as needed)
         self.sim.advance_into(self._samples, 0, self.steps)  # load the compiled kernel now
@@ -144,6 +157,7 @@ class SimSession:
             self.command_stamp_ns / NS_PER_S
         rows = si_rows(samples, self.sim.offsets, self._factors, stamps_ns / NS_PER_S,
                        self.submerged_weight_n, command_s)
+        rows[:, MEASURED] = self.sensors.measure(surface_truth(rows))
         return Block(rows, stamps_ns, self.sim.offsets)
 
     def _advanced(self, count: int) -> None:
@@ -191,8 +205,18 @@ class SimSession:
     def set_wob_n(self, wob_n: float) -> None:
         self.sim.set_inputs(w_app=self.scales.w_from_newton(wob_n))
 
+    def set_motor_torque_nm(self, torque_nm: float) -> None:
+        """The motor torque command of the torque mode (within the drive's limit)."""
+        self.sim.set_motor_torque_nm(torque_nm)
+
+    def set_top_drive(self, drive: TopDrivePhysical) -> None:
+        """New drive gains, limit and mode (SI) from the next period, without a bump; the
+        inertia is fixed for a session."""
+        self.sim.set_top_drive(drive.scaled(self.scales))
+
     def reset(self) -> None:
         """Model back to its initial state and setpoints; the simulated clock runs on."""
         self.sim.reset()
+        self.sensors.reset()
         self._snapshots.clear()
         self._bucket_end = self.next_index + self._bucket_samples

@@ -33,7 +33,13 @@ TELEMETRY_FIELDS = (
     "surface_torque_nm",
     "applied_wob_n",
     "hook_load_n",
-    "command_stamp_s",      # stamp of the drill/cmd/top_drive command in force (-1: none)
+    "motor_torque_nm",             # top-drive motor torque over the step
+    "speed_setpoint_rpm",          # top-drive speed setpoint in force (ramped)
+    # what the rig's surface sensors give (model.measurement: noise, quantum, delay)
+    "drive_speed_measured_rad_s",  # encoder
+    "motor_torque_measured_nm",    # the drive's torque estimate
+    "string_torque_measured_nm",   # torque sub at the quill
+    "command_stamp_s",             # stamp of the drill/cmd/top_drive command in force (-1: none)
 )
 TELEMETRY_INDEX = {name: i for i, name in enumerate(TELEMETRY_FIELDS)}
 N_FIELDS = len(TELEMETRY_FIELDS)
@@ -45,9 +51,13 @@ SOURCE_COLUMNS = {
     "wob_n": k.C_WOB, "tob_nm": k.C_TOB, "depth_of_cut_m": k.C_DOC, "wearflat_wob_n": k.C_WF,
     "mode": k.C_MODE, "surface_angle_rad": k.C_PHI_S, "surface_rpm": k.C_OMEGA_S,
     "surface_torque_nm": k.C_T_PIPE, "applied_wob_n": k.C_W_APP,
+    "motor_torque_nm": k.C_MOTOR_TORQUE, "speed_setpoint_rpm": k.C_OMEGA_REF,
 }
 _SOURCE_FIELDS = np.array([F[name] for name in SOURCE_COLUMNS], dtype=np.int64)
 _SOURCE_KERNEL_COLUMNS = np.array(list(SOURCE_COLUMNS.values()), dtype=np.int64)
+# The measured surface signals, in model.measurement.SIGNALS order, and their truth.
+MEASURED = [F["drive_speed_measured_rad_s"], F["motor_torque_measured_nm"],
+            F["string_torque_measured_nm"]]
 _DEPTH = F["bit_depth_m"]
 _ANGLES = [F["bit_angle_rad"], F["surface_angle_rad"]]
 
@@ -55,7 +65,8 @@ _ANGLES = [F["bit_angle_rad"], F["surface_angle_rad"]]
 def field_scales(scales: Scales) -> np.ndarray:
     """SI factor of each telemetry field (1 for sim time, mode and hook load), shape (F,)."""
     rpm = RPM_PER_RAD_S / scales.time_s
-    factors = {"bit_rpm": rpm, "surface_rpm": rpm, "bit_depth_m": scales.length_m,
+    factors = {"bit_rpm": rpm, "surface_rpm": rpm, "speed_setpoint_rpm": rpm,
+               "motor_torque_nm": scales.torque_nm, "bit_depth_m": scales.length_m,
                "rop_m_s": scales.length_m / scales.time_s, "depth_of_cut_m": scales.length_m,
                "wob_n": scales.force_n, "wearflat_wob_n": scales.force_n,
                "applied_wob_n": scales.force_n, "tob_nm": scales.torque_nm,
@@ -84,4 +95,12 @@ def si_rows(samples: np.ndarray, offsets: tuple[float, float], factors: np.ndarr
     out[:, F["sim_time_s"]] = sim_times_s
     out[:, F["hook_load_n"]] = submerged_weight_n - out[:, F["applied_wob_n"]]
     out[:, F["command_stamp_s"]] = command_stamp_s
+    out[:, MEASURED] = surface_truth(out)          # perfect sensors (see model.measurement)
     return out
+
+
+def surface_truth(rows: np.ndarray) -> np.ndarray:
+    """The true surface signals of SI rows, shape (rows, 3): drive speed rad/s, motor torque
+    N m, string torque at the quill N m (``model.measurement.SIGNALS`` order)."""
+    return np.column_stack([rows[:, F["surface_rpm"]] / RPM_PER_RAD_S,
+                            rows[:, F["motor_torque_nm"]], rows[:, F["surface_torque_nm"]]])

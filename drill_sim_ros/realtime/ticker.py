@@ -117,7 +117,6 @@ class Ticker:
             if self._stopping:
                 return
             if delay is not None and delay <= SHORT_WAIT_S:
-                if delay > 0:
-                    time.sleep(delay)           # a wake meanwhile waits for this tick
+                time.sleep(delay)   # 0 still yields the GIL; a wake meanwhile waits for this tick
             elif select.select(wait, (), (), delay)[0]:
                 os.read(fd, 4096)               # all the wakes so far at once

@@ -37,8 +37,13 @@ BIT_JOINT_VALUES = (("bit_angle_rad", False), ("bit_depth_m", False), ("bit_rpm"
 SURFACE_JOINT_VALUES = (("surface_angle_rad", False), ("bit_depth_m", False),
                         ("surface_rpm", True), ("rop_m_s", False),
                         ("surface_torque_nm", False), ("hook_load_n", False))
+MEASURED_JOINT_VALUES = (("surface_angle_rad", False), ("surface_angle_rad", False),
+                         ("drive_speed_measured_rad_s", False),
+                         ("drive_speed_measured_rad_s", False),
+                         ("motor_torque_measured_nm", False),
+                         ("string_torque_measured_nm", False))
 SAMPLE_TOPICS = (*FLOAT64_TOPICS, topics.BIT_MODE, topics.BIT_JOINT_STATES,
-                 topics.SURFACE_JOINT_STATES, topics.TELEMETRY)
+                 topics.SURFACE_JOINT_STATES, topics.SURFACE_MEASURED, topics.TELEMETRY)
 TELEMETRY_LABEL = ",".join(TELEMETRY_FIELDS)
 
 _MODE = F["mode"]
@@ -54,7 +59,9 @@ def _layouts() -> dict[str, tuple[Layout, list[tuple[str, bool]]]]:
     out[topics.BIT_MODE] = (uint8_layout(), [])
     for topic, names, values in ((topics.BIT_JOINT_STATES, topics.BIT_JOINTS, BIT_JOINT_VALUES),
                                  (topics.SURFACE_JOINT_STATES, topics.SURFACE_JOINTS,
-                                  SURFACE_JOINT_VALUES)):
+                                  SURFACE_JOINT_VALUES),
+                                 (topics.SURFACE_MEASURED, topics.MEASURED_JOINTS,
+                                  MEASURED_JOINT_VALUES)):
         out[topic] = (joint_state_layout(names), list(values))
     out[topics.TELEMETRY] = (multi_array_layout(TELEMETRY_LABEL, N_FIELDS),
                              [(name, False) for name in TELEMETRY_FIELDS])

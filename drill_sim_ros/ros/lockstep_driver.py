@@ -3,9 +3,10 @@
 The sim (``lockstep:=true -p lockstep_trigger:=command``) advances exactly one period per
 message on ``drill/cmd/top_drive`` and then publishes the state at the end of that period.
 :class:`LockstepDriver` closes the loop: for every telemetry sample it receives it calls
-``policy(row)`` (one SI row, ``TELEMETRY_FIELDS`` order) and publishes the command, stamped
-with the sample's stamp. Its first command (when the sim's subscription matches) reacts to
-the sim's initial state at t = 0, so the loop starts whether or not the t = 0 sample arrived.
+``policy(row)`` (one SI row, ``TELEMETRY_FIELDS`` order) and publishes the :class:`Command`
+it returns, stamped with the sample's stamp. Its first command (when the sim's subscription
+matches) reacts to the sim's initial state at t = 0, so the loop starts whether or not the
+t = 0 sample arrived.
 Nothing is lost: both directions are reliable and deep, and each side waits for the other.
 """
 
@@ -13,6 +14,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -28,18 +30,29 @@ from drill_sim_ros.ros.messages import stamp
 
 LOCKSTEP_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1000,
                           reliability=ReliabilityPolicy.RELIABLE)
-# A command: (top-drive speed setpoint rad/s or None, applied WOB N or None).
-Policy = Callable[[np.ndarray | None], tuple[float | None, float | None]]
 _TIME = TELEMETRY_INDEX["sim_time_s"]
 
 
-def top_drive_command(speed_rad_s: float | None, wob_n: float | None,
-                      reacts_to_ns: int) -> JointState:
-    """A drill/cmd/top_drive message; None (sent as NaN) commands nothing."""
+@dataclass(frozen=True)
+class Command:
+    """What one drill/cmd/top_drive message commands; None commands nothing."""
+
+    speed_rad_s: float | None = None       # speed setpoint (kinematic and speed modes)
+    motor_torque_nm: float | None = None   # motor torque (torque mode)
+    wob_n: float | None = None             # applied WOB
+
+
+# A policy: the sample it reacts to (None: the initial state at t = 0) -> the command.
+Policy = Callable[[np.ndarray | None], Command]
+
+
+def top_drive_command(command: Command, reacts_to_ns: int) -> JointState:
+    """The drill/cmd/top_drive message of ``command`` (None is sent as NaN)."""
     def value(x: float | None) -> float:
         return math.nan if x is None else float(x)
-    msg = JointState(name=list(topics.COMMAND_JOINTS), velocity=[value(speed_rad_s), math.nan],
-                     effort=[math.nan, value(wob_n)])
+    msg = JointState(name=list(topics.COMMAND_JOINTS),
+                     velocity=[value(command.speed_rad_s), math.nan],
+                     effort=[value(command.motor_torque_nm), value(command.wob_n)])
     msg.header.stamp = stamp(reacts_to_ns)
     return msg
 
@@ -85,7 +98,7 @@ class LockstepDriver(Node):
             self._command(row, stamp_ns)
 
     def _command(self, row: np.ndarray | None, stamp_ns: int) -> None:
-        speed_rad_s, wob_n = self._policy(row)
+        command = self._policy(row)
         self._reacted_ns = stamp_ns
-        self._pub.publish(top_drive_command(speed_rad_s, wob_n, stamp_ns))
+        self._pub.publish(top_drive_command(command, stamp_ns))
         self.sent += 1

@@ -16,8 +16,10 @@ from typing import Any
 
 from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
 
-from drill_sim_ros.model.params import structure
+from drill_sim_ros.model.measurement import MAX_DELAY_PERIODS, SIGNALS
+from drill_sim_ros.model.params import UNIT_SCALES, structure
 from drill_sim_ros.model.presets import DEFAULT_PRESET, Preset
+from drill_sim_ros.model.top_drive import MODES, TopDrive, TopDrivePhysical
 
 GRAVITY_M_S2 = 9.80665
 MUD_DENSITY_KG_M3 = 1200.0
@@ -73,6 +75,39 @@ def _max_wob_n(preset: Preset | None) -> float:
     return max(10.0 * _preset_wob_n(preset), 1.0)
 
 
+def _drive(preset: Preset | None) -> TopDrivePhysical:
+    return TopDrive().physical(UNIT_SCALES) if preset is None else \
+        preset.top_drive.physical(preset.scales)
+
+
+def _drive_value(name: str) -> Callable[[Preset | None], Any]:
+    """The preset's top-drive value ``name`` (SI; an unlimited torque as 0)."""
+    def default(preset: Preset | None) -> Any:
+        value = getattr(_drive(preset), name)
+        return 0.0 if name == "max_torque_nm" and math.isinf(value) else value
+    return default
+
+
+def _sensor_specs() -> tuple[ParamSpec, ...]:
+    """sensors.<signal>.noise_std / quantum / delay_periods for each surface signal."""
+    out = []
+    for signal in SIGNALS:
+        unit = "rad/s" if signal.endswith("rad_s") else "N m"
+        out += [
+            ParamSpec(f"sensors.{signal}.noise_std", DOUBLE, 0.0,
+                      f"Gaussian noise (standard deviation) of the measured {signal} [{unit}];"
+                      " 0 = none. Seeded by sensors.seed: lockstep stays bit-identical.",
+                      0.0, 1e9, read_only=True),
+            ParamSpec(f"sensors.{signal}.quantum", DOUBLE, 0.0,
+                      f"Quantisation step of the measured {signal} [{unit}]; 0 = none.",
+                      0.0, 1e9, read_only=True),
+            ParamSpec(f"sensors.{signal}.delay_periods", INTEGER, 0,
+                      f"Delay of the measured {signal} in whole publish periods.",
+                      0, MAX_DELAY_PERIODS, read_only=True),
+        ]
+    return tuple(out)
+
+
 SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("model.preset", STRING, DEFAULT_PRESET,
               "Preset name (config/presets/<name>.yaml) or path to a preset YAML file.",
@@ -117,6 +152,23 @@ SPECS: tuple[ParamSpec, ...] = (
               "What advances one period in lockstep: 'service' (a ~/step call) or 'command' "
               "(each message on drill/cmd/top_drive, applied first).",
               choices=("service", "command")),
+    ParamSpec("top_drive.mode", STRING, _drive_value("mode"),
+              "kinematic: the paper's imposed speed; speed: the drive's inertia turned by its "
+              "PI speed loop; torque: the motor torque commanded on drill/cmd/top_drive. "
+              "Switching keeps the drive's speed and torque (no bump).",
+              choices=MODES),
+    ParamSpec("top_drive.inertia_kg_m2", DOUBLE, _drive_value("inertia_kg_m2"),
+              "Drive inertia J referred to the quill [kg m^2] (default: the preset's).",
+              1e-9, 1e9, read_only=True),
+    ParamSpec("top_drive.kp_nm_s", DOUBLE, _drive_value("kp_nm_s"),
+              "Speed loop proportional gain [N m per rad/s] (speed mode).", 0.0, 1e12),
+    ParamSpec("top_drive.ki_nm", DOUBLE, _drive_value("ki_nm"),
+              "Speed loop integral gain [N m per rad] (speed mode).", 0.0, 1e12),
+    ParamSpec("top_drive.max_torque_nm", DOUBLE, _drive_value("max_torque_nm"),
+              "Motor torque limit +-[N m] (speed and torque modes); 0 = none.", 0.0, 1e12),
+    ParamSpec("sensors.seed", INTEGER, 0, "Seed of the surface sensors' noise.", 0,
+              2**31 - 1, read_only=True),
+    *_sensor_specs(),
     ParamSpec("run_seconds", DOUBLE, 0.0,
               "Exit cleanly after this many wall seconds; 0 = run until stopped.", 0.0, 1e9,
               read_only=True),

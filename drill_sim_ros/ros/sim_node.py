@@ -41,10 +41,12 @@ from std_srvs.srv import SetBool, Trigger
 
 from drill_sim_ros import topics
 from drill_sim_ros.model.errors import DrillSimError, NumericalFault
+from drill_sim_ros.model.measurement import SIGNALS, RigSensors, SignalSpec
 from drill_sim_ros.model.params import RPM_PER_RAD_S
 from drill_sim_ros.model.presets import load_preset
 from drill_sim_ros.model.session import Block, SessionConfig, SimSession
 from drill_sim_ros.model.telemetry import MODE_NAMES, TELEMETRY_INDEX
+from drill_sim_ros.model.top_drive import TopDrivePhysical
 from drill_sim_ros.realtime.pacing import Pacer, RateMeter
 from drill_sim_ros.realtime.ticker import HandoffLock, Ticker
 from drill_sim_ros.ros import messages
@@ -84,17 +86,37 @@ def session_config(values: dict[str, Any], preset: Any) -> SessionConfig:
         surface_rpm=values["model.surface_rpm"],
         top_drive_accel_rpm_s=values["limits.top_drive_accel_rpm_s"],
         wob_rate_n_s=values["limits.wob_rate_n_s"], window_s=values["diagnostics.window_s"],
-        submerged_weight_n=values["model.submerged_string_weight_n"])
+        submerged_weight_n=values["model.submerged_string_weight_n"],
+        top_drive=top_drive(values), sensors=rig_sensors(values))
 
 
-def clamp_command(value: float, limit: float, unit: str) -> tuple[float | None, str | None]:
-    """A setpoint command within [0, ``limit``]: (the value to apply, None) when it is inside,
-    (the bound it saturates at, why) when it is finite and beyond, (None, why) when it is not
-    finite (rejected)."""
+def top_drive(values: dict[str, Any]) -> TopDrivePhysical:
+    """The drive of the ``top_drive.*`` parameters (a torque limit of 0: none)."""
+    limit = values["top_drive.max_torque_nm"]
+    return TopDrivePhysical(mode=values["top_drive.mode"],
+                            inertia_kg_m2=values["top_drive.inertia_kg_m2"],
+                            kp_nm_s=values["top_drive.kp_nm_s"], ki_nm=values["top_drive.ki_nm"],
+                            max_torque_nm=limit if limit > 0 else math.inf)
+
+
+def rig_sensors(values: dict[str, Any]) -> RigSensors:
+    """The surface sensors of the ``sensors.*`` parameters."""
+    specs = {signal: SignalSpec(noise_std=values[f"sensors.{signal}.noise_std"],
+                                quantum=values[f"sensors.{signal}.quantum"],
+                                delay_periods=values[f"sensors.{signal}.delay_periods"])
+             for signal in SIGNALS}
+    return RigSensors(specs, seed=values["sensors.seed"])
+
+
+def clamp_command(value: float, limit: float, unit: str, low: float = 0.0
+                  ) -> tuple[float | None, str | None]:
+    """A setpoint command within [``low``, ``limit``]: (the value to apply, None) when it is
+    inside, (the bound it saturates at, why) when it is finite and beyond, (None, why) when
+    it is not finite (rejected)."""
     if not math.isfinite(value):
         return None, f"{value!r} is not finite"
-    if value < 0.0:
-        return 0.0, f"{value:.10g} {unit} is below 0 {unit}"
+    if value < low:
+        return low, f"{value:.10g} {unit} is below {low:.10g} {unit}"
     if value > limit:
         return limit, f"{value:.10g} {unit} exceeds the limit {limit:.10g} {unit}"
     return value, None
@@ -246,7 +268,11 @@ class SimNode(Node):
             if self._session is None:
                 return
             self._session.submerged_weight_n = self._values["model.submerged_string_weight_n"]
-            if any(p.name in ("real_time_factor", "lockstep") for p in params):
+            names = {p.name for p in params}
+            if names & {"top_drive.kp_nm_s", "top_drive.ki_nm", "top_drive.max_torque_nm",
+                        "top_drive.mode"}:
+                self._session.set_top_drive(top_drive(self._values))   # between runs: no bump
+            if names & {"real_time_factor", "lockstep"}:
                 self._restart_ticks()
 
     # ---- pacing and the one tick path --------------------------------------------------
@@ -342,11 +368,13 @@ class SimNode(Node):
             for (joint, interface), value in joint_commands(msg).items():
                 if (joint, interface) == ("top_drive", "velocity"):
                     self._set_surface_rpm(topic, value * RPM_PER_RAD_S)
+                elif (joint, interface) == ("top_drive", "effort"):
+                    self._set_motor_torque_nm(topic, value)
                 elif (joint, interface) == ("hook", "effort"):
                     self._set_wob_n(topic, value)
                 else:
                     self._reject(topic, f"joint {joint!r} takes no {interface} command "
-                                        "(top_drive: velocity; hook: effort)")
+                                        "(top_drive: velocity, effort; hook: effort)")
             self._session.command_stamp_ns = stamp_ns(msg.header.stamp)
             self._record_command(topic, raw)
             if self._command_steps():
@@ -367,10 +395,19 @@ class SimNode(Node):
         if value is not None:
             self._session.set_wob_n(value)
 
-    def _clamped(self, topic: str, value: float, limit: str, unit: str) -> float | None:
-        """The setpoint to apply at the next step, clamped to its limits (counted as
-        saturated), or None for a non-finite one (rejected; the last setpoint stays)."""
-        applied, problem = clamp_command(value, self._values[limit], unit)
+    def _set_motor_torque_nm(self, topic: str, torque_nm: float) -> None:
+        """The torque mode's motor torque, within +-top_drive.max_torque_nm."""
+        limit = self._values["top_drive.max_torque_nm"] or math.inf
+        value = self._clamped(topic, torque_nm, limit, "N m", low=-limit)
+        if value is not None:
+            self._session.set_motor_torque_nm(value)
+
+    def _clamped(self, topic: str, value: float, limit: str | float, unit: str,
+                 low: float = 0.0) -> float | None:
+        """The setpoint to apply at the next step, clamped to [``low``, the limit] (counted
+        as saturated), or None for a non-finite one (rejected; the last setpoint stays)."""
+        high = self._values[limit] if isinstance(limit, str) else limit
+        applied, problem = clamp_command(value, high, unit, low)
         if problem is None:
             return applied
         if applied is None:

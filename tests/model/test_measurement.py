@@ -8,9 +8,10 @@ import pytest
 
 from drill_sim_ros.model import kernel as k
 from drill_sim_ros.model.errors import ParameterError
-from drill_sim_ros.model.measurement import SIGNALS, RigSensors, SignalSpec, surface_truth
+from drill_sim_ros.model.measurement import SIGNALS, RigSensors, SignalSpec
 from drill_sim_ros.model.presets import load_preset
 from drill_sim_ros.model.simulator import SimConfig, Simulator
+from drill_sim_ros.model.telemetry import field_scales, si_rows, surface_truth
 
 
 def _truth(rows: int = 20_000) -> np.ndarray:
@@ -66,7 +67,8 @@ def test_surface_truth_of_the_field_preset_in_si() -> None:
     sim = Simulator(preset.params, SimConfig(dtau=preset.dtau), top_drive=preset.top_drive,
                     scales=preset.scales)
     rows = sim.advance(1000, every=100).data
-    truth = surface_truth(rows, preset.scales)
+    si = si_rows(rows, sim.offsets, field_scales(preset.scales), rows[:, k.C_TAU], 0.0)
+    truth = surface_truth(si)
     assert truth[0, 0] == pytest.approx(2 * np.pi)               # 60 rpm
     assert truth[0, 2] == pytest.approx(sim.scales.tob_nm(rows[0, k.C_T_PIPE]))
     assert truth[0, 1] == pytest.approx(truth[0, 2])             # on the trivial solution

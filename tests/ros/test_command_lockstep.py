@@ -24,7 +24,7 @@ from mcap_ros2.decoder import DecoderFactory
 from drill_sim_ros import topics
 from drill_sim_ros.model.params import RPM_PER_RAD_S
 from drill_sim_ros.model.presets import load_preset
-from drill_sim_ros.ros.lockstep_driver import LockstepDriver
+from drill_sim_ros.ros.lockstep_driver import Command, LockstepDriver
 from tests.archive.helpers import running, stop
 from tests.ros.harness import ros_context
 
@@ -38,33 +38,43 @@ WOB0 = PRESET.physical.applied_wob_n
 
 def sim_command(*params: str, namespace: str = "") -> list[str]:
     args = ["lockstep:=true", "lockstep_trigger:=command", "status_line:=false",
-            "publish_clock:=false", *params]
+            "publish_clock:=false", "top_drive.mode:=kinematic", *params]
     remap = ["-r", f"__ns:={namespace}"] if namespace else []
     return ["sim_node", "--ros-args", *remap, *[a for p in args for a in ("-p", p)]]
 
 
-def speed_schedule(row: np.ndarray | None) -> tuple[float | None, float | None]:
+def speed_schedule(row: np.ndarray | None) -> Command:
     """A deterministic policy of the sample it sees: the surface speed steps with time, and
     the WOB follows the bit speed (a controller-like dependence on the state)."""
     t_s = 0.0 if row is None else row[F["sim_time_s"]]
     rpm = RPM0 + (20.0 if math.floor(t_s / 0.5) % 2 else 0.0)
     wob = None if row is None else WOB0 * (1.0 + 0.001 * (row[F["bit_rpm"]] - RPM0))
-    return rpm / RPM_PER_RAD_S, wob
+    return Command(speed_rad_s=rpm / RPM_PER_RAD_S, wob_n=wob)
 
 
-def drive(periods: int, timeout_s: float, namespace: str = "") -> LockstepDriver:
+MAX_TORQUE_NM = 30_000.0
+
+
+def torque_schedule(row: np.ndarray | None) -> Command:
+    """Motor torque steps, one of them beyond the drive's limit of MAX_TORQUE_NM."""
+    t_s = 0.0 if row is None else row[F["sim_time_s"]]
+    return Command(motor_torque_nm=(8_000.0, 12_000.0, 45_000.0)[int(t_s / 0.2) % 3])
+
+
+def drive(periods: int, timeout_s: float, namespace: str = "",
+          policy=speed_schedule) -> LockstepDriver:
     with ros_context() as ros:
-        driver = ros.add(LockstepDriver(speed_schedule, periods, context=ros.context,
+        driver = ros.add(LockstepDriver(policy, periods, context=ros.context,
                                         namespace=namespace or None))
         assert ros.spin_until(lambda: driver.done, timeout_s), (len(driver.rows), driver.sent)
         return driver
 
 
 def run_sim(tmp_path: Path, name: str, periods: int, timeout_s: float,
-            *params: str) -> LockstepDriver:
+            *params: str, policy=speed_schedule) -> LockstepDriver:
     log = tmp_path / f"{name}.log"
     with running(sim_command(*params), log) as sim:
-        driver = drive(periods, timeout_s)
+        driver = drive(periods, timeout_s, policy=policy)
         assert stop(sim, signal.SIGINT) == 0, log.read_text()
     return driver
 
@@ -80,11 +90,31 @@ def test_one_period_of_latency_and_identical_bytes_run_after_run(tmp_path):
     # sample k ran under the command that reacted to sample k - 1 (the first: t = 0)
     np.testing.assert_allclose(rows[:, F["command_stamp_s"]], times - PERIOD_S, atol=1e-12)
     # ... and already shows its effect: the surface speed commanded from the previous sample
-    commanded_rpm = [speed_schedule(None)[0]] + [speed_schedule(r)[0] for r in rows[:-1]]
+    commands = [speed_schedule(None)] + [speed_schedule(r) for r in rows[:-1]]
     np.testing.assert_allclose(rows[:, F["surface_rpm"]],
-                               np.array(commanded_rpm) * RPM_PER_RAD_S, rtol=1e-12)
-    commanded_wob = [WOB0] + [speed_schedule(r)[1] for r in rows[:-1]]
+                               np.array([c.speed_rad_s for c in commands]) * RPM_PER_RAD_S,
+                               rtol=1e-12)
+    commanded_wob = [WOB0] + [c.wob_n for c in commands[1:]]
     np.testing.assert_allclose(rows[:, F["applied_wob_n"]], commanded_wob, rtol=1e-12)
+
+
+def test_torque_mode_applies_the_commanded_motor_torque_within_the_limit(tmp_path):
+    periods = 100
+    driver = run_sim(tmp_path, "torque", periods, 60.0, "top_drive.mode:=torque",
+                     f"top_drive.max_torque_nm:={MAX_TORQUE_NM}", policy=torque_schedule)
+    rows = np.array(driver.rows)
+    commanded = np.array([torque_schedule(None).motor_torque_nm]
+                         + [torque_schedule(r).motor_torque_nm for r in rows[:-1]])
+    np.testing.assert_allclose(rows[:, F["motor_torque_nm"]],
+                               np.minimum(commanded, MAX_TORQUE_NM), rtol=1e-12)
+    assert (commanded > MAX_TORQUE_NM).any() and (commanded < MAX_TORQUE_NM).any()
+    # the drive is an inertia: its speed changes, as J dOmega/dt = motor - string torque says
+    j_kg_m2 = PRESET.top_drive.physical(PRESET.scales).inertia_kg_m2
+    speed = rows[:, F["surface_rpm"]] / RPM_PER_RAD_S
+    net = rows[1:, F["motor_torque_nm"]] - 0.5 * (rows[1:, F["surface_torque_nm"]]
+                                                   + rows[:-1, F["surface_torque_nm"]])
+    np.testing.assert_allclose(np.diff(speed) * j_kg_m2 / PERIOD_S, net, rtol=0.05,
+                               atol=0.02 * MAX_TORQUE_NM)
 
 
 def test_ten_thousand_periods_lose_no_command_and_the_recording_holds_them(tmp_path):

@@ -17,7 +17,7 @@ from drill_sim_ros.ros.frame import SampleFrame
 F = topics.TELEMETRY_INDEX
 TIMES_NS = np.array([0, 10_000_000, 123_456_789_012, 5_000_000_000], dtype=np.int64)
 PADDED = (topics.BIT_MODE, topics.BIT_JOINT_STATES, topics.SURFACE_JOINT_STATES,
-          topics.TELEMETRY)
+          topics.SURFACE_MEASURED, topics.TELEMETRY)
 
 
 def random_rows(rows: int, seed: int = 3) -> np.ndarray:
@@ -60,6 +60,10 @@ def expected_messages(v: np.ndarray, time_ns: int) -> dict[str, object]:
             v[F["surface_angle_rad"]], v[F["bit_depth_m"]],
             v[F["surface_rpm"]] / RPM_PER_RAD_S, v[F["rop_m_s"]], v[F["surface_torque_nm"]],
             v[F["hook_load_n"]]]),
+        topics.SURFACE_MEASURED: joint_state(topics.MEASURED_JOINTS, sec, nanosec, [
+            v[F["surface_angle_rad"]], v[F["surface_angle_rad"]],
+            v[F["drive_speed_measured_rad_s"]], v[F["drive_speed_measured_rad_s"]],
+            v[F["motor_torque_measured_nm"]], v[F["string_torque_measured_nm"]]]),
         topics.TELEMETRY: telemetry,
         topics.CLOCK: clock,
     }

@@ -25,7 +25,7 @@ def lockstep_run() -> dict[str, list[bytes]]:
     """One run in a fresh context: STEPS steps with COMMANDS; serialized messages per topic."""
     with ros_context() as ros:
         node = SimNode(context=ros.context, parameter_overrides=overrides(
-            lockstep=True, status_line=False))
+            lockstep=True, status_line=False, top_drive__mode="kinematic"))
         node.start()
         ros.add(node)
         probe = ros.add(Probe(ros.context, RECORDED, raw=True))

@@ -42,6 +42,9 @@ def ros():
 
 def start_node(ros: Ros, **params) -> SimNode:
     params.setdefault("status_line", False)
+    # the paper's imposed top-drive speed unless a test asks for the drive (the field preset's
+    # default is the speed loop), so commanded speeds show exactly in surface_rpm
+    params.setdefault("top_drive__mode", "kinematic")
     node = SimNode(context=ros.context, parameter_overrides=overrides(**params))
     node.start()
     return ros.add(node)
@@ -254,11 +257,16 @@ def test_bad_parameters_are_rejected_with_a_reason(ros):
                                ("real_time_factor", math.nan, ("real_time_factor",)),
                                ("real_time_factor", "fast", ("real_time_factor", "number")),
                                ("limits.max_wob_n", -5.0, ("limits.max_wob_n",)),
-                               ("publish_rate_hz", 50.0, ("read-only", "publish_rate_hz"))]:
+                               ("publish_rate_hz", 50.0, ("read-only", "publish_rate_hz")),
+                               ("top_drive.mode", "fast", ("top_drive.mode", "kinematic",
+                                                           "speed", "torque")),
+                               ("lockstep_trigger", "clock", ("service", "command"))]:
         ok, reason = set_parameter(ros, probe, name, value)
         assert not ok, (name, value)
         assert all(w in reason for w in words), reason
     ok, reason = set_parameter(ros, probe, "real_time_factor", 2)    # an integer is a number
+    assert ok, reason
+    ok, reason = set_parameter(ros, probe, "top_drive.mode", "speed")  # at runtime
     assert ok, reason
     request = GetParameters.Request(names=["real_time_factor", "publish_rate_hz"])
     values = ros.call(probe, GetParameters, f"{NODE}/get_parameters", request).values
