@@ -164,6 +164,7 @@ def simulate(spec: RunSpec, trace: TextIO | None = None, trace_every: int = 100,
     sim = Simulator(spec.params, SimConfig(dtau=spec.dtau, n_nodes=spec.n_nodes,
                                            method=spec.method, tau_avg=spec.average_from),
                     perturb_v=spec.perturb_v, perturb_omega=spec.perturb_omega)
+    root = analysis.rightmost_root(spec.params)     # before the run, so it cannot lose it
     sim.advance(0, every=1)               # compile (or load from cache) outside the timing
     total = sim.steps_for(spec.tau_end)
     writer = _trace_writer(trace, spec) if trace else None
@@ -177,17 +178,17 @@ def simulate(spec: RunSpec, trace: TextIO | None = None, trace_every: int = 100,
             _write_trace(writer, samples, spec)
         bar.update(sim.steps)
     bar.close()
-    return summarize(spec, sim, kernel_seconds)
+    return summarize(spec, sim, kernel_seconds, root)
 
 
-def summarize(spec: RunSpec, sim: Simulator, kernel_seconds: float) -> dict[str, Any]:
-    """The run's figures: events, cycle averages (eqs. 42-48), stability (App. B)."""
+def summarize(spec: RunSpec, sim: Simulator, kernel_seconds: float,
+              root: complex) -> dict[str, Any]:
+    """The run's figures: events, cycle averages (eqs. 42-48), stability (App. B: ``root``)."""
     p = spec.params
     acc = sim.accumulators
     avg = analysis.cycle_averages(p, acc)
     stick, bounce = analysis.first_event_tau(acc)
     triv = analysis.trivial_solution(p)
-    root = analysis.rightmost_root(p)
     ssi = (avg.omega_max - avg.omega_min) / (2.0 * avg.mean_omega) if avg.mean_omega else None
     out: dict[str, Any] = {
         "params": {g: getattr(p, g) for g in GROUPS},
