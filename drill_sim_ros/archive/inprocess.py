@@ -116,24 +116,20 @@ class InProcessRecorder:
         return self._close_error or self._writer.failure
 
     def close(self) -> bool:
-        """Drain the queue and finish the file(s); True if complete. Idempotent, never raises.
-
-        Logs one line: the counts, or why the recording is incomplete.
-        """
+        """Drain the queue and finish the file(s); True if complete. Idempotent, never raises
+        (the caller logs :meth:`summary`)."""
         if not self._closed:
             self._closed = True
             try:
                 self._writer.close()
             except ArchiveError as exc:
                 self._close_error = str(exc)
-            self._log_end()
         return self.error is None
 
-    def _log_end(self) -> None:
+    def summary(self) -> str:
+        """One line: the counts, or why the recording is incomplete."""
         files = ", ".join(self.paths)
         if self.error is None:
-            _log.info("%s: recorded %d messages to %s (%d dropped)",
-                      self.node_name, self.written, files, self.dropped)
-        else:
-            _log.error("%s: recording incomplete: %s; %d messages in %s, %d lost",
-                       self.node_name, self.error, self.written, files, self.dropped)
+            return f"recorded {self.written} messages to {files} ({self.dropped} dropped)"
+        return (f"recording incomplete: {self.error}; {self.written} messages kept in "
+                f"{files}, {self.dropped} lost")

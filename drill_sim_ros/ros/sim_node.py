@@ -19,7 +19,6 @@ import signal
 import sys
 import time
 from collections.abc import Callable
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -39,14 +38,21 @@ from std_msgs.msg import Float64
 from std_srvs.srv import SetBool, Trigger
 
 from drill_sim_ros import topics
-from drill_sim_ros.model.errors import DrillSimError, NumericalFault
+from drill_sim_ros.model.errors import DrillSimError, NumericalFault, ParameterError
 from drill_sim_ros.model.presets import load_preset
 from drill_sim_ros.ros import messages
 from drill_sim_ros.ros.conversions import stamp
 from drill_sim_ros.ros.engine import EXIT_WAIT, R_SAMPLES, TickLoop
 from drill_sim_ros.ros.frame import SAMPLE_TOPICS, FramePublisher, SampleFrame
 from drill_sim_ros.ros.pacing import Pacer, RateMeter, lateness_percentiles_ms
-from drill_sim_ros.ros.parameters import SPEC_BY_NAME, coerce, declare_all, validate
+from drill_sim_ros.ros.parameters import (
+    SPEC_BY_NAME,
+    coerce,
+    declare_all,
+    init_ros,
+    recording_options,
+    validate,
+)
 from drill_sim_ros.ros.session import SessionConfig, SimSession
 from drill_sim_ros.ros.status_line import StatusLine, format_status
 from drill_sim_ros.ros.ticker import SHORT_WAIT_S, HandoffLock, Ticker
@@ -86,9 +92,9 @@ def command_problem(value: float, limit: float, unit: str) -> str | None:
     if not math.isfinite(value):
         return f"{value!r} is not finite"
     if value < 0.0:
-        return f"{value:g} {unit} is negative"
+        return f"{value!r} {unit} is negative"
     if value > limit:
-        return f"{value:g} {unit} exceeds the limit {limit:g} {unit}"
+        return f"{value!r} {unit} exceeds the limit {limit!r} {unit}"
     return None
 
 
@@ -108,6 +114,7 @@ class SimNode(Node):
         self._paused = False
         self._closing = False
         self._fault: str | None = None
+        self.recording_failed = False
         self.rejected_commands = 0
         self._last_row: np.ndarray | None = None     # SI, TELEMETRY_FIELDS; lock held
         self._pubs = {t: self.create_publisher(messages.type_of(t), t, self._qos(t),
@@ -159,19 +166,16 @@ class SimNode(Node):
         return CLOCK_QOS if topic in (topics.CLOCK, topics.DIAGNOSTICS) else DATA_QOS
 
     def _open_recorder(self, path: str) -> Any:
-        """The in-process MCAP recorder of ``record.path`` (None when off or unavailable)."""
+        """The in-process MCAP recorder of ``record.path`` (None when off). An existing or
+        unwritable path raises one ArchiveError line: the node does not start."""
         if not path:
             return None
-        try:
-            from drill_sim_ros.archive.inprocess import InProcessRecorder
-            Path(path).parent.mkdir(parents=True, exist_ok=True)
-            recorder = InProcessRecorder(path, node_name=topics.NODE_NAME,
-                                         metadata=self._run_metadata())
-            for topic in self._pubs:
-                recorder.add_topic(topic, topics.MSG_TYPES[topic], self._qos(topic))
-        except Exception as exc:  # recording is optional: keep simulating
-            self.get_logger().error(f"recording to {path!r} is off: {exc}")
-            return None
+        from drill_sim_ros.archive.inprocess import InProcessRecorder
+        recorder = InProcessRecorder(path, node_name=topics.NODE_NAME,
+                                     metadata=self._run_metadata(),
+                                     **recording_options(self._values))
+        for topic in self._pubs:
+            recorder.add_topic(topic, topics.MSG_TYPES[topic], self._qos(topic))
         self.get_logger().info(f"recording to {path}")
         return recorder
 
@@ -412,6 +416,7 @@ class SimNode(Node):
             "overruns": self._pacer.overruns, "lateness_ns": self._pacer.lateness_ns(),
             "rejected": self.rejected_commands, "dropped": self._recorder_count("dropped"),
             "written": self._recorder_count("written"), "severity": sev,
+            "record_error": None if self._recorder is None else self._recorder.error,
             "stick_fraction": stick_fraction,
             "mode": "none" if row is None else topics.MODE_NAMES[
                 int(row[topics.TELEMETRY_INDEX["mode"]])],
@@ -433,9 +438,12 @@ class SimNode(Node):
             "recorder_dropped": str(f["dropped"]),
             "recorder_written": str(f["written"]),
             "fault": f["fault"] or "",
+            "recorder_error": f["record_error"] or "",
         }
         if f["fault"] is not None:
             level, message = DiagnosticStatus.ERROR, f"numerical fault: {f['fault']}"
+        elif f["record_error"] is not None:
+            level, message = DiagnosticStatus.ERROR, f"recording stopped: {f['record_error']}"
         elif f["overruns"] or f["dropped"]:
             level, message = DiagnosticStatus.WARN, "overruns or recorder drops"
         else:
@@ -488,12 +496,11 @@ class SimNode(Node):
         finally:                            # whatever failed above, finish the recording
             if self._recorder is not None:
                 recorder, self._recorder = self._recorder, None
-                recorder.close()
+                self.recording_failed = not recorder.close()
                 # after Ctrl-C the context may be gone: a logger of no node has no /rosout
                 # publisher
-                rclpy.logging.get_logger("drill_sim_ros").info(
-                    f"recording closed: {recorder.written} messages written, "
-                    f"{recorder.dropped} dropped")
+                logger = rclpy.logging.get_logger("drill_sim_ros")
+                (logger.error if self.recording_failed else logger.info)(recorder.summary())
 
     def destroy_node(self) -> None:
         self.close()
@@ -502,7 +509,11 @@ class SimNode(Node):
 
 def main(args: list[str] | None = None) -> int:
     """Console script ``sim_node`` (``ros2 run drill_sim_ros sim_node``)."""
-    rclpy.init(args=args)
+    try:
+        init_ros(args)
+    except ParameterError as exc:
+        rclpy.logging.get_logger(topics.NODE_NAME).fatal(str(exc))
+        return 1
     # A closed terminal (SIGHUP) stops the node like Ctrl-C or SIGTERM, so the recording is
     # finished instead of cut off without its summary.
     signal.signal(signal.SIGHUP, lambda *_: rclpy.try_shutdown())
@@ -530,7 +541,7 @@ def main(args: list[str] | None = None) -> int:
         if node is not None:
             node.destroy_node()
         rclpy.try_shutdown()
-    return 0
+    return 1 if node is not None and node.recording_failed else 0
 
 
 if __name__ == "__main__":
