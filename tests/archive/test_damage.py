@@ -138,3 +138,24 @@ def test_reindex_api_refuses_non_ros_input(tmp_path) -> None:
     _json_mcap(path, "")
     with pytest.raises(Exception, match="not a ROS 2 recording"):
         reindex(path, tmp_path / "out.mcap")
+
+
+def test_replay_refuses_a_non_ros_file_and_an_offset_past_the_end(tmp_path,
+                                                                 recording) -> None:
+    path = tmp_path / "sensor.mcap"
+    _json_mcap(path, "")
+    done = _run("mcap_replay", str(path))
+    assert done.returncode == 2 and "not a ROS 2 recording" in done.stderr
+    done = _run("mcap_replay", str(recording), "--start-offset", "100")
+    assert done.returncode == 2 and "past the end" in done.stderr
+    assert len(done.stderr.strip().splitlines()) == 1
+
+
+@pytest.mark.ros
+def test_replay_of_a_damaged_chunk_goes_on_after_it(recording) -> None:
+    chunk = _chunks(recording)[DAMAGED_CHUNK]
+    damaged = _damaged_copy(recording, chunk.chunk_start_offset + chunk.chunk_length // 2)
+    done = _run("mcap_replay", str(damaged), "--rate", "100", "--delay", "0")
+    assert done.returncode == 1, done.stderr
+    assert "skipped bytes" in done.stderr and "Traceback" not in done.stderr
+    assert f"sent {len(_outside(chunk))} messages" in done.stderr
