@@ -30,7 +30,7 @@ from drill_sim_ros.archive.errors import ArchiveError
 from drill_sim_ros.archive.qos import qos_profiles_yaml, subscription_qos
 from drill_sim_ros.archive.ros_types import message_class
 from drill_sim_ros.archive.rotation import RotatingWriter
-from drill_sim_ros.archive.signals import shutdown_on_hangup
+from drill_sim_ros.archive.signals import interrupt_on_hangup
 from drill_sim_ros.terminal import StatusLine
 
 _log = logging.getLogger(__name__)
@@ -156,7 +156,7 @@ def main(args: list[str] | None = None) -> int:
         _log.error("%s", exc)
         return 2
     rclpy.init(args=argv)
-    shutdown_on_hangup(rclpy.try_shutdown)
+    interrupt_on_hangup()
     node = McapRecorder(sink, options.topics)
     failure = None
     try:

@@ -35,7 +35,7 @@ from drill_sim_ros.archive.pacing import Pacer
 from drill_sim_ros.archive.qos import replay_qos
 from drill_sim_ros.archive.reader import ArchiveReader, RecordedChannel
 from drill_sim_ros.archive.ros_types import message_class
-from drill_sim_ros.archive.signals import shutdown_on_hangup
+from drill_sim_ros.archive.signals import interrupt_on_hangup
 from drill_sim_ros.archive.writer import MESSAGE_ENCODING
 from drill_sim_ros.terminal import StatusLine
 
@@ -213,7 +213,7 @@ def main(args: list[str] | None = None) -> int:
         _log.error("%s", refusal)
         return 2
     rclpy.init(args=argv)
-    shutdown_on_hangup(rclpy.try_shutdown)
+    interrupt_on_hangup()
     sent = None
     try:
         sent = _replay(reader, extent, options)

@@ -2,16 +2,15 @@
 
 Outside rclpy (``mcap_reindex``, ``mcap_to_rerun``), :func:`stop_on_signals` turns SIGTERM and
 SIGHUP (a closed terminal) into the KeyboardInterrupt that SIGINT raises, so every tool
-finishes or discards its output the same way on all three. For rclpy tools, whose SIGINT and
-SIGTERM handlers shut the context down, :func:`shutdown_on_hangup` adds SIGHUP to them.
+finishes or discards its output the same way on all three. rclpy tools keep rclpy's SIGINT
+and SIGTERM handling and add :func:`interrupt_on_hangup`.
 """
 
 from __future__ import annotations
 
 import signal
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from contextlib import contextmanager
-from typing import Any
 
 STOP_SIGNALS = (signal.SIGTERM, signal.SIGHUP)
 
@@ -31,6 +30,6 @@ def stop_on_signals() -> Iterator[None]:
             signal.signal(sig, handler)
 
 
-def shutdown_on_hangup(shutdown: Callable[[], Any]) -> None:
-    """SIGHUP calls ``shutdown`` (e.g. ``rclpy.try_shutdown``), as rclpy does for SIGTERM."""
-    signal.signal(signal.SIGHUP, lambda *_: shutdown())
+def interrupt_on_hangup() -> None:
+    """SIGHUP raises KeyboardInterrupt, as SIGINT does under rclpy's handler (rclpy tools)."""
+    signal.signal(signal.SIGHUP, _interrupt)
