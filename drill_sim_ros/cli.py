@@ -195,6 +195,7 @@ def simulate(spec: RunSpec, trace: TextIO | None = None, trace_every: int = 100,
                     top_drive=spec.top_drive, scales=spec.scales)
     if spec.motor_torque is not None:
         sim.set_inputs(motor_torque=spec.motor_torque)
+    root = analysis.rightmost_root(spec.params)     # before the run, so it cannot lose it
     sim.advance(0, every=1)               # compile (or load from cache) outside the timing
     total = sim.steps_for(spec.tau_end)
     writer = _trace_writer(trace, spec) if trace else None
@@ -208,17 +209,17 @@ def simulate(spec: RunSpec, trace: TextIO | None = None, trace_every: int = 100,
             _write_trace(writer, samples, spec)
         bar.update(sim.steps)
     bar.close()
-    return summarize(spec, sim, kernel_seconds)
+    return summarize(spec, sim, kernel_seconds, root)
 
 
-def summarize(spec: RunSpec, sim: Simulator, kernel_seconds: float) -> dict[str, Any]:
-    """The run's figures: events, cycle averages (eqs. 42-48), stability (App. B)."""
+def summarize(spec: RunSpec, sim: Simulator, kernel_seconds: float,
+              root: complex) -> dict[str, Any]:
+    """The run's figures: events, cycle averages (eqs. 42-48), stability (App. B: ``root``)."""
     p = spec.params
     acc = sim.accumulators
     avg = analysis.cycle_averages(p, acc)
     stick, bounce = analysis.first_event_tau(acc)
     triv = analysis.trivial_solution(p)
-    root = analysis.rightmost_root(p)
     sev = analysis.severity_of(avg.omega_min, avg.omega_max, avg.mean_omega, p.omega0)
     out: dict[str, Any] = {
         "params": {g: getattr(p, g) for g in GROUPS},

@@ -94,3 +94,20 @@ def test_top_drive_options_and_the_field_preset_drive() -> None:
     bad = drill_sim("run", "--tau-end", "1", "--drive-inertia-ratio", "-1")
     assert bad.returncode == 2
     assert "'top_drive.inertia_ratio'" in bad.stderr and "Traceback" not in bad.stderr
+
+
+@pytest.mark.parametrize("omega0", ["0.05", "0"])
+def test_run_and_info_at_the_low_end_of_omega0(omega0: str, tmp_path: Path) -> None:
+    """A long (or infinite) delay once raised OverflowError after the whole run."""
+    run = drill_sim("run", "--omega0", omega0, "--tau-end", "2", "--json")
+    assert run.returncode == 0, run.stderr
+    assert "Traceback" not in run.stderr
+    result = json.loads(run.stdout)
+    assert result["steps"] > 0 and result["params"]["omega0"] == float(omega0)
+    assert (result["growth_rate"] is None) == (omega0 == "0")
+    preset = tmp_path / "slow.yaml"
+    preset.write_text("description: slow top drive\n"
+                      f"dimensionless: {{n: 6, psi: 50.0, beta: 0.3, lam: 5.0, w0: 7.0, "
+                      f"omega0: {omega0}}}\n")
+    info = drill_sim("info", str(preset))
+    assert info.returncode == 0 and "Traceback" not in info.stderr, info.stderr

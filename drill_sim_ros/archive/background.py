@@ -7,6 +7,10 @@ dropped only when ``capacity`` messages are already waiting, i.e. when the write
 about ``capacity / rate`` behind; every drop is counted. Channel registrations are never
 dropped. When the queue stays empty for ``idle_flush_s``, the open chunk is flushed, so the
 file on disk lags the producer by at most about one chunk.
+
+When the sink fails (a full disk), the thread stops, logs the reason once, and :attr:`error`
+holds it; from then on every message is counted as dropped. :attr:`written` counts only what
+the sink handed to the OS, never what it merely buffered.
 """
 
 from __future__ import annotations
@@ -33,6 +37,10 @@ class Sink(Protocol):
     def write(self, channel: Any, data: bytes, log_time_ns: int) -> None: ...
     def flush(self) -> None: ...
     def finish(self) -> None: ...
+    @property
+    def messages_on_disk(self) -> int: ...
+    @property
+    def message_count(self) -> int: ...
 
 
 class _Channel:
@@ -66,7 +74,6 @@ class BackgroundWriter:
         self._closed = False
         self.error: BaseException | None = None
         self.dropped = 0
-        self.written = 0
         self.max_backlog = 0
         self._thread = threading.Thread(target=self._run, name=name, daemon=True)
         self._thread.start()
@@ -92,13 +99,27 @@ class BackgroundWriter:
     def backlog(self) -> int:
         return len(self._items)
 
+    @property
+    def written(self) -> int:
+        """Messages the sink handed to the OS (a full disk stops this count)."""
+        return self._sink.messages_on_disk
+
+    @property
+    def failure(self) -> str | None:
+        """One line: why writing stopped, or None."""
+        return None if self.error is None else str(self.error)
+
     # ---- writer thread ------------------------------------------------------------------
     def _run(self) -> None:
         try:
             self._loop()
         except BaseException as exc:  # a disk error must not vanish with the thread
             self.error = exc
-            _log.error("MCAP writer thread failed: %s", exc)
+            # lost: what the sink buffered but never wrote, and everything still queued
+            self.dropped += self._sink.message_count - self._sink.messages_on_disk
+            self.dropped += sum(not isinstance(item, _Channel) for item in self._items)
+            self._items.clear()
+            _log.error("recording stopped: %s; every further message is dropped", exc)
 
     def _loop(self) -> None:
         while True:
@@ -122,12 +143,14 @@ class BackgroundWriter:
                 continue
             sink.write(handles[item[0]], item[1], item[2])
             count += 1
-        self.written += count
         return count > 0
 
     # ---- end ----------------------------------------------------------------------------
     def close(self) -> None:
-        """Write everything queued, then finish the sink. Idempotent."""
+        """Write everything queued, then finish the sink. Idempotent.
+
+        Raises one ArchiveError (after finishing what it can) if anything failed.
+        """
         if self._closed:
             return
         self._closing = True
@@ -136,6 +159,9 @@ class BackgroundWriter:
         self._closed = True
         if self._thread.is_alive():
             raise ArchiveError(f"the MCAP writer did not drain within {_CLOSE_TIMEOUT_S} s")
-        self._sink.finish()
+        try:
+            self._sink.finish()
+        except ArchiveError as exc:
+            self.error = self.error or exc
         if self.error is not None:
-            raise ArchiveError(f"MCAP writing failed: {self.error}") from self.error
+            raise ArchiveError(str(self.error)) from None

@@ -5,6 +5,14 @@ sized for about 100 s of the sim's default output; the writer thread sustains we
 sim's rate (see benchmarks/bench_mcap.py), so in lockstep and in free-run the queue never
 fills and ``close()`` drains every queued message. Only a writer that falls ~100 s behind
 drops messages, and each drop is counted in ``dropped``.
+
+The output is opened at construction under the archive's output policy: an existing file is
+refused (:class:`~drill_sim_ros.archive.output.OutputExistsError`) unless ``overwrite``, and
+an unwritable path raises :class:`~drill_sim_ros.archive.output.OutputError`, one line each.
+With ``split_size_bytes`` or ``split_duration_s`` the run goes into numbered files
+(``run_0000.mcap``, ...) like ``mcap_recorder``'s, each complete with the run metadata, so
+the summary kept in memory (about 1 kB per chunk) is bounded by the split. If writing fails
+(a full disk), :attr:`error` says why from then on, and :meth:`close` finishes what it can.
 """
 
 from __future__ import annotations
@@ -15,19 +23,21 @@ from rclpy.qos import QoSProfile
 from rclpy.serialization import serialize_message
 
 from drill_sim_ros.archive.background import DEFAULT_CAPACITY, BackgroundWriter
+from drill_sim_ros.archive.errors import ArchiveError
 from drill_sim_ros.archive.qos import qos_profiles_yaml
-from drill_sim_ros.archive.writer import Ros2McapWriter
+from drill_sim_ros.archive.rotation import RotatingWriter
 
 _log = logging.getLogger(__name__)
 RUN_METADATA = "drill_sim"
+OVERWRITE_PARAMETER_HINT = "-p record.overwrite:=true"
 
 
 class InProcessRecorder:
     """Records rclpy messages to ``path`` (MCAP, ROS 2 profile, zstd chunks).
 
     node_name: the publishing node, for the log; topics must be added before they are written.
-    metadata: written once as an MCAP metadata record named ``drill_sim`` (e.g. the preset,
-    so ``mcap_to_rerun`` picks the right scales).
+    metadata: written once per file as an MCAP metadata record named ``drill_sim`` (e.g. the
+    preset, so ``mcap_to_rerun`` picks the right scales).
     """
 
     def __init__(
@@ -37,16 +47,30 @@ class InProcessRecorder:
         capacity: int = DEFAULT_CAPACITY,
         compression: str = "zstd",
         metadata: dict[str, str] | None = None,
+        overwrite: bool = False,
+        split_size_bytes: int | None = None,
+        split_duration_s: float | None = None,
+        overwrite_hint: str = OVERWRITE_PARAMETER_HINT,
     ) -> None:
-        self.path = path
         self.node_name = node_name
         self._topics: set[str] = set()
-        writer = Ros2McapWriter(path, compression=compression)
-        if metadata:
-            writer.add_metadata(RUN_METADATA, {k: str(v) for k, v in metadata.items()})
-        self._writer = BackgroundWriter(writer, capacity, name="mcap-inprocess")
+        records = {RUN_METADATA: {k: str(v) for k, v in metadata.items()}} if metadata else {}
+        self._files = RotatingWriter(path, compression, split_size_bytes, split_duration_s,
+                                     overwrite=overwrite, metadata=records,
+                                     overwrite_hint=overwrite_hint)
+        self._writer = BackgroundWriter(self._files, capacity, name="mcap-inprocess")
         self._unknown_topic_drops = 0
         self._closed = False
+        self._close_error: str | None = None
+
+    @property
+    def path(self) -> str:
+        """The file being written (the latest part when splitting)."""
+        return str(self._files.paths[-1])
+
+    @property
+    def paths(self) -> list[str]:
+        return [str(p) for p in self._files.paths]
 
     def add_topic(self, topic: str, msg_type: str, qos_profile: QoSProfile | None = None) -> None:
         """Declare ``topic`` of type ``pkg/msg/Type`` with the QoS its publisher offers."""
@@ -72,12 +96,13 @@ class InProcessRecorder:
 
     @property
     def dropped(self) -> int:
-        """Messages not recorded: queue overflow, writes after close or to undeclared topics."""
+        """Messages not recorded: queue overflow, a failed disk, writes after close or to
+        undeclared topics."""
         return self._writer.dropped + self._unknown_topic_drops
 
     @property
     def written(self) -> int:
-        """Messages handed to the MCAP writer so far."""
+        """Messages in the file(s): handed to the OS, not merely buffered."""
         return self._writer.written
 
     @property
@@ -85,13 +110,26 @@ class InProcessRecorder:
         """Messages queued but not yet written."""
         return self._writer.backlog
 
-    def close(self) -> None:
-        """Drain the queue and finish the file with its summary. Idempotent."""
-        if self._closed:
-            return
-        self._closed = True
-        self._writer.close()
-        _log.info(
-            "%s: recorded %d messages to %s (%d dropped)",
-            self.node_name, self.written, self.path, self.dropped,
-        )
+    @property
+    def error(self) -> str | None:
+        """One line: why recording stopped (e.g. a full disk), None while it works."""
+        return self._close_error or self._writer.failure
+
+    def close(self) -> bool:
+        """Drain the queue and finish the file(s); True if complete. Idempotent, never raises
+        (the caller logs :meth:`summary`)."""
+        if not self._closed:
+            self._closed = True
+            try:
+                self._writer.close()
+            except ArchiveError as exc:
+                self._close_error = str(exc)
+        return self.error is None
+
+    def summary(self) -> str:
+        """One line: the counts, or why the recording is incomplete."""
+        files = ", ".join(self.paths)
+        if self.error is None:
+            return f"recorded {self.written} messages to {files} ({self.dropped} dropped)"
+        return (f"recording incomplete: {self.error}; {self.written} messages kept in "
+                f"{files}, {self.dropped} lost")

@@ -1,36 +1,32 @@
-"""Generator-based reading of MCAP archives, including truncated or summary-less files.
+"""Generator-based reading of MCAP archives, including damaged or summary-less files.
 
 Messages are read in file order from the data section, chunk by chunk, with chunk CRCs checked.
-A file cut short (a recorder killed with SIGKILL, a partial copy) yields every message up to
-its last complete chunk; then :attr:`ArchiveReader.problem` says what was wrong and a warning
-is logged. A missing file or one that is not MCAP raises at construction.
+A damaged chunk (flipped bytes) is skipped and reading goes on with the next intact one
+(:mod:`drill_sim_ros.archive.recovery`); a file cut short (a recorder killed with SIGKILL, a
+partial copy) yields every message up to its last complete chunk. Either way
+:attr:`ArchiveReader.problem` then says in one line what was skipped, and a warning is logged.
+A missing file or one that is not MCAP raises at construction.
 """
 
 from __future__ import annotations
 
 import logging
-import struct
+import mmap
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
-from typing import IO
 
-import zstandard
-from mcap.exceptions import EndOfFile, McapError
 from mcap.reader import make_reader
-from mcap.records import Channel, DataEnd, Footer, Message, Metadata, Schema
-from mcap.stream_reader import MAGIC_SIZE, StreamReader
+from mcap.records import Channel, DataEnd, Header, Message, Metadata, Schema
 from mcap.summary import Summary
 
 from drill_sim_ros.archive.errors import ArchiveNotFoundError, NotAnArchiveError
+from drill_sim_ros.archive.recovery import DAMAGE, MAGIC_SIZE, Damage, RecordScanner
 
 _log = logging.getLogger(__name__)
 
 MCAP_MAGIC = b"\x89MCAP0\r\n"
-# No record we write comes near this; a larger length field means corruption.
-RECORD_SIZE_LIMIT = 256 * 1024 * 1024
-# What a damaged data section raises inside mcap's parser (CRC errors are ValueErrors).
-_DAMAGE = (McapError, ValueError, struct.error, zstandard.ZstdError, RuntimeError, MemoryError)
+ROS2_PROFILE = "ros2"
 
 
 @dataclass(frozen=True)
@@ -60,21 +56,6 @@ class RecordedMessage:
         return self.channel.topic
 
 
-class _ExactStream:
-    """A file whose short reads raise EndOfFile, so a cut record is never half-parsed."""
-
-    def __init__(self, stream: IO[bytes]) -> None:
-        self._stream = stream
-        self.offset = 0
-
-    def read(self, size: int) -> bytes:
-        data = self._stream.read(size)
-        if len(data) < size:
-            raise EndOfFile()
-        self.offset += size
-        return data
-
-
 def _check_file(path: Path) -> None:
     if not path.exists():
         raise ArchiveNotFoundError(f"{path}: no such file")
@@ -88,7 +69,12 @@ def _check_file(path: Path) -> None:
 
 
 class ArchiveReader:
-    """Reads the messages, channels and metadata of one MCAP file (ROS 2 profile)."""
+    """Reads the messages, channels and metadata of one MCAP file (ROS 2 profile).
+
+    Damaged stretches (a cut, flipped bytes in a chunk) are skipped; after a pass over
+    :meth:`messages`, :attr:`damage` lists them, :attr:`problem` says in one line what was
+    skipped (chunks, messages, log times) and :attr:`lost_data` whether any message was.
+    """
 
     def __init__(self, path: str | Path) -> None:
         self.path = Path(path)
@@ -96,16 +82,26 @@ class ArchiveReader:
         self.size = self.path.stat().st_size
         self.channels: dict[int, RecordedChannel] = {}
         self.metadata: list[Metadata] = []
+        self.profile: str | None = None
+        self.message_encodings: dict[str, str] = {}     # topic -> channel message encoding
         self.problem: str | None = None
+        self.damage: list[Damage] = []
+        self.read_count = 0
         self._schemas: dict[int, Schema] = {}
+        self._summary_channels: dict[int, Channel] | None = None
 
     def summary(self) -> Summary | None:
         """The summary section (statistics, channels, chunk indexes), or None if absent."""
         try:
             with self.path.open("rb") as stream:
                 return make_reader(stream).get_summary()
-        except (*_DAMAGE, EOFError, OSError):
+        except (*DAMAGE, EOFError, OSError):
             return None
+
+    @property
+    def lost_data(self) -> bool:
+        """True if a damaged stretch of the data section was skipped (messages lost)."""
+        return any(not d.in_summary for d in self.damage)
 
     def messages(
         self, topic_filter: Callable[[str], bool] | None = None
@@ -113,7 +109,7 @@ class ArchiveReader:
         """Yield the stored messages in file order, optionally only topics passing the filter."""
         for record in self._data_records():
             if isinstance(record, Message):
-                channel = self.channels.get(record.channel_id)
+                channel = self._channel_of(record.channel_id)
                 if channel is None or (topic_filter and not topic_filter(channel.topic)):
                     continue
                 yield RecordedMessage(
@@ -122,43 +118,72 @@ class ArchiveReader:
 
     def _data_records(self) -> Iterator[object]:
         """Records of the data section; registers schemas/channels/metadata on the way."""
-        with self.path.open("rb") as raw:
-            stream = _ExactStream(raw)
-            reader = StreamReader(
-                stream, validate_crcs=True, record_size_limit=RECORD_SIZE_LIMIT
-            )
-            yield from self._guarded(reader, stream)
+        self.read_count, self.damage, self.problem = 0, [], None
+        if self.size <= MAGIC_SIZE:
+            self._report_end(False, False)
+            return
+        with self.path.open("rb") as raw, mmap.mmap(raw.fileno(), 0,
+                                                     access=mmap.ACCESS_READ) as data:
+            scanner = RecordScanner(data)
+            for record in scanner.records():
+                if isinstance(record, DataEnd) or scanner.scan.in_summary:
+                    continue
+                self._register(record)
+                if isinstance(record, Message):
+                    self.read_count += 1
+                yield record
+            self.damage = scanner.scan.damage
+            self._report_end(scanner.scan.footer, scanner.scan.in_summary)
 
-    def _guarded(self, reader: StreamReader, stream: _ExactStream) -> Iterator[object]:
-        count, in_summary = 0, False
-        try:
-            for record in reader.records:
-                if isinstance(record, Footer):
-                    return
-                in_summary = in_summary or isinstance(record, DataEnd)
-                if not in_summary:
-                    self._register(record)
-                    count += isinstance(record, Message)
-                    yield record
-            self._report(f"no footer after {count} messages")
-        except EndOfFile:
+    def _report_end(self, footer: bool, in_summary: bool) -> None:
+        parts = [f"skipped {d.describe()}" for d in self.damage if not d.at_end]
+        cut = next((d for d in self.damage if d.at_end), None)
+        if cut is not None or not footer:
             where = "in its summary section" if in_summary else "without a summary"
-            self._report(
-                f"truncated: ends at byte {self.size} {where} after {count} messages "
-                f"(recording interrupted? `mcap_reindex {self.path}` restores the summary)"
-            )
-        except _DAMAGE as exc:
-            self._report(f"corrupt near byte {stream.offset} after {count} messages: {exc}")
+            lost = "" if cut is None or cut.in_summary else f", losing {cut.describe()}"
+            parts.append(f"truncated: ends at byte {self.size} {where} after "
+                         f"{self.read_count} messages{lost}")
+        if not parts:
+            return
+        total = self._lost_by_statistics()
+        if total:
+            parts.append(f"{total} of the file's messages lost in all")
+        hint = "" if in_summary and not self.lost_data else \
+            f" (`mcap_reindex {self.path}` writes a complete copy of the rest)"
+        self.problem = f"{self.path}: " + "; ".join(parts) + hint
+        _log.warning("%s", self.problem)
 
-    def _report(self, problem: str) -> None:
-        self.problem = f"{self.path}: {problem}"
-        _log.warning("%s; the readable part was read", self.problem)
+    def _lost_by_statistics(self) -> int | None:
+        if not self.lost_data:
+            return None
+        summary = self.summary()
+        if summary is None or summary.statistics is None:
+            return None
+        return summary.statistics.message_count - self.read_count
+
+    def _channel_of(self, channel_id: int) -> RecordedChannel | None:
+        """A channel met in the data section, else the summary's copy (its chunk was lost)."""
+        channel = self.channels.get(channel_id)
+        if channel is None and self.damage is not None:
+            if self._summary_channels is None:
+                summary = self.summary()
+                self._summary_channels = {} if summary is None else dict(summary.channels)
+                for schema in ([] if summary is None else summary.schemas.values()):
+                    self._schemas.setdefault(schema.id, schema)
+            record = self._summary_channels.get(channel_id)
+            if record is not None:
+                self._register(record)
+                channel = self.channels[channel_id]
+        return channel
 
     def _register(self, record: object) -> None:
-        if isinstance(record, Schema):
+        if isinstance(record, Header):
+            self.profile = record.profile
+        elif isinstance(record, Schema):
             self._schemas[record.id] = record
         elif isinstance(record, Channel):
             self.channels[record.id] = self._channel(record)
+            self.message_encodings[record.topic] = record.message_encoding
         elif isinstance(record, Metadata):
             self.metadata.append(record)
 

@@ -6,7 +6,9 @@
 Topics matching REGEX (default: every /drill/... topic, /diagnostics and /clock) are found by
 discovery as they appear. Each is subscribed with raw=True, so the serialized CDR bytes go to
 the file unchanged, with a QoS compatible with what its publishers offer; the offered profiles
-are stored in the channel metadata. SIGINT or SIGTERM finishes the file with its summary.
+are stored in the channel metadata. SIGINT, SIGTERM or SIGHUP finishes the file with its
+summary. An existing output is refused unless ``--overwrite``. If the file cannot be written
+(a full disk), the recorder says so once, stops, and exits 1 with what it kept.
 """
 
 from __future__ import annotations
@@ -19,6 +21,7 @@ from collections.abc import Callable
 
 import rclpy
 from rclpy.executors import ExternalShutdownException
+from rclpy.impl.implementation_singleton import rclpy_implementation
 from rclpy.node import Node
 from rclpy.utilities import remove_ros_args
 
@@ -27,10 +30,12 @@ from drill_sim_ros.archive.errors import ArchiveError
 from drill_sim_ros.archive.qos import qos_profiles_yaml, subscription_qos
 from drill_sim_ros.archive.ros_types import message_class
 from drill_sim_ros.archive.rotation import RotatingWriter
+from drill_sim_ros.archive.signals import interrupt_on_hangup
 from drill_sim_ros.terminal import StatusLine
 
 _log = logging.getLogger(__name__)
 
+RCLError = rclpy_implementation.RCLError
 DEFAULT_TOPICS = r"/drill/.*|/diagnostics|/clock"
 DISCOVERY_PERIOD_S = 0.5
 STATUS_PERIOD_S = 0.5
@@ -46,6 +51,13 @@ class McapRecorder(Node):
         self._recorded: dict[str, object] = {}
         self._skipped: set[str] = set()
         self._discovery = self.create_timer(DISCOVERY_PERIOD_S, self.discover)
+        self._health = self.create_timer(DISCOVERY_PERIOD_S, self._stop_if_failed)
+
+    def _stop_if_failed(self) -> None:
+        """A recorder that cannot write stops (the writer thread has said why)."""
+        if self._sink.failure is not None:
+            self._health.cancel()
+            rclpy.try_shutdown(context=self.context)
 
     @property
     def topics(self) -> list[str]:
@@ -90,6 +102,8 @@ def _parse(argv: list[str]) -> argparse.Namespace:
     parser.add_argument("--topics", default=DEFAULT_TOPICS,
                         help=f"regex that topic names must match (default: {DEFAULT_TOPICS})")
     parser.add_argument("--compression", choices=("zstd", "none"), default="zstd")
+    parser.add_argument("--overwrite", action="store_true",
+                        help="replace an existing output file (default: refuse)")
     split = parser.add_mutually_exclusive_group()
     split.add_argument("--split-size", type=float, metavar="MB",
                        help="start a new file after MB megabytes")
@@ -107,7 +121,8 @@ def _parse(argv: list[str]) -> argparse.Namespace:
 
 def _open_sink(args: argparse.Namespace) -> tuple[RotatingWriter, BackgroundWriter]:
     split_bytes = int(args.split_size * 1e6) if args.split_size else None
-    files = RotatingWriter(args.output, args.compression, split_bytes, args.split_duration)
+    files = RotatingWriter(args.output, args.compression, split_bytes, args.split_duration,
+                           overwrite=args.overwrite)
     return files, BackgroundWriter(files, name="mcap-recorder")
 
 
@@ -124,6 +139,9 @@ def _spin(node: McapRecorder, files: RotatingWriter, sink: BackgroundWriter) -> 
         rclpy.spin(node)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
+    except RCLError:
+        if rclpy.ok():
+            raise                   # a shutdown while the wait set was built is a clean stop
     finally:
         status.close()
 
@@ -138,15 +156,25 @@ def main(args: list[str] | None = None) -> int:
         _log.error("%s", exc)
         return 2
     rclpy.init(args=argv)
+    interrupt_on_hangup()
     node = McapRecorder(sink, options.topics)
+    failure = None
     try:
         _spin(node, files, sink)
     finally:
         node.destroy_node()
         rclpy.try_shutdown()
-        sink.close()
+        try:
+            sink.close()
+        except ArchiveError as exc:
+            failure = str(exc)
+    where = ", ".join(str(p) for p in files.paths)
+    if failure is not None:
+        _log.error("recording incomplete: %s; %d messages kept in %s, %d lost", failure,
+                   sink.written, where, sink.dropped)
+        return 1
     _log.info("%d messages on %d topics in %s (%d dropped)", sink.written, len(node.topics),
-              ", ".join(str(p) for p in files.paths), sink.dropped)
+              where, sink.dropped)
     return 0
 
 

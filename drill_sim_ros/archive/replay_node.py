@@ -6,7 +6,9 @@ Messages are sent as the stored CDR bytes (``publisher.publish(bytes)``: no deco
 re-encode) on publishers of the recorded types and offered QoS, spaced by their log times
 divided by R. ``--clock`` publishes /clock (rosgraph_msgs/Clock) from the log time, so nodes
 with use_sim_time follow the replay. A missing or non-MCAP file is an error (exit 2); of a
-truncated or corrupt file, the readable part is replayed with a warning (exit 1).
+damaged or cut file, every intact chunk is replayed, with a warning naming what was skipped
+(exit 1). A file with no ROS 2 channel or a ``--start-offset`` past its end is refused (exit 2);
+a replay that sent nothing exits 1. SIGINT, SIGTERM and SIGHUP stop it alike.
 """
 
 from __future__ import annotations
@@ -33,6 +35,8 @@ from drill_sim_ros.archive.pacing import Pacer
 from drill_sim_ros.archive.qos import replay_qos
 from drill_sim_ros.archive.reader import ArchiveReader, RecordedChannel
 from drill_sim_ros.archive.ros_types import message_class
+from drill_sim_ros.archive.signals import interrupt_on_hangup
+from drill_sim_ros.archive.writer import MESSAGE_ENCODING
 from drill_sim_ros.terminal import StatusLine
 
 _log = logging.getLogger(__name__)
@@ -173,7 +177,7 @@ def _parse(argv: list[str]) -> argparse.Namespace:
     return args
 
 
-def _replay(reader: ArchiveReader, extent: Plan, options: argparse.Namespace) -> None:
+def _replay(reader: ArchiveReader, extent: Plan, options: argparse.Namespace) -> int:
     node = Node("mcap_replay")
     replayer = Replayer(node, extent.channels, options.clock)
     progress = Progress(extent, options.rate)
@@ -191,6 +195,7 @@ def _replay(reader: ArchiveReader, extent: Plan, options: argparse.Namespace) ->
         progress.end()
         _log.info("sent %d messages", replayer.sent)
         node.destroy_node()
+    return replayer.sent
 
 
 def main(args: list[str] | None = None) -> int:
@@ -203,17 +208,40 @@ def main(args: list[str] | None = None) -> int:
         _log.error("%s", exc)
         return 2
     extent = plan(reader, re.compile(options.topics))
-    if not extent.channels:
-        _log.error("%s: no readable messages on topics matching %r", options.file, options.topics)
+    refusal = _nothing_to_send(reader, extent, options)
+    if refusal is not None:
+        _log.error("%s", refusal)
         return 2
     rclpy.init(args=argv)
+    interrupt_on_hangup()
+    sent = None
     try:
-        _replay(reader, extent, options)
+        sent = _replay(reader, extent, options)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:
         rclpy.try_shutdown()
-    return 1 if reader.problem else 0
+    if sent == 0:
+        _log.error("nothing was sent")
+        return 1
+    return 1 if reader.lost_data else 0
+
+
+def _nothing_to_send(reader: ArchiveReader, extent: Plan,
+                     options: argparse.Namespace) -> str | None:
+    """Why the replay would send nothing (None if it will send something)."""
+    foreign = sorted(t for t, e in reader.message_encodings.items() if e != MESSAGE_ENCODING)
+    if not extent.channels:
+        what = f"; not ROS 2 (cdr): {', '.join(foreign)}" if foreign else ""
+        return f"{options.file}: no readable messages on topics matching {options.topics!r}{what}"
+    if all(not c.type_name or c.topic in foreign for c in extent.channels):
+        return (f"{options.file} is not a ROS 2 recording: {', '.join(foreign)} "
+                f"not encoded as {MESSAGE_ENCODING!r}")
+    length_s = (extent.last_log_ns - extent.first_log_ns) / 1e9
+    if options.start_offset > length_s:
+        return (f"--start-offset {options.start_offset:g} s is past the end of the recording "
+                f"({length_s:.3f} s of log time)")
+    return None
 
 
 if __name__ == "__main__":

@@ -11,6 +11,7 @@ import logging
 from pathlib import Path
 
 from drill_sim_ros.archive.errors import ArchiveError
+from drill_sim_ros.archive.output import OVERWRITE_HINT, check_output
 from drill_sim_ros.archive.writer import ChannelInfo, Ros2McapWriter
 
 _log = logging.getLogger(__name__)
@@ -25,6 +26,9 @@ class RotatingWriter:
         compression: str = "zstd",
         split_size_bytes: int | None = None,
         split_duration_s: float | None = None,
+        overwrite: bool = False,
+        metadata: dict[str, dict[str, str]] | None = None,
+        overwrite_hint: str = OVERWRITE_HINT,
     ) -> None:
         if (split_size_bytes or 0) < 0 or (split_duration_s or 0) < 0:
             raise ArchiveError("split limits must be positive")
@@ -32,13 +36,26 @@ class RotatingWriter:
         self._compression = compression
         self._split_size = split_size_bytes or None
         self._split_ns = int(split_duration_s * 1e9) if split_duration_s else None
+        self._overwrite, self._hint = overwrite, overwrite_hint
+        self._metadata = metadata or {}
         self._topics: dict[str, tuple[str, str]] = {}
         self.paths: list[Path] = []
         self._finished_messages = 0
+        self._finished_on_disk = 0
         self._finished_bytes = 0
-        self._writer = self._open_next()
+        self._refuse_existing_parts()
+        self._writer: Ros2McapWriter | None = self._open_next()
         self._channels: dict[str, ChannelInfo] = {}
         self._file_start_ns: int | None = None
+
+    def _refuse_existing_parts(self) -> None:
+        """Split files are numbered from 0000: any existing part is refused up front."""
+        if not self.splitting or self._overwrite:
+            return
+        parts = sorted(self._base.parent.glob(f"{self._base.stem}_[0-9][0-9][0-9][0-9]"
+                                              f"{self._base.suffix}"))
+        if parts:
+            check_output(parts[0], self._overwrite, self._hint)
 
     @property
     def splitting(self) -> bool:
@@ -51,9 +68,12 @@ class RotatingWriter:
 
     def _open_next(self) -> Ros2McapWriter:
         path = self._next_path()
-        path.parent.mkdir(parents=True, exist_ok=True)
+        writer = Ros2McapWriter(str(path), compression=self._compression,
+                                overwrite=self._overwrite, overwrite_hint=self._hint)
         self.paths.append(path)
-        return Ros2McapWriter(str(path), compression=self._compression)
+        for name, data in self._metadata.items():
+            writer.add_metadata(name, data)
+        return writer
 
     def add_channel(self, topic: str, type_name: str, offered_qos_yaml: str = "") -> str:
         self._topics[topic] = (type_name, offered_qos_yaml)
@@ -85,23 +105,31 @@ class RotatingWriter:
         _log.info("split: now writing %s", self.paths[-1])
 
     def _close_current(self) -> None:
-        self._writer.finish()
-        self._finished_messages += self._writer.message_count
-        self._finished_bytes += self._writer.bytes_written
+        writer, self._writer = self._writer, None
+        try:
+            writer.finish()
+        finally:
+            self._finished_messages += writer.message_count
+            self._finished_on_disk += writer.messages_on_disk
+            self._finished_bytes += writer.bytes_written
 
     def flush(self) -> None:
-        if self._writer.has_open_chunk:
+        if self._writer is not None and self._writer.has_open_chunk:
             self._writer.flush()
 
     def finish(self) -> None:
         if self._writer is not None:
             self._close_current()
-            self._writer = None
 
     @property
     def message_count(self) -> int:
         current = self._writer.message_count if self._writer is not None else 0
         return self._finished_messages + current
+
+    @property
+    def messages_on_disk(self) -> int:
+        current = self._writer.messages_on_disk if self._writer is not None else 0
+        return self._finished_on_disk + current
 
     @property
     def bytes_written(self) -> int:

@@ -17,6 +17,8 @@ queued upstream (see :mod:`drill_sim_ros.archive.background`). The stated bound 
 from __future__ import annotations
 
 import logging
+from collections.abc import Iterator
+from contextlib import contextmanager, suppress
 from dataclasses import dataclass, field
 from typing import IO
 
@@ -24,6 +26,7 @@ import yaml
 from mcap.writer import CompressionType, Writer
 
 from drill_sim_ros.archive.errors import ArchiveError, WriterClosedError
+from drill_sim_ros.archive.output import OVERWRITE_HINT, OutputError, open_output
 from drill_sim_ros.archive.schemas import SCHEMA_ENCODING, MessageDefinition, message_definition
 
 _log = logging.getLogger(__name__)
@@ -60,16 +63,15 @@ class _Span:
     channel_counts: dict[int, int] = field(default_factory=dict)
 
 
-def _open_output(output: str | IO[bytes]) -> IO[bytes]:
-    """The stream to write to; a path is opened here and closed by finish()."""
-    return open(output, "wb") if isinstance(output, str) else output
-
-
 class Ros2McapWriter:
     """Writes serialized CDR messages to an MCAP file in the ROS 2 profile.
 
     A context manager; :meth:`finish` writes the summary (statistics, indexes) and the
-    ``rosbag2`` metadata record, and may be called more than once.
+    ``rosbag2`` metadata record, and may be called more than once. A path is opened under
+    the output policy (:func:`~drill_sim_ros.archive.output.open_output`): an existing file
+    is refused unless ``overwrite``. An OS error while writing (a full disk) raises one
+    :class:`~drill_sim_ros.archive.output.OutputError`; :attr:`messages_on_disk` counts only
+    the messages of chunks handed to the OS.
     """
 
     def __init__(
@@ -79,6 +81,8 @@ class Ros2McapWriter:
         chunk_size: int = DEFAULT_CHUNK_SIZE,
         max_chunk_span_s: float = DEFAULT_MAX_CHUNK_SPAN_S,
         rosbag2_metadata: bool = True,
+        overwrite: bool = False,
+        overwrite_hint: str = OVERWRITE_HINT,
     ) -> None:
         if compression not in COMPRESSIONS:
             raise ArchiveError(f"compression must be one of {sorted(COMPRESSIONS)}")
@@ -86,15 +90,16 @@ class Ros2McapWriter:
             raise ArchiveError("chunk_size and max_chunk_span_s must be positive")
         self._path = output if isinstance(output, str) else getattr(output, "name", "<stream>")
         self._owns_stream = isinstance(output, str)
-        try:
-            self._stream: IO[bytes] = _open_output(output)
-        except OSError as exc:
-            raise ArchiveError(f"cannot create {output}: {exc}") from exc
+        self._stream: IO[bytes] = (open_output(output, overwrite, overwrite_hint)
+                                   if isinstance(output, str) else output)
+        self._error: OutputError | None = None
+        self._on_disk = 0
         self._compression = compression
         self._writer = Writer(
             self._stream, chunk_size=chunk_size, compression=COMPRESSIONS[compression]
         )
-        self._writer.start(profile=PROFILE, library="drill_sim_ros")
+        with self._guard():
+            self._writer.start(profile=PROFILE, library="drill_sim_ros")
         self._max_span_ns = int(max_chunk_span_s * 1e9)
         self._chunk_size = chunk_size
         self._rosbag2_metadata = rosbag2_metadata
@@ -131,9 +136,10 @@ class Ros2McapWriter:
         metadata = {"offered_qos_profiles": offered_qos_yaml}
         if definition.type_hash:
             metadata["topic_type_hash"] = definition.type_hash
-        channel_id = self._writer.register_channel(
-            topic, MESSAGE_ENCODING, self._schema_id(definition), metadata
-        )
+        with self._guard():
+            channel_id = self._writer.register_channel(
+                topic, MESSAGE_ENCODING, self._schema_id(definition), metadata
+            )
         info = ChannelInfo(
             channel_id, topic, definition.type_name, offered_qos_yaml, definition.type_hash
         )
@@ -152,9 +158,27 @@ class Ros2McapWriter:
         """Append one serialized message; closes the chunk when it spans the time limit."""
         self._check_open()
         publish_time = log_time_ns if publish_time_ns is None else publish_time_ns
-        self._writer.add_message(channel.channel_id, log_time_ns, data, publish_time, sequence)
-        channel.message_count += 1
-        self._track(log_time_ns, len(data))
+        before = self._stream.tell()
+        channel.message_count += 1                  # counted as lost if this raises
+        with self._guard():
+            self._writer.add_message(channel.channel_id, log_time_ns, data, publish_time,
+                                     sequence)
+            if self._stream.tell() != before:       # mcap closed the chunk by size
+                self._hand_over()
+            self._track(log_time_ns, len(data))
+
+    @contextmanager
+    def _guard(self) -> Iterator[None]:
+        """OS errors (ENOSPC, EIO) become one OutputError, kept in :attr:`error`."""
+        try:
+            yield
+        except OSError as exc:
+            self._error = OutputError(f"cannot write {self._path}: {exc.strerror or exc}")
+            raise self._error from None
+
+    def _hand_over(self) -> None:
+        self._stream.flush()
+        self._on_disk = self.message_count
 
     def _track(self, log_time_ns: int, size: int) -> None:
         span = self._span
@@ -172,12 +196,24 @@ class Ros2McapWriter:
         """Close the open chunk (if any) and hand everything to the OS."""
         if self._finished:
             return
-        self._writer.flush()
+        with self._guard():
+            self._writer.flush()
+            self._on_disk = self.message_count
         self._span.chunk_start_ns, self._span.chunk_bytes = None, 0
 
     @property
     def has_open_chunk(self) -> bool:
         return self._span.chunk_start_ns is not None
+
+    @property
+    def messages_on_disk(self) -> int:
+        """Messages in chunks handed to the OS (the open chunk excluded)."""
+        return self._on_disk
+
+    @property
+    def error(self) -> OutputError | None:
+        """The write error that stopped this file, if any."""
+        return self._error
 
     @property
     def message_count(self) -> int:
@@ -202,25 +238,43 @@ class Ros2McapWriter:
     def _check_open(self) -> None:
         if self._finished:
             raise WriterClosedError(f"{self._path} is already finished")
+        if self._error is not None:
+            raise self._error
 
     def add_metadata(self, name: str, data: dict[str, str]) -> None:
         self._check_open()
-        self._writer.add_metadata(name, data)
+        with self._guard():
+            self._writer.add_metadata(name, data)
 
     def finish(self) -> None:
         """Write the summary and close the file. Safe to call again."""
         if self._finished:
             return
+        self._finished = True
+        try:
+            if self._error is None:
+                with self._guard():
+                    self._end()
+        finally:
+            self._release()
+        _log.debug("finished %s: %d messages", self._path, self.message_count)
+
+    def _end(self) -> None:
         if self._rosbag2_metadata:
             self._writer.add_metadata("rosbag2", self._rosbag2_record())
         self._writer.finish()
+        self._stream.flush()
         self._final_size = self._stream.tell()
-        self._finished = True
-        if self._owns_stream:
+        self._on_disk = self.message_count
+
+    def _release(self) -> None:
+        """Close the file even after a write error (what could not be written is lost)."""
+        if not self._final_size:
+            self._final_size = self._stream.tell()
+        if not self._owns_stream:
+            return
+        with suppress(OSError):                 # the buffer could not be written either
             self._stream.close()
-        else:
-            self._stream.flush()
-        _log.debug("finished %s: %d messages", self._path, self.message_count)
 
     def _rosbag2_record(self) -> dict[str, str]:
         text = yaml.safe_dump(rosbag2_bag_metadata(self), default_flow_style=False,

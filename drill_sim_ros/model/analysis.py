@@ -52,17 +52,28 @@ def critical_delay(p: DimensionlessParams) -> float:
     return math.pi / math.sqrt(2.0 * p.n * p.psi)
 
 
-def _char_axial(s: complex, npsi: float, tau: float) -> tuple[complex, complex]:
-    """P(s) = s^2 + n psi (1 - exp(-s tau)) (B.2) and dP/ds."""
+# Largest -Re(s) tau for which exp(-s tau) is evaluated: exp(709.8) is the largest float.
+_EXP_ARG_LIMIT = 700.0
+
+
+def _char_axial(s: complex, npsi: float, tau: float) -> tuple[complex, complex] | None:
+    """P(s) = s^2 + n psi (1 - exp(-s tau)) (B.2) and dP/ds; None where exp overflows.
+
+    At a root |exp(-s tau)| = |1 + s^2 / (n psi)|, so -Re(s) tau <= ln(1 + |s|^2 / (n psi)):
+    a point with -Re(s) tau > 700 is no root, nor near one of modulus below sqrt(n psi) e^350.
+    """
+    if -s.real * tau > _EXP_ARG_LIMIT:
+        return None
     e = cmath.exp(-s * tau)
     return s * s + npsi * (1.0 - e), 2.0 * s + npsi * tau * e
 
 
 def _newton(s: complex, npsi: float, tau: float, iters: int = 60) -> complex | None:
     for _ in range(iters):
-        f, df = _char_axial(s, npsi, tau)
-        if df == 0:
-            return None
+        value = _char_axial(s, npsi, tau)
+        if value is None or value[1] == 0:
+            return None                       # wandered far left, or a stationary point
+        f, df = value
         step = f / df
         s -= step
         if abs(step) < 1e-13 * max(1.0, abs(s)):
@@ -75,9 +86,12 @@ def rightmost_root(p: DimensionlessParams, tau: float | None = None) -> complex:
 
     tau defaults to tau_n0. Newton's method from a grid of starting points covering
     |s| <= 3 sqrt(2 n psi) (all roots with Re s > 0 lie within sqrt(2 n psi), App. B).
-    Returns s = growth rate + i * angular frequency (Im s >= 0).
+    Returns s = growth rate + i * angular frequency (Im s >= 0); NaN + NaN i when the delay
+    is infinite (omega0 = 0: the bit does not turn, B.2 has no finite delay).
     """
     tau = trivial_delay(p) if tau is None else tau
+    if not math.isfinite(tau):
+        return complex(math.nan, math.nan)
     npsi = p.n * p.psi
     radius = math.sqrt(2.0 * npsi)
     best: complex | None = None
@@ -87,7 +101,7 @@ def rightmost_root(p: DimensionlessParams, tau: float | None = None) -> complex:
             if root is None or abs(root) < 1e-8 * radius:
                 continue                      # diverged, or the root at the origin (B.3)
             if abs(_char_axial(root, npsi, tau)[0]) > 1e-6 * npsi:
-                continue
+                continue                      # converged onto no root
             root = complex(root.real, abs(root.imag))
             if best is None or root.real > best.real + 1e-12:
                 best = root

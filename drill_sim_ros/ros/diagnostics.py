@@ -35,6 +35,7 @@ class Figures:
     rejected: int
     saturated: int
     dropped: int
+    record_error: str | None
     written: int
     severity: Severity
     stick_fraction: float
@@ -64,9 +65,12 @@ def node_status(f: Figures) -> DiagnosticStatus:
         "recorder_dropped": str(f.dropped),
         "recorder_written": str(f.written),
         "fault": f.fault or "",
+        "recorder_error": f.record_error or "",
     }
     if f.fault is not None:
         level, message = DiagnosticStatus.ERROR, f"numerical fault: {f.fault}"
+    elif f.record_error is not None:
+        level, message = DiagnosticStatus.ERROR, f"recording stopped: {f.record_error}"
     elif f.overruns or f.dropped:
         level, message = DiagnosticStatus.WARN, "overruns or recorder drops"
     else:

@@ -9,18 +9,27 @@ is rejected always names the parameter and its allowed range.
 
 from __future__ import annotations
 
+import itertools
 import math
+import re
+import sys
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
+import rclpy
+import yaml
 from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
+from rclpy.exceptions import InvalidParameterTypeException, InvalidParameterValueException
+from rclpy.impl.implementation_singleton import rclpy_implementation
 
+from drill_sim_ros.model.errors import ParameterError
 from drill_sim_ros.model.measurement import MAX_DELAY_PERIODS, SIGNALS
 from drill_sim_ros.model.params import UNIT_SCALES, structure
 from drill_sim_ros.model.presets import DEFAULT_PRESET, Preset
 from drill_sim_ros.model.top_drive import MODES, TopDrive, TopDrivePhysical
 
+RCLError = rclpy_implementation.RCLError
 GRAVITY_M_S2 = 9.80665
 MUD_DENSITY_KG_M3 = 1200.0
 DOUBLE, INTEGER, BOOL, STRING = "double", "int", "bool", "string"
@@ -173,8 +182,17 @@ SPECS: tuple[ParamSpec, ...] = (
               "Exit cleanly after this many wall seconds; 0 = run until stopped.", 0.0, 1e9,
               read_only=True),
     ParamSpec("record.path", STRING, "",
-              "Record every published message to this MCAP file (in process); '' = off.",
-              read_only=True),
+              "Record every published message to this MCAP file (in process); '' = off. "
+              "An existing file is refused unless record.overwrite.", read_only=True),
+    ParamSpec("record.overwrite", BOOL, False,
+              "Replace an existing record.path (or its split parts) instead of refusing "
+              "to start.", read_only=True),
+    ParamSpec("record.split_size_mb", DOUBLE, 0.0,
+              "Start a new numbered file (run_0000.mcap, ...) after this many MB; 0 = one "
+              "file.", 0.0, 1e6, read_only=True),
+    ParamSpec("record.split_duration_s", DOUBLE, 0.0,
+              "Start a new numbered file after this many simulated seconds; 0 = one file.",
+              0.0, 1e9, read_only=True),
     ParamSpec("diagnostics.window_s", DOUBLE, 20.0,
               "Simulated seconds of bit speed behind the stick-slip severity on /diagnostics.",
               0.1, 3600.0, read_only=True),
@@ -233,16 +251,81 @@ def yaml_defaults(preset: Preset | None = None) -> dict[str, Any]:
 def declare_all(node: Any, load: Callable[[str], Preset]) -> tuple[Preset, dict[str, Any]]:
     """Declare every spec on ``node``; returns the loaded preset and the values in use.
 
-    ``model.preset`` is declared first so the physical defaults can come from it.
+    ``model.preset`` is declared first so the physical defaults can come from it. A value
+    that rclpy or the spec rejects raises one ParameterError naming it and its range.
     """
     first = SPECS[0]
-    name = node.declare_parameter(first.name, first.default, descriptor(first)).value
+    name = _declare(node, first, first.default)
     preset = load(name)
     values: dict[str, Any] = {first.name: name}
     for spec in SPECS[1:]:
-        param = node.declare_parameter(spec.name, spec.default_for(preset), descriptor(spec))
-        reason = validate(spec, param.value)
+        value = _declare(node, spec, spec.default_for(preset))
+        reason = validate(spec, value)
         if reason is not None:
-            raise ValueError(reason)
-        values[spec.name] = coerce(spec, param.value)
+            raise ParameterError(reason)
+        values[spec.name] = coerce(spec, value)
     return preset, values
+
+
+_KIND_TEXT = {DOUBLE: "a number", INTEGER: "an integer", BOOL: "true or false",
+              STRING: "a string"}
+
+
+def _declare(node: Any, spec: ParamSpec, default: Any) -> Any:
+    """The declared value; rclpy's range and type rejections become one ParameterError."""
+    try:
+        return node.declare_parameter(spec.name, default, descriptor(spec)).value
+    except InvalidParameterValueException as exc:
+        given = _VALUE_IN_REASON.search(str(exc))
+        shown = given.group(1) if given else "the given value"
+        raise ParameterError(f"{spec.name} = {shown} is outside [{spec.low:g}, "
+                             f"{spec.high:g}]") from None
+    except InvalidParameterTypeException as exc:
+        given = _TYPE_IN_REASON.search(str(exc))
+        shown = f"{given.group(1)!r} ({given.group(2).lower()})" if given else "another type"
+        raise ParameterError(f"{spec.name} must be {_KIND_TEXT[spec.kind]}, got "
+                             f"{shown}") from None
+
+
+# rclpy's exception texts (rclpy/exceptions.py) carry the rejected value; they hold no field.
+_VALUE_IN_REASON = re.compile(r"Invalid parameter value \((.*?)\) for parameter")
+_TYPE_IN_REASON = re.compile(r"to '(.*?)' of type '(\w+)'")
+# rcl's messages end in source locations (", at /path/file.c:123") that help nobody here.
+_SOURCE_LOCATION = re.compile(r",? at [^,]*\.c:\d+")
+
+
+def check_params_files(args: list[str]) -> None:
+    """Each ``--params-file`` must exist and parse as YAML (one ParameterError line if not).
+
+    Checked before rcl sees them, which would log its own parse error and a C source location.
+    """
+    for flag, path in itertools.pairwise(args):
+        if flag != "--params-file":
+            continue
+        try:
+            with open(path, encoding="utf-8") as stream:
+                yaml.safe_load(stream)
+        except OSError as exc:
+            raise ParameterError(f"--params-file {path}: {exc.strerror or exc}") from None
+        except yaml.YAMLError as exc:
+            raise ParameterError(f"--params-file {path} is not valid YAML: "
+                                 f"{' '.join(str(exc).split())}") from None
+
+
+def init_ros(args: list[str] | None = None) -> None:
+    """``rclpy.init``; an unparsable ``--ros-args`` or params file raises one ParameterError."""
+    check_params_files(sys.argv if args is None else args)
+    try:
+        rclpy.init(args=args)
+    except RCLError as exc:
+        text = _SOURCE_LOCATION.sub("", str(exc)).replace("failed to initialize rcl: ", "")
+        raise ParameterError(f"bad ROS arguments: {text.strip()}") from None
+
+
+def recording_options(values: dict[str, Any]) -> dict[str, Any]:
+    """The ``record.*`` values as :class:`~drill_sim_ros.archive.inprocess.InProcessRecorder`
+    keyword arguments."""
+    size_mb, duration_s = values["record.split_size_mb"], values["record.split_duration_s"]
+    return {"overwrite": values["record.overwrite"],
+            "split_size_bytes": int(size_mb * 1e6) if size_mb > 0 else None,
+            "split_duration_s": duration_s if duration_s > 0 else None}

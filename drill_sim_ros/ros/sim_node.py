@@ -20,7 +20,6 @@ import math
 import signal
 import sys
 import time
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -40,7 +39,7 @@ from std_msgs.msg import Float64, String
 from std_srvs.srv import SetBool, Trigger
 
 from drill_sim_ros import topics
-from drill_sim_ros.model.errors import DrillSimError, NumericalFault
+from drill_sim_ros.model.errors import DrillSimError, NumericalFault, ParameterError
 from drill_sim_ros.model.measurement import SIGNALS, RigSensors, SignalSpec
 from drill_sim_ros.model.params import RPM_PER_RAD_S
 from drill_sim_ros.model.presets import load_preset
@@ -53,7 +52,14 @@ from drill_sim_ros.ros import messages
 from drill_sim_ros.ros.diagnostics import Figures, diagnostics
 from drill_sim_ros.ros.frame import SAMPLE_TOPICS
 from drill_sim_ros.ros.messages import RUN_INFO_QOS, stamp_ns
-from drill_sim_ros.ros.parameters import SPEC_BY_NAME, coerce, declare_all, validate
+from drill_sim_ros.ros.parameters import (
+    SPEC_BY_NAME,
+    coerce,
+    declare_all,
+    init_ros,
+    recording_options,
+    validate,
+)
 from drill_sim_ros.ros.sinks import SampleSinks
 from drill_sim_ros.terminal import StatusLine, format_status
 
@@ -116,9 +122,9 @@ def clamp_command(value: float, limit: float, unit: str, low: float = 0.0
     if not math.isfinite(value):
         return None, f"{value!r} is not finite"
     if value < low:
-        return low, f"{value:.10g} {unit} is below {low:.10g} {unit}"
+        return low, f"{value!r} {unit} is below {low!r} {unit}"
     if value > limit:
-        return limit, f"{value:.10g} {unit} exceeds the limit {limit:.10g} {unit}"
+        return limit, f"{value!r} {unit} exceeds the limit {limit!r} {unit}"
     return value, None
 
 
@@ -150,6 +156,7 @@ class SimNode(Node):
         self._paused = False
         self._closing = False
         self._fault: str | None = None
+        self.recording_failed = False
         self.rejected_commands = 0
         self.saturated_commands = 0
         self._last_row: np.ndarray | None = None     # SI, TELEMETRY_FIELDS; lock held
@@ -202,22 +209,18 @@ class SimNode(Node):
         return CLOCK_QOS if topic in (topics.CLOCK, topics.DIAGNOSTICS) else DATA_QOS
 
     def _open_recorder(self, path: str) -> Any:
-        """The in-process MCAP recorder of ``record.path`` (None when off or unavailable)."""
+        """The in-process MCAP recorder of ``record.path`` (None when off). An existing or
+        unwritable path raises one ArchiveError line: the node does not start."""
         if not path:
             return None
-        try:
-            from drill_sim_ros.archive.inprocess import InProcessRecorder
-            Path(path).parent.mkdir(parents=True, exist_ok=True)
-            recorder = InProcessRecorder(path, node_name=topics.NODE_NAME,
-                                         metadata=self._run_metadata())
-            for topic, publisher in self._pubs.items():
-                recorder.add_topic(publisher.topic_name, topics.MSG_TYPES[topic],
-                                   self._qos(topic))
-            for topic, name in self._command_names.items():
-                recorder.add_topic(name, topics.MSG_TYPES[topic], COMMAND_QOS)
-        except Exception as exc:  # recording is optional: keep simulating
-            self.get_logger().error(f"recording to {path!r} is off: {exc}")
-            return None
+        from drill_sim_ros.archive.inprocess import InProcessRecorder
+        recorder = InProcessRecorder(path, node_name=topics.NODE_NAME,
+                                     metadata=self._run_metadata(),
+                                     **recording_options(self._values))
+        for topic, publisher in self._pubs.items():
+            recorder.add_topic(publisher.topic_name, topics.MSG_TYPES[topic], self._qos(topic))
+        for topic, name in self._command_names.items():
+            recorder.add_topic(name, topics.MSG_TYPES[topic], COMMAND_QOS)
         self.get_logger().info(f"recording to {path}")
         return recorder
 
@@ -496,6 +499,7 @@ class SimNode(Node):
             overruns=self._pacer.overruns, lateness_ns=self._pacer.lateness_ns(),
             rejected=self.rejected_commands, saturated=self.saturated_commands,
             dropped=self._recorder_count("dropped"),
+            record_error=None if self._sinks.recorder is None else self._sinks.recorder.error,
             written=self._recorder_count("written"), severity=sev,
             stick_fraction=stick_fraction,
             mode="none" if row is None else MODE_NAMES[int(row[TELEMETRY_INDEX["mode"]])],
@@ -538,12 +542,11 @@ class SimNode(Node):
         finally:                            # whatever failed above, finish the recording
             recorder, self._sinks.recorder = self._sinks.recorder, None
             if recorder is not None:
-                recorder.close()
+                self.recording_failed = not recorder.close()
                 # after Ctrl-C the context may be gone: a logger of no node has no /rosout
                 # publisher
-                rclpy.logging.get_logger("drill_sim_ros").info(
-                    f"recording closed: {recorder.written} messages written, "
-                    f"{recorder.dropped} dropped")
+                logger = rclpy.logging.get_logger("drill_sim_ros")
+                (logger.error if self.recording_failed else logger.info)(recorder.summary())
 
     def destroy_node(self) -> None:
         self.close()
@@ -552,7 +555,11 @@ class SimNode(Node):
 
 def main(args: list[str] | None = None) -> int:
     """Console script ``sim_node`` (``ros2 run drill_sim_ros sim_node``)."""
-    rclpy.init(args=args)
+    try:
+        init_ros(args)
+    except ParameterError as exc:
+        rclpy.logging.get_logger(topics.NODE_NAME).fatal(str(exc))
+        return 1
     # A closed terminal (SIGHUP) stops the node like Ctrl-C or SIGTERM, so the recording is
     # finished instead of cut off without its summary.
     signal.signal(signal.SIGHUP, lambda *_: rclpy.try_shutdown())
@@ -581,7 +588,7 @@ def main(args: list[str] | None = None) -> int:
         if node is not None:
             node.destroy_node()
         rclpy.try_shutdown()
-    return 0
+    return 1 if node is not None and node.recording_failed else 0
 
 
 if __name__ == "__main__":

@@ -10,9 +10,11 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import signal
 import sys
 import time
+from typing import Any
 
 import numpy as np
 import rclpy
@@ -36,6 +38,8 @@ from drill_sim_ros.viz.recording import (
     DEFAULT_VIEWER_URL,
     close_recording,
     open_recording,
+    port_free,
+    viewer_listening,
 )
 from drill_sim_ros.viz.running_stats import default_window_s
 from drill_sim_ros.viz.telemetry import N_FIELDS, TelemetryBatch, field_order
@@ -146,6 +150,12 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
     parser.add_argument("--best-effort", action="store_true",
                         help="subscribe best-effort (default: reliable)")
     args = parser.parse_args(argv)
+    if not 1 <= args.serve_port <= 65535:
+        parser.error(f"--serve-port = {args.serve_port} must lie in [1, 65535]")
+    if not (math.isfinite(args.flush_hz) and 0 < args.flush_hz <= 1000):
+        parser.error(f"--flush-hz = {args.flush_hz!r} must lie in (0, 1000]")
+    if args.window_s is not None and not (math.isfinite(args.window_s) and args.window_s > 0):
+        parser.error(f"--window-s = {args.window_s!r} must be a positive number of seconds")
     if not (args.save or args.connect or args.serve):
         args.connect = DEFAULT_VIEWER_URL
     return args
@@ -173,6 +183,27 @@ def run_units(preset: str | None, timeout_s: float = RUN_INFO_WAIT_S) -> PaperUn
     return PaperUnits.load(DEFAULT_PRESET)
 
 
+class StartError(Exception):
+    """The bridge cannot start as asked (one line)."""
+
+
+def check_sinks(args: argparse.Namespace, logger: Any) -> None:
+    """Refuse a busy --serve port; drop (or refuse) a --connect with no viewer listening.
+
+    rerun buffers everything for a viewer that is not there yet (about 21 MB a minute at the
+    sim's rate), so the bridge never streams to an address where nothing listens.
+    """
+    if args.serve and (busy := port_free(args.serve_port)) is not None:
+        raise StartError(f"--serve-port {args.serve_port}: cannot listen on 127.0.0.1 "
+                         f"({busy})")
+    if args.connect and not viewer_listening(args.connect):
+        if not (args.save or args.serve):
+            raise StartError(f"no viewer listening at {args.connect}: start one first "
+                             "(`rerun`), or use --save FILE.rrd or --serve")
+        logger.warning(f"no viewer listening at {args.connect}: not streaming there")
+        args.connect = None
+
+
 def make_dashboard(args: argparse.Namespace) -> Dashboard:
     units = run_units(args.preset)
     window = default_window_s(units) if args.window_s is None else args.window_s
@@ -185,13 +216,24 @@ def _interrupt(signum: int, frame: object) -> None:
     raise KeyboardInterrupt(f"signal {signum}")
 
 
-def main(argv: list[str] | None = None) -> None:
+CLOSE_TIMEOUT_S = 1.5       # stop within 2 s even when a viewer stopped reading
+
+
+def main(argv: list[str] | None = None) -> int:
     disable_analytics()
     argv = sys.argv if argv is None else argv
     args = parse_args(remove_ros_args(argv)[1:])
-    # Own signal handling: the context stays up on SIGINT/SIGTERM so the queue is drained.
+    logger = rclpy.logging.get_logger(NODE_NAME)
+    try:
+        check_sinks(args, logger)
+    except StartError as exc:
+        logger.fatal(str(exc))
+        return 2
+    # Own signal handling: the context stays up on SIGINT/SIGTERM/SIGHUP so the queue is
+    # drained and the .rrd finished.
     rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
     signal.signal(signal.SIGTERM, _interrupt)
+    signal.signal(signal.SIGHUP, _interrupt)
     dashboard: Dashboard | None = None
     node: RerunBridge | None = None
     try:
@@ -207,9 +249,13 @@ def main(argv: list[str] | None = None) -> None:
             node.finish()
             node.destroy_node()
         rclpy.try_shutdown()
-        if dashboard is not None:
-            close_recording(dashboard.rec)
+        problem = None if dashboard is None else close_recording(dashboard.rec,
+                                                                 CLOSE_TIMEOUT_S)
+    if problem is not None:
+        logger.error(f"not everything reached the viewer: {problem}")
+        return 1
+    return 0
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

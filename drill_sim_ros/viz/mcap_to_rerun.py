@@ -2,15 +2,26 @@
 
 The same views as the live bridge (:class:`~drill_sim_ros.viz.dashboard.Dashboard`), from the
 ``/drill/telemetry`` messages of the file. Turns rerun's analytics off first.
+
+A damaged or cut recording gives what ``mcap_reindex`` would keep (every intact chunk), with
+one warning naming what was skipped, and exit code 1. The .rrd is written beside its target
+and moved in place only when complete: an error or SIGINT/SIGTERM/SIGHUP leaves no partial
+file. An existing .rrd is refused unless ``--overwrite``.
 """
 
 from __future__ import annotations
 
 import argparse
+import logging
+import math
 import sys
 from pathlib import Path
 
 from drill_sim_ros import topics
+from drill_sim_ros.archive.errors import ArchiveError
+from drill_sim_ros.archive.output import commit, temporary_beside
+from drill_sim_ros.archive.reader import ArchiveReader
+from drill_sim_ros.archive.signals import stop_on_signals
 from drill_sim_ros.model.errors import ParameterError
 from drill_sim_ros.model.presets import DEFAULT_PRESET
 from drill_sim_ros.viz.analytics_off import disable_analytics
@@ -37,48 +48,76 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
                              f"else {DEFAULT_PRESET})")
     parser.add_argument("--window-s", type=float, default=None,
                         help="sliding window for E-S and severity, s (default 20 t*)")
-    return parser.parse_args(argv)
+    parser.add_argument("--overwrite", action="store_true",
+                        help="replace an existing output (default: refuse)")
+    args = parser.parse_args(argv)
+    if args.window_s is not None and not (math.isfinite(args.window_s) and args.window_s > 0):
+        parser.error(f"--window-s = {args.window_s!r} must be a positive number of seconds")
+    return args
 
 
 def convert(mcap: Path, output: Path, preset: str | None = None,
-            window_s: float | None = None) -> int:
-    """Write ``output`` from ``mcap``; return the number of telemetry samples logged."""
+            window_s: float | None = None, overwrite: bool = False) -> tuple[int, ArchiveReader]:
+    """Write ``output`` from ``mcap``; return the telemetry samples logged and the reader
+    (its ``problem`` and ``lost_data``). Nothing is left at ``output`` unless it succeeds."""
+    reader = ArchiveReader(mcap)
+    batches = read_telemetry(reader)
+    first = next(batches)                # NoTelemetryError before anything else is said
     units = recorded_units(mcap, preset)
     window = default_window_s(units) if window_s is None else window_s
-    rec = open_recording(build_blueprint(window), save=output)
+    temporary = temporary_beside(output, overwrite)
     try:
-        dashboard = Dashboard(rec, units, window)
-        for batch in read_telemetry(mcap):
-            dashboard.log_batch(batch)
+        rec = open_recording(build_blueprint(window), save=temporary)
+        try:
+            dashboard = Dashboard(rec, units, window)
+            dashboard.log_batch(first)
+            for batch in batches:
+                dashboard.log_batch(batch)
+        finally:
+            close_recording(rec)
+        commit(temporary, output, overwrite)
     finally:
-        close_recording(rec)
-    return dashboard.samples
+        temporary.unlink(missing_ok=True)
+    return dashboard.samples, reader
 
 
 def recorded_units(mcap: Path, preset: str | None) -> PaperUnits:
     """The scales of the 2D views: ``preset`` if given, else the recorded run info, else
-    the recorded preset name, else the default preset (with a warning naming it)."""
+    the preset named in the file's metadata (recordings made before the run info existed),
+    else the default preset, with a warning naming it."""
     if preset:
         return PaperUnits.load(preset)
     info = recorded_run_info(mcap)
     if info is not None:
         return PaperUnits.from_run_info(info)
-    fallback = recorded_preset(mcap) or DEFAULT_PRESET
-    print(f"mcap_to_rerun: warning: {mcap} has no {topics.RUN_INFO}; the 2D views use the "
-          f"scales of preset {fallback!r} (override with --preset)", file=sys.stderr)
-    return PaperUnits.load(fallback)
+    recorded = recorded_preset(mcap)
+    if recorded:
+        return PaperUnits.load(recorded)
+    print(f"mcap_to_rerun: warning: {mcap} has no {topics.RUN_INFO} and names no preset; the "
+          f"2D views use the scales of preset {DEFAULT_PRESET!r} (override with --preset)",
+          file=sys.stderr)
+    return PaperUnits.load(DEFAULT_PRESET)
 
 
 def main(argv: list[str] | None = None) -> int:
     disable_analytics()
     args = parse_args(argv)
+    logging.basicConfig(level=logging.ERROR, format="mcap_to_rerun: %(message)s")
     try:
-        count = convert(args.mcap, args.output, args.preset, args.window_s)
-    except (OSError, NoTelemetryError, ParameterError) as exc:
+        with stop_on_signals():
+            count, reader = convert(args.mcap, args.output, args.preset, args.window_s,
+                                     args.overwrite)
+    except (OSError, NoTelemetryError, ParameterError, ArchiveError) as exc:
         print(f"mcap_to_rerun: {exc}", file=sys.stderr)
-        return 1
+        return 2 if isinstance(exc, (ArchiveError, ParameterError, OSError)) else 1
+    except KeyboardInterrupt as exc:
+        print(f"mcap_to_rerun: interrupted ({exc or 'SIGINT'}); no {args.output} written",
+              file=sys.stderr)
+        return 130
+    if reader.problem is not None:
+        print(f"mcap_to_rerun: warning: {reader.problem}", file=sys.stderr)
     print(f"mcap_to_rerun: {count} telemetry samples -> {args.output}")
-    return 0
+    return 1 if reader.lost_data else 0
 
 
 if __name__ == "__main__":

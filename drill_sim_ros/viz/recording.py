@@ -6,7 +6,9 @@
 
 from __future__ import annotations
 
+import socket
 from pathlib import Path
+from urllib.parse import urlsplit
 
 import rerun as rr
 import rerun.blueprint as rrb
@@ -45,7 +47,40 @@ def open_recording(blueprint: rrb.Blueprint, *, save: str | Path | None = None,
     return rec
 
 
-def close_recording(rec: rr.RecordingStream, timeout_s: float = 10.0) -> None:
-    """Flush everything (the .rrd gets its footer) and detach the sinks."""
-    rec.flush(timeout_sec=timeout_s)
+def close_recording(rec: rr.RecordingStream, timeout_s: float = 10.0) -> str | None:
+    """Flush everything (the .rrd gets its footer) and detach the sinks.
+
+    Returns None, or one line on why a sink could not be flushed (a viewer gone away).
+    """
+    problem = None
+    try:
+        rec.flush(timeout_sec=timeout_s)
+    except RuntimeError as exc:             # rerun reports a sink it cannot flush this way
+        problem = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
     rec.disconnect()
+    return problem
+
+
+def tcp_address(url: str) -> tuple[str, int]:
+    """(host, port) of a ``rerun+http://host:port/proxy`` URL (port 9876 by default)."""
+    parsed = urlsplit(url)
+    return parsed.hostname or LOOPBACK, parsed.port or DEFAULT_SERVE_PORT
+
+
+def viewer_listening(url: str, timeout_s: float = 0.5) -> bool:
+    """True if something accepts TCP connections at ``url``'s host and port."""
+    try:
+        with socket.create_connection(tcp_address(url), timeout=timeout_s):
+            return True
+    except OSError:
+        return False
+
+
+def port_free(port: int) -> str | None:
+    """None if ``port`` can be bound on 127.0.0.1, else the reason."""
+    with socket.socket() as sock:
+        try:
+            sock.bind((LOOPBACK, port))
+        except OSError as exc:
+            return exc.strerror or str(exc)
+    return None

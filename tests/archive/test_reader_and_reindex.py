@@ -106,11 +106,15 @@ def _run(*argv: str, timeout_s: float = 30) -> subprocess.CompletedProcess:
                           timeout=timeout_s, env=os.environ.copy())
 
 
-def test_reindex_cli_in_place_and_errors(finished, tmp_path) -> None:
-    cut = _cut(finished, finished.stat().st_size // 2)
-    done = _run("mcap_reindex", str(cut))
-    assert done.returncode == 0, done.stderr
+def test_reindex_cli_in_place_keeps_the_original_and_reports_the_loss(finished,
+                                                                       tmp_path) -> None:
+    cut = _cut(finished, finished.stat().st_size // 2)   # inside a chunk: that chunk is lost
+    original = cut.read_bytes()
+    done = _run("mcap_reindex", str(cut), "--in-place")
+    assert done.returncode == 1, done.stderr
+    assert "truncated" in done.stderr and "Traceback" not in done.stderr
     assert ArchiveReader(cut).summary() is not None
+    assert cut.with_name(cut.name + ".orig").read_bytes() == original
     missing = _run("mcap_reindex", str(tmp_path / "absent.mcap"))
     assert missing.returncode == 2 and "no such file" in missing.stderr
 

@@ -82,7 +82,7 @@ def _record(tmp_path, name: str):
     return path, running(command, tmp_path / f"{name}.log")
 
 
-@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM, signal.SIGHUP])
 def test_recorded_run_decodes_with_both_libraries_and_counts_match(tmp_path, sig) -> None:
     path, recorder_cm = _record(tmp_path, "dds.mcap")
     rounds = 100

@@ -14,6 +14,7 @@ drift-free (absolute targets), so these do not accumulate. We require median |er
 from __future__ import annotations
 
 import logging
+import signal
 import statistics
 import threading
 import time
@@ -150,13 +151,14 @@ def test_start_offset_skips_the_beginning(recording, tmp_path) -> None:
     assert sorted(i for i, _ in listener.arrivals) == expected
 
 
-def test_loop_replays_again_until_interrupted(recording, tmp_path) -> None:
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGHUP])
+def test_loop_replays_again_until_interrupted(recording, tmp_path, sig) -> None:
     command = ["mcap_replay", str(recording), "--topics", "/drill/test/.*", "--rate", "10",
                "--loop", "--wait-for-subscribers", "20", "--delay", "0.3"]
     with ros_node("test_listener") as node:
         listener = _Listener(node)
         with running(command, tmp_path / "replay.log") as replay:
             assert wait_for(lambda: len(listener.arrivals) >= 2 * COUNT + 10, 30)
-            assert stop(replay) == 0, (tmp_path / "replay.log").read_text()
+            assert stop(replay, sig) == 0, (tmp_path / "replay.log").read_text()
     counts = [i for i, _ in listener.arrivals]
     assert counts.count(0) >= 2 and counts.count(COUNT - 1) >= 2     # looped at least twice

@@ -137,6 +137,12 @@ class _BlockedSink:
     def finish(self) -> None:
         self.finished = True
 
+    @property
+    def message_count(self) -> int:
+        return len(self.rows)
+
+    messages_on_disk = message_count
+
 
 def test_overflow_drops_are_counted_and_close_drains_the_rest() -> None:
     sink = _BlockedSink()
@@ -153,5 +159,6 @@ def test_overflow_drops_are_counted_and_close_drains_the_rest() -> None:
 def test_bad_writer_options_raise_archive_errors(tmp_path) -> None:
     with pytest.raises(ArchiveError):
         Ros2McapWriter(str(tmp_path / "a.mcap"), compression="lzma")
-    with pytest.raises(ArchiveError):
-        Ros2McapWriter(str(tmp_path / "no" / "such" / "dir.mcap"))
+    (tmp_path / "a_file").write_bytes(b"")
+    with pytest.raises(ArchiveError, match="cannot write"):
+        Ros2McapWriter(str(tmp_path / "a_file" / "dir.mcap"))

@@ -83,3 +83,30 @@ def test_growth_of_small_perturbation_matches_rightmost_root(method: str) -> Non
           f"{root.imag:.4f}")
     assert rate == pytest.approx(root.real, rel=0.02)
     assert freq == pytest.approx(root.imag, rel=0.02)
+
+
+@pytest.mark.parametrize("omega0", [0.05, 0.01, 1e-4])
+def test_rightmost_root_of_a_long_delay_lies_between_its_asymptotic_bounds(omega0) -> None:
+    """omega0 -> 0 makes tau_n0 = 2 pi / (n omega0) long; exp(-s tau) once overflowed.
+
+    For tau >> 1 the unstable roots sit near s = i w, w = sqrt(n psi), s = i w + sigma + i d:
+    (B.2) gives |2 i w (sigma + i d)| ~ n psi exp(-sigma tau). With d = 0 that is the upper
+    bound sigma_hi exp(sigma_hi tau) = w / 2; the roots are 2 pi / tau apart along Im s, so
+    the rightmost has |d| <= pi / tau, whence the lower bound.
+    """
+    p = DimensionlessParams(n=6, psi=50.0, beta=0.3, lam=5.0, w0=7.0, omega0=omega0)
+    tau, npsi = an.trivial_delay(p), p.n * p.psi
+    w = np.sqrt(npsi)
+    root = an.rightmost_root(p)
+    assert abs(root**2 + npsi * (1 - np.exp(-root * tau))) < 1e-6 * npsi
+    sigmas = np.linspace(1e-9, 5.0 / tau * np.log(tau), 200_001)
+    modulus = npsi * np.exp(-sigmas * tau)
+    sigma_hi = sigmas[np.argmin(np.abs(2 * w * sigmas - modulus))]
+    sigma_lo = sigmas[np.argmin(np.abs(2 * w * np.hypot(sigmas, np.pi / tau) - modulus))]
+    assert sigma_lo <= root.real <= sigma_hi * (1 + 1e-6)
+    assert abs(root.imag - w) < 2 * np.pi / tau
+
+
+def test_rightmost_root_is_undefined_without_rotation() -> None:
+    p = DimensionlessParams(n=6, psi=50.0, beta=0.3, lam=5.0, w0=7.0, omega0=0.0)
+    assert np.isnan(an.rightmost_root(p).real)

@@ -175,5 +175,5 @@ def test_the_scales_come_from_the_recorded_run_info(tmp_path, capsys):
     assert capsys.readouterr().err == ""
     fallback = recorded_units(without, None)
     assert fallback.preset == DEFAULT_PRESET
-    assert f"no {topics.RUN_INFO}" in capsys.readouterr().err
+    assert f"no {topics.RUN_INFO} and names no preset" in capsys.readouterr().err
     assert recorded_units(with_info, "field_8p5in_shale").preset == "field_8p5in_shale"

@@ -1,0 +1,37 @@
+"""Reasons that name the value exactly, and the record.* parameters as recorder options."""
+
+from __future__ import annotations
+
+import pytest
+
+from drill_sim_ros.model.errors import ParameterError
+from drill_sim_ros.ros.parameters import check_params_files, recording_options, yaml_defaults
+from drill_sim_ros.ros.sim_node import clamp_command
+
+
+def test_a_saturated_command_shows_its_value_exactly() -> None:
+    applied, reason = clamp_command(600000.0001, 600000.0, "N")
+    assert (applied, reason) == (600000.0, "600000.0001 N exceeds the limit 600000.0 N")
+    assert clamp_command(600000.0, 600000.0, "N") == (600000.0, None)
+
+
+def test_record_parameters_become_recorder_options() -> None:
+    values = yaml_defaults()
+    assert recording_options(values) == {"overwrite": False, "split_size_bytes": None,
+                                         "split_duration_s": None}
+    values.update({"record.overwrite": True, "record.split_size_mb": 2.5,
+                   "record.split_duration_s": 600.0})
+    assert recording_options(values) == {"overwrite": True, "split_size_bytes": 2_500_000,
+                                         "split_duration_s": 600.0}
+
+
+def test_params_files_are_checked_before_rcl(tmp_path) -> None:
+    good = tmp_path / "good.yaml"
+    good.write_text("drill_sim:\n  ros__parameters:\n    lockstep: true\n")
+    check_params_files(["sim_node", "--ros-args", "--params-file", str(good)])
+    with pytest.raises(ParameterError, match="No such file"):
+        check_params_files(["--params-file", str(tmp_path / "absent.yaml")])
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("a: [1,\n")
+    with pytest.raises(ParameterError, match="not valid YAML"):
+        check_params_files(["--ros-args", "--params-file", str(bad)])
