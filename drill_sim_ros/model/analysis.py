@@ -151,6 +151,11 @@ def efficiency(p: DimensionlessParams, kappa: float) -> float:
     return (p.w0 - contact) / (p.w0 - contact * (1.0 - p.beta))
 
 
+def kappa_from_depth(mean_depth: float, delta0: float, lam: float) -> float:
+    """kappa from the mean depth of cut, eq. (45a): kappa = (<delta> - delta0) / lam."""
+    return (mean_depth - delta0) / lam if lam > 0 else math.nan
+
+
 def predicted_from_kappa(p: DimensionlessParams, kappa: float) -> dict[str, float]:
     """The mean response implied by kappa alone: eqs. (45), (47), (50)."""
     triv = trivial_solution(p)
