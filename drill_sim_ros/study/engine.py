@@ -86,7 +86,7 @@ def batch_size(n_points: int, n_workers: int) -> int:
 def connect(scheduler: str | None = None, workers: int | None = None) -> Iterator[object]:
     """A distributed Client: to ``scheduler`` if given, else to a LocalCluster of
     ``workers`` single-threaded processes (default: one per core), all bound to 127.0.0.1
-    with no dashboard."""
+    (the HTTP endpoints on ephemeral loopback ports)."""
     from distributed import Client, LocalCluster
     if scheduler:
         try:
@@ -100,7 +100,8 @@ def connect(scheduler: str | None = None, workers: int | None = None) -> Iterato
     if not 1 <= n <= 1024:
         raise DrillSimError(f"--workers = {n} must be in [1, 1024]")
     with LocalCluster(n_workers=n, threads_per_worker=1, processes=True, host=LOOPBACK,
-                      dashboard_address=None, worker_dashboard_address=None,
+                      dashboard_address=f"{LOOPBACK}:0",
+                      worker_dashboard_address=f"{LOOPBACK}:0",
                       silence_logs=40) as cluster, Client(cluster) as client:
         yield client
 

@@ -129,7 +129,7 @@ def point_params(base: DimensionlessParams, values: dict[str, float],
     """``base`` with the axis ``values`` applied (lambda before W0 = ratio * lambda)."""
     changes: dict[str, float | int] = {g: values[g] for g in GROUPS if g in values}
     if "n" in changes:
-        changes["n"] = int(round(changes["n"]))
+        changes["n"] = round(changes["n"])
     lam = float(changes.get("lam", base.lam))
     if "w0_ratio" in values:
         changes["w0"] = values["w0_ratio"] * lam

@@ -10,16 +10,16 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-import xarray as xr  # noqa: E402
-from matplotlib.colors import BoundaryNorm, ListedColormap  # noqa: E402
-from matplotlib.patches import Patch  # noqa: E402
+import matplotlib.pyplot as plt
+import numpy as np
+import xarray as xr
+from matplotlib.colors import BoundaryNorm, ListedColormap
+from matplotlib.patches import Patch
 
-from drill_sim_ros.model.errors import DrillSimError  # noqa: E402
-from drill_sim_ros.study.grid import AXIS_LABELS  # noqa: E402
-from drill_sim_ros.study.point import VARIABLES  # noqa: E402
-from drill_sim_ros.study.regime import REGIME_COLORS, REGIME_NAMES  # noqa: E402
+from drill_sim_ros.model.errors import DrillSimError
+from drill_sim_ros.study.grid import AXIS_LABELS
+from drill_sim_ros.study.point import VARIABLES
+from drill_sim_ros.study.regime import REGIME_COLORS, REGIME_NAMES
 
 REGIME_CMAP = ListedColormap(REGIME_COLORS)
 REGIME_NORM = BoundaryNorm(np.arange(-0.5, len(REGIME_NAMES)), len(REGIME_NAMES))
@@ -52,10 +52,7 @@ def draw_regime(ax: plt.Axes, da: xr.DataArray, labels: bool = True) -> None:
     for code in present:
         if not labels:
             break
-        rows, cols = np.nonzero(da.values == code)
-        mid = len(rows) // 2
-        order = np.lexsort((cols, rows))
-        r, c = rows[order[mid]], cols[order[mid]]
+        r, c = _label_cell(da.values == code)
         ax.text(da[x].values[c], da[y].values[r], REGIME_NAMES[code], ha="center",
                 va="center", fontsize=8, color="white" if code >= 2 else "black",
                 bbox={"boxstyle": "round,pad=0.2", "fc": REGIME_COLORS[code], "ec": "none",
@@ -64,6 +61,17 @@ def draw_regime(ax: plt.Axes, da: xr.DataArray, labels: bool = True) -> None:
               fontsize=7, loc="upper right", framealpha=0.9)
     ax.set_xlabel(axis_label(str(x)))
     ax.set_ylabel(axis_label(str(y)))
+
+
+def _label_cell(mask: np.ndarray) -> tuple[int, int]:
+    """The cell of ``mask`` nearest the middle of its region, kept off the edges when the
+    region allows."""
+    rows, cols = np.nonzero(mask)
+    inner = (rows > 0) & (rows < mask.shape[0] - 1) & (cols > 0) & (cols < mask.shape[1] - 1)
+    if inner.any():
+        rows, cols = rows[inner], cols[inner]
+    best = np.argmin((rows - rows.mean()) ** 2 + (cols - cols.mean()) ** 2)
+    return int(rows[best]), int(cols[best])
 
 
 def draw_variable(ax: plt.Axes, da: xr.DataArray, levels: int = 6, cmap: str = "viridis",

@@ -22,7 +22,7 @@ from drill_sim_ros.study.regime import classify
 
 SAMPLE_DTAU = 0.01        # window sampling of omega and v (axial periods are >= ~0.1)
 CHUNK_STEPS = 500_000
-SCHMITT_FRACTION = 0.25   # hysteresis of the period detector, of the half-range of omega
+SCHMITT_FRACTION = 0.25   # hysteresis of the period detector, of the half range of omega
 
 # name: (units, description). The order is the column order of evaluate_point's output.
 VARIABLES: dict[str, tuple[str, str]] = {
@@ -59,7 +59,8 @@ def evaluate_point(params: DimensionlessParams, num: Numerics) -> np.ndarray:
         tau, omega, v = _run(sim, num)
     except NumericalFault:
         return np.full(N_VARS, math.nan)
-    return _figures(params, num, sim.accumulators, tau, omega, v)
+    with np.errstate(divide="ignore", invalid="ignore"):   # <delta> = 0: E, S infinite
+        return _figures(params, num, sim.accumulators, tau, omega, v)
 
 
 def _run(sim: Simulator, num: Numerics) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -111,16 +112,18 @@ def _figures(p: DimensionlessParams, num: Numerics, acc: np.ndarray, tau: np.nda
 
 
 def torsional_period(tau: np.ndarray, omega: np.ndarray) -> float:
-    """Mean time between upward crossings of the bit speed through its mean, with
-    hysteresis (a crossing counts from below mean - h to above mean + h); NaN when the
-    record holds fewer than two whole cycles or no oscillation."""
+    """Mean time between upward crossings of the bit speed through the middle of its
+    range, with hysteresis (a crossing counts from below mid - h to above mid + h,
+    h = SCHMITT_FRACTION * half range; the middle, not the mean, so cycles that stick most
+    of the time count too); NaN with fewer than two whole cycles or no oscillation."""
     if omega.size < 3:
         return math.nan
-    mean, half_range = float(omega.mean()), 0.5 * float(omega.max() - omega.min())
-    if not half_range > 1e-12 * max(1.0, abs(mean)):
+    lo, hi = float(omega.min()), float(omega.max())
+    mid, half_range = 0.5 * (lo + hi), 0.5 * (hi - lo)
+    if not half_range > 1e-12 * max(1.0, abs(mid)):
         return math.nan
     h = SCHMITT_FRACTION * half_range
-    below, above = omega < mean - h, omega > mean + h
+    below, above = omega < mid - h, omega > mid + h
     events = np.flatnonzero(below | above)
     kind = above[events]
     ups = events[np.flatnonzero(kind[1:] & ~kind[:-1]) + 1]

@@ -58,7 +58,7 @@ def new_dataset(spec: MapSpec) -> xr.Dataset:
 
 def _axis_values(axis: Axis) -> np.ndarray:
     if axis.name == "n":
-        return np.array([int(round(v)) for v in axis.values], dtype=np.int64)
+        return np.array([round(v) for v in axis.values], dtype=np.int64)
     return np.array(axis.values, dtype=np.float64)
 
 
