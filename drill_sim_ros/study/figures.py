@@ -31,7 +31,7 @@ from drill_sim_ros.model.errors import DrillSimError
 from drill_sim_ros.model.params import DimensionlessParams
 from drill_sim_ros.model.presets import load_preset
 from drill_sim_ros.model.simulator import SimConfig, Simulator
-from drill_sim_ros.study import engine, plot
+from drill_sim_ros.study import engine, plot, store
 from drill_sim_ros.study.cli import MapProgress
 from drill_sim_ros.study.grid import Axis, MapSpec, Numerics, parse_vary
 from drill_sim_ros.study.point import torsional_period
