@@ -53,8 +53,11 @@ class Maps:
 
     def get(self, name: str, spec: MapSpec) -> xr.Dataset:
         path = self.directory / f"{name}.nc"
-        if path.exists() and store.load(path).attrs.get("spec_json") != spec.to_json():
-            path.unlink()                  # the figure's definition changed: start afresh
+        if path.exists():
+            attrs = store.load(path).attrs
+            if (attrs.get("spec_json") != spec.to_json()
+                    or attrs.get("model_fingerprint") != store.model_fingerprint()):
+                path.unlink()              # the figure or the model changed: start afresh
         bar = MapProgress(self.progress)
         try:
             run = engine.run_map(spec, path, self.client, progress=bar)
@@ -274,40 +277,51 @@ def fig11(out: Path, maps: Maps) -> Path:
 FIG12_OMEGAS = [1.0, 2.0, 3.0, 4.0, 6.0, 8.0, 10.0]
 
 
+FIG12_LAM_ADMISSIBLE = 5.0     # W0' = 1.6: below the bouncing bound of Figs. 13-14
+
+
 def fig12(out: Path, maps: Maps) -> Path:
-    ds = maps.get("fig12", spec("fig12", "beta=0.276,1.5",
-                                values_axis("omega0", FIG12_OMEGAS)))
-    base = load_preset("fig12").params
-    fig, axes = plt.subplots(1, 2, figsize=(11, 5))
-    for ax, beta in zip(axes, ds["beta"].values, strict=True):
-        row = ds.sel(beta=beta)
-        s, e = row["drilling_strength"].values, row["specific_energy"].values
-        p0 = base.with_(beta=float(beta))
-        triv_s = [p0.w0 / (p0.w0 - p0.lam)]
-        triv_e = [analysis.trivial_solution(p0).torque / (p0.w0 - p0.lam)]
-        line_s = np.linspace(1.0, max(np.nanmax(s), triv_s[0]) * 1.05, 50)
-        ax.plot(line_s, 1 - beta + beta * line_s, "k-", lw=0.8, label="friction line (eq. 50)")
-        ax.plot([1], [1], "k*", ms=10, label="cutting point")
-        ax.plot(triv_s, triv_e, "ws", mec="k", ms=9, label="trivial solution")
-        sc = ax.scatter(s, e, c=row["omega0"].values, cmap="plasma", s=40, zorder=3)
-        for si, ei, w in zip(s, e, row["omega0"].values, strict=True):
-            ax.annotate(f"{w:g}", (si, ei), textcoords="offset points", xytext=(5, -10),
-                        fontsize=7)
-        bounced = row["regime"].values == BOUNCING
-        if bounced.any():
-            ax.plot(s[bounced], e[bounced], "o", mfc="none", mec="k", ms=11,
-                    label="bit bounced")
-        plt.colorbar(sc, ax=ax, label="ω₀")
-        ax.set_xlabel("S = ⟨W⟩/⟨δ⟩")
-        ax.set_ylabel("E = ⟨T⟩/⟨δ⟩")
-        ax.set_title(f"β = {beta:g}", fontsize=10)
-        ax.legend(fontsize=7, loc="upper left")
+    cases = ((0.9, "paper's case, λ = 0.9 (W₀′ = 8.9)"),
+             (FIG12_LAM_ADMISSIBLE, f"λ = {FIG12_LAM_ADMISSIBLE:g} (W₀′ = 1.6)"))
+    fig, axes = plt.subplots(2, 2, figsize=(11, 9.5))
+    for row_axes, (lam, tag) in zip(axes, cases, strict=True):
+        name = "fig12" if lam == 0.9 else "fig12_lam5"
+        ds = maps.get(name, spec("fig12", "beta=0.276,1.5",
+                                 values_axis("omega0", FIG12_OMEGAS), lam=lam))
+        for ax, beta in zip(row_axes, ds["beta"].values, strict=True):
+            _es_panel(ax, ds.sel(beta=beta), load_preset("fig12").params.with_(
+                beta=float(beta), lam=lam))
+            ax.set_title(f"β = {beta:g}, {tag}", fontsize=9)
     caption(fig, f"RGD07 Fig. 12: E-S diagram for β = 0.276 and 1.5 with ω₀ = "
-            f"{', '.join(f'{w:g}' for w in FIG12_OMEGAS)} (W₀ = 8, ψ = 100, λ = 0.9, n = 6; "
-            f"averages over τ in [{AVERAGE_FROM:g}, {TAU_END:g}], Δτ = 5e-5). Paper: the "
-            "state point moves up the friction line with increasing ω₀ (η decreases) and "
+            f"{', '.join(f'{w:g}' for w in FIG12_OMEGAS)} (W₀ = 8, ψ = 100, n = 6; top: the "
+            f"paper's λ = 0.9, bottom: λ = {FIG12_LAM_ADMISSIBLE:g}; averages over τ in "
+            f"[{AVERAGE_FROM:g}, {TAU_END:g}], Δτ = 5e-5; circled: the bit bounced). Paper: "
+            "the state point moves up the friction line with increasing ω₀ (η decreases) and "
             "converges to the trivial solution (minimum efficiency).", 3)
     return save(fig, out / "fig12.png")
+
+
+def _es_panel(ax: plt.Axes, row: xr.Dataset, p0: DimensionlessParams) -> None:
+    """One E-S panel: friction line (eq. 50), cutting point, trivial state, the runs."""
+    s, e = row["drilling_strength"].values, row["specific_energy"].values
+    delta0 = p0.w0 - p0.lam
+    triv_s, triv_e = p0.w0 / delta0, analysis.trivial_solution(p0).torque / delta0
+    line_s = np.linspace(min(1.0, np.nanmin(s)), max(np.nanmax(s), triv_s) * 1.05, 50)
+    ax.plot(line_s, 1 - p0.beta + p0.beta * line_s, "k-", lw=0.8,
+            label="friction line (eq. 50)")
+    ax.plot([1], [1], "k*", ms=10, label="cutting point")
+    ax.plot([triv_s], [triv_e], "ws", mec="k", ms=9, label="trivial solution")
+    sc = ax.scatter(s, e, c=row["omega0"].values, cmap="plasma", s=40, zorder=3)
+    for si, ei, w in zip(s, e, row["omega0"].values, strict=True):
+        ax.annotate(f"{w:g}", (si, ei), textcoords="offset points", xytext=(5, -10),
+                    fontsize=7)
+    bounced = row["regime"].values == BOUNCING
+    if bounced.any():
+        ax.plot(s[bounced], e[bounced], "o", mfc="none", mec="k", ms=11, label="bit bounced")
+    plt.colorbar(sc, ax=ax, label="ω₀")
+    ax.set_xlabel("S = ⟨W⟩/⟨δ⟩")
+    ax.set_ylabel("E = ⟨T⟩/⟨δ⟩")
+    ax.legend(fontsize=7, loc="upper left")
 
 
 FIG13_OMEGAS = [1.0, 3.0, 4.0, 7.0, 8.2, 8.4]
@@ -395,12 +409,12 @@ def field_map(out: Path, maps: Maps) -> Path:
     regime = ds["regime"].assign_coords(wob_n=ds["wob_n"] / 1e3)
     plot.draw_regime(axes[0], regime)
     axes[0].set_ylabel("applied weight [kN]")
-    ssi = ds["ssi"].assign_coords(wob_n=ds["wob_n"] / 1e3)
+    ssi = ds["ssi"].where(ds["regime"] != BOUNCING).assign_coords(wob_n=ds["wob_n"] / 1e3)
     plot.draw_variable(axes[1], ssi, label="SSI = (max − min)/(2 mean) of bit rpm",
                        cmap="magma")
     axes[1].set_ylabel("applied weight [kN]")
     axes[0].set_title("regime (no controller)", fontsize=10)
-    axes[1].set_title("stick-slip severity", fontsize=10)
+    axes[1].set_title("stick-slip severity (blank: bouncing)", fontsize=10)
     caption(fig, f"Field preset {pr.name} (8.5-in PDC bit in shale, 2500 m of 5-in pipe, "
             f"t* = {pr.scales.time_s:.3f} s, ψ = {pr.params.psi:.0f}, β = "
             f"{pr.params.beta:.2f}, λ = {pr.params.lam:.2f}) over surface speed and applied "

@@ -2,13 +2,15 @@
 
 One data variable per :data:`point.VARIABLES` entry, over the map's axes (coordinates in
 their units), plus ``done`` (1 where the point was computed). The attributes hold the spec
-(``spec_json``, compared on resume), the numerics, the package version and the regime
+(``spec_json``) and a fingerprint of the model code (``model_fingerprint``), both
+compared on resume, the numerics, the package version and the regime
 codes. Files are replaced atomically (written beside, then renamed), so an interrupted
 write never leaves a broken map.
 """
 
 from __future__ import annotations
 
+import hashlib
 import json
 import os
 from datetime import UTC, datetime
@@ -24,6 +26,19 @@ from drill_sim_ros.study.point import VARIABLES
 from drill_sim_ros.study.regime import REGIME_NAMES
 
 ENGINE = "h5netcdf"
+# The sources whose change changes a point's figures: a map computed by other ones is not
+# resumed (the figures would mix two models).
+_MODEL_SOURCES = ("model/kernel.py", "model/simulator.py", "model/analysis.py",
+                  "study/point.py", "study/regime.py", "study/grid.py")
+
+
+def model_fingerprint() -> str:
+    """Short SHA-256 of the model and per-point sources."""
+    root = Path(__file__).resolve().parents[1]
+    digest = hashlib.sha256()
+    for name in _MODEL_SOURCES:
+        digest.update((root / name).read_bytes())
+    return digest.hexdigest()[:16]
 
 
 def new_dataset(spec: MapSpec) -> xr.Dataset:
@@ -40,6 +55,7 @@ def new_dataset(spec: MapSpec) -> xr.Dataset:
     attrs = {
         "title": "drill_sim regime map (Richard, Germay & Detournay 2007 model)",
         "spec_json": spec.to_json(), "preset": spec.preset,
+        "model_fingerprint": model_fingerprint(),
         "package": "drill_sim_ros", "package_version": __version__,
         "created_utc": datetime.now(UTC).isoformat(timespec="seconds"),
         "tau_end": num.tau_end, "average_from": num.average_from, "dtau": num.dtau,
@@ -75,6 +91,9 @@ def open_map(spec: MapSpec, path: Path) -> xr.Dataset:
     if ds.attrs.get("spec_json") != spec.to_json():
         raise DrillSimError(f"--out {path} holds a different map (other axes, base case or "
                             "numerics); choose another --out or delete the file")
+    if ds.attrs.get("model_fingerprint") != model_fingerprint():
+        raise DrillSimError(f"--out {path} was computed by another version of the model "
+                            "code; choose another --out or delete the file")
     return ds
 
 

@@ -91,3 +91,17 @@ def test_ctrl_c_keeps_done_points_and_rerun_completes(tmp_path: Path) -> None:
     assert int(final["done"].sum()) == 36
     mask = kept["done"].values == 1
     np.testing.assert_array_equal(final["kappa"].values[mask], kept["kappa"].values[mask])
+
+
+def test_map_of_other_model_code_is_refused(tmp_path: Path) -> None:
+    out = tmp_path / "map.nc"
+    ds = store.new_dataset(small_spec())
+    assert ds.attrs["model_fingerprint"] == store.model_fingerprint()
+    ds.attrs["model_fingerprint"] = "0" * 16          # as written before a kernel change
+    store.save(ds, out)
+    try:
+        store.open_map(small_spec(), out)
+    except DrillSimError as exc:
+        assert "another version of the model" in str(exc)
+    else:
+        raise AssertionError("a map of other model code was resumed")
