@@ -7,10 +7,13 @@ import argparse
 import time
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from drill_sim_ros.model.errors import DrillSimError
-from drill_sim_ros.terminal import StatusLine
+from drill_sim_ros.study.progress import MapProgress
+
+if TYPE_CHECKING:
+    from drill_sim_ros.study.grid import MapSpec
 
 CONTROLLERS_MISSING = ("--controller: closed-loop controllers are not available yet "
                        "(no controller is implemented in this version); run the map without it")
@@ -52,30 +55,8 @@ def add_parsers(sub: Any, add_model_args: Callable[[argparse.ArgumentParser], No
     f.add_argument("--workers", type=int, default=None, help="local worker processes")
 
 
-class MapProgress:
-    """Points done, rate and time left on one terminal line."""
-
-    def __init__(self, enabled: bool) -> None:
-        self.line = StatusLine(force=True) if enabled else StatusLine()
-        self.started = time.perf_counter()
-        self.first: tuple[int, float] | None = None
-
-    def __call__(self, done: int, total: int, _seconds: float) -> None:
-        now = time.perf_counter()
-        if self.first is None:
-            self.first = (done, now)
-        d0, t0 = self.first
-        rate = (done - d0) / (now - t0) if now > t0 and done > d0 else 0.0
-        eta = (total - done) / rate if rate > 0 else float("nan")
-        frac = done / total if total else 1.0
-        self.line.show(f"[{'#' * int(30 * frac):<30}] {done:,}/{total:,} points  "
-                       f"{rate:6.2f} points/s  eta {eta:6.0f} s")
-
-    def close(self) -> None:
-        self.line.close()
-
-
-def map_spec_from(args: argparse.Namespace, resolve: Callable[[argparse.Namespace], Any]):
+def map_spec_from(args: argparse.Namespace,
+                  resolve: Callable[[argparse.Namespace], Any]) -> MapSpec:
     """A :class:`MapSpec` from the ``map`` options; ``resolve`` is ``drill_sim run``'s."""
     from drill_sim_ros.model.presets import load_preset
     from drill_sim_ros.study.grid import MapSpec, Numerics, parse_vary

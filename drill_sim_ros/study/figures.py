@@ -32,9 +32,9 @@ from drill_sim_ros.model.params import DimensionlessParams
 from drill_sim_ros.model.presets import load_preset
 from drill_sim_ros.model.simulator import SimConfig, Simulator
 from drill_sim_ros.study import engine, plot, store
-from drill_sim_ros.study.cli import MapProgress
-from drill_sim_ros.study.grid import Axis, MapSpec, Numerics, parse_vary
+from drill_sim_ros.study.grid import MapSpec, Numerics, parse_vary
 from drill_sim_ros.study.point import torsional_period
+from drill_sim_ros.study.progress import MapProgress
 from drill_sim_ros.study.regime import BOUNCING
 
 TAU_END = 600.0
@@ -459,5 +459,3 @@ def make_all(out: Path, cache: Path | None = None, only: list[str] | None = None
             log(f"{name}: {time.perf_counter() - t0:.1f} s")
     return written
 
-
-__all__ = ["FIGURES", "Axis", "make_all"]
