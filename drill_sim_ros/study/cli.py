@@ -108,9 +108,14 @@ def cmd_map_plot(args: argparse.Namespace) -> int:
 def cmd_figures(args: argparse.Namespace) -> int:
     from drill_sim_ros.study import figures
     t0 = time.perf_counter()
-    written = figures.make_all(args.output, cache=args.cache, only=args.only,
-                               scheduler=args.scheduler, workers=args.workers,
-                               progress=_isatty())
+    try:
+        written = figures.make_all(args.output, cache=args.cache, only=args.only,
+                                   scheduler=args.scheduler, workers=args.workers,
+                                   progress=_isatty())
+    except KeyboardInterrupt:
+        kept = f"; the maps done are kept in {args.cache}" if args.cache else ""
+        print(f"drill_sim figures: interrupted{kept}")
+        return 130
     for path in written:
         print(f"wrote {path}")
     print(f"drill_sim figures: {len(written)} figures in {time.perf_counter() - t0:.0f} s")

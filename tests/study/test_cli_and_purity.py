@@ -74,3 +74,12 @@ def test_study_imports_no_adapters() -> None:
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                             timeout=120)
     assert result.returncode == 0, result.stdout + result.stderr
+
+
+def test_figures_renders_one_figure_and_names_unknown_ones(tmp_path: Path) -> None:
+    result = drill_sim("figures", "-o", str(tmp_path), "--only", "fig8", "--workers", "1")
+    assert result.returncode == 0, result.stderr
+    image = mpimg.imread(tmp_path / "fig8.png")
+    assert image.shape[0] > 400 and image.shape[1] > 600
+    _one_line_error(drill_sim("figures", "-o", str(tmp_path), "--only", "fig99"), "fig99",
+                    "fig11")
