@@ -18,7 +18,7 @@ from drill_sim_ros.model.errors import NumericalFault
 from drill_sim_ros.model.params import DimensionlessParams
 from drill_sim_ros.model.simulator import SimConfig, Simulator
 from drill_sim_ros.study.grid import Numerics
-from drill_sim_ros.study.regime import classify
+from drill_sim_ros.study.regime import classify, trivial_kappa
 
 SAMPLE_DTAU = 0.01        # window sampling of omega and v (axial periods are >= ~0.1)
 CHUNK_STEPS = 500_000
@@ -107,7 +107,8 @@ def _figures(p: DimensionlessParams, num: Numerics, acc: np.ndarray, tau: np.nda
     for name, value in values.items():
         out[COLUMN[name]] = value
     out[COLUMN["regime"]] = classify(avg.stick_fraction, out[COLUMN["bounce_tau"]],
-                                     avg.kappa, amplitude, num.perturb_v)
+                                     avg.kappa, amplitude, num.perturb_v,
+                                     trivial_kappa(p.w0, p.lam))
     return out
 
 

@@ -20,14 +20,21 @@ REGIME_COLORS = ("#d9d9d9", "#80b1d3", "#fb8072", "#6a3d9a")
 KAPPA_TRIVIAL = 1e-3      # below it the wearflat keeps (almost) permanent contact (eq. 42)
 
 
+def trivial_kappa(w0: float, lam: float) -> float:
+    """kappa of the trivial motion: 0 when W0 > lambda (full contact, eq. 34); when
+    W0 <= lambda the bit slides on its wearflats with W_f = W0 (eq. 18), so 1 - W0/lambda."""
+    return 1.0 - min(w0, lam) / lam if lam > 0 else 0.0
+
+
 def classify(stick_fraction: float, bounce_tau: float, kappa: float,
-             axial_amplitude: float, perturbation: float) -> int:
+             axial_amplitude: float, perturbation: float, kappa0: float = 0.0) -> int:
     """Regime code from a run's figures.
 
     bouncing: the bit left the rock at any time (bounce_tau not NaN);
     stick-slip: the bit stuck within the statistics window;
-    axial vibration only: contact was lost (kappa > KAPPA_TRIVIAL) or the axial velocity
-    oscillates with more than the initial perturbation (it grew, RGD07 App. B);
+    axial vibration only: contact was lost (kappa above the trivial ``kappa0`` by more than
+    KAPPA_TRIVIAL) or the axial velocity oscillates with more than the initial
+    perturbation (it grew, RGD07 App. B);
     trivial: otherwise (the perturbation decayed or stayed put).
     """
     if not math.isnan(bounce_tau):
@@ -35,6 +42,6 @@ def classify(stick_fraction: float, bounce_tau: float, kappa: float,
     if stick_fraction > 0.0:
         return STICK_SLIP
     grown = axial_amplitude > max(abs(perturbation), 1e-12)
-    if kappa > KAPPA_TRIVIAL or grown:
+    if kappa - kappa0 > KAPPA_TRIVIAL or grown:
         return AXIAL
     return TRIVIAL

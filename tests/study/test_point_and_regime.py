@@ -95,6 +95,15 @@ def test_below_critical_delay_stays_trivial() -> None:
     assert out[COLUMN["axial_amplitude"]] < 0.01
 
 
+def test_sliding_without_cutting_is_trivial() -> None:
+    """W0 < lambda: no cutting, the bit slides on its wearflats (text after eq. 18),
+    W_f = W0, so kappa = 1 - W0/lambda without any vibration."""
+    params = FIG8A.with_(w0=4.0)
+    code, out = _regime(params)
+    assert out[COLUMN["kappa"]] == pytest.approx(1 - 4.0 / 5.0, abs=1e-6)
+    assert code == regime.TRIVIAL
+
+
 def test_classify_order() -> None:
     assert regime.classify(0.1, 5.0, 0.2, 3.0, 0.01) == regime.BOUNCING
     assert regime.classify(0.1, math.nan, 0.2, 3.0, 0.01) == regime.STICK_SLIP

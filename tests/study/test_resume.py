@@ -78,7 +78,9 @@ def test_ctrl_c_keeps_done_points_and_rerun_completes(tmp_path: Path) -> None:
         time.sleep(0.1)
     assert re.search(r" [2-9]/36 points", "".join(err)), "".join(err)[-500:]
     proc.send_signal(signal.SIGINT)
-    stdout, _ = proc.communicate(timeout=WAIT_S)
+    proc.wait(timeout=WAIT_S)
+    reader.join(timeout=WAIT_S)                  # stderr is the reader thread's alone
+    stdout = proc.stdout.read()
     assert proc.returncode == 130, stdout + "".join(err)[-2000:]
     assert "interrupted" in stdout
     kept = store.load(out)
