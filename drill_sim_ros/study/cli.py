@@ -111,7 +111,7 @@ def cmd_figures(args: argparse.Namespace) -> int:
     try:
         written = figures.make_all(args.output, cache=args.cache, only=args.only,
                                    scheduler=args.scheduler, workers=args.workers,
-                                   progress=_isatty())
+                                   progress=_isatty(), log=print)
     except KeyboardInterrupt:
         kept = f"; the maps done are kept in {args.cache}" if args.cache else ""
         print(f"drill_sim figures: interrupted{kept}")

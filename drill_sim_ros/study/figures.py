@@ -443,7 +443,8 @@ def _map_dir(cache: Path | None) -> Iterator[Path]:
 
 def make_all(out: Path, cache: Path | None = None, only: list[str] | None = None,
              scheduler: str | None = None, workers: int | None = None,
-             progress: bool = False, log: Callable[[str], None] = print) -> list[Path]:
+             progress: bool = False,
+             log: Callable[[str], None] | None = None) -> list[Path]:
     """Render the figures named in ``only`` (default all) into ``out``."""
     names = only or list(FIGURES)
     unknown = [n for n in names if n not in FIGURES]
@@ -456,6 +457,7 @@ def make_all(out: Path, cache: Path | None = None, only: list[str] | None = None
         for name in names:
             t0 = time.perf_counter()
             written.append(FIGURES[name](out, maps))
-            log(f"{name}: {time.perf_counter() - t0:.1f} s")
+            if log:
+                log(f"{name}: {time.perf_counter() - t0:.1f} s")
     return written
 
