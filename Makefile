@@ -20,7 +20,7 @@ export PYTHONUNBUFFERED := 1
 RUN_DIR ?= runs/$(shell date -u +%Y%m%dT%H%M%SZ)
 RUN_SECONDS ?= 0
 
-.PHONY: venv run test lint bench clean colcon
+.PHONY: venv run test lint bench clean colcon figures
 
 venv: $(VENV)/.stamp
 
@@ -70,6 +70,13 @@ bench: venv
 	$(PY) benchmarks/bench_mcap.py
 	$(PY) benchmarks/bench_bridge.py
 	$(PY) benchmarks/bench_recording_faults.py
+	$(PY) benchmarks/bench_map.py
+
+# The paper's figures and the field map (docs/gallery/*.png), computed on a local Dask
+# cluster; FIGURES_CACHE keeps the maps as NetCDF so a re-run resumes them.
+FIGURES_CACHE ?= runs/figures
+figures: venv
+	$(BIN)/drill_sim figures -o docs/gallery --cache $(FIGURES_CACHE)
 
 # The ament_python install tree that `ros2 run drill_sim_ros sim_node` uses.
 colcon: venv

@@ -1,4 +1,4 @@
-"""Offline command line: ``drill_sim run | sweep | presets | info``.
+"""Offline command line: ``drill_sim run | sweep | presets | info | map | map-plot | figures``.
 
 ``drill_sim run`` integrates the RGD07 model without ROS and prints a summary (or one JSON
 object with ``--json``). The run is dimensionless unless ``--params`` names a physical
@@ -25,6 +25,7 @@ from drill_sim_ros.model.params import GROUPS, UNIT_SCALES, DimensionlessParams,
 from drill_sim_ros.model.presets import Preset, available_presets, load_preset
 from drill_sim_ros.model.simulator import SimConfig, Simulator
 from drill_sim_ros.model.top_drive import MODES, TopDrive
+from drill_sim_ros.study import cli as study_cli
 from drill_sim_ros.terminal import StatusLine
 
 TRACE_COLUMNS = ("tau", "omega", "v", "wob", "tob", "depth_of_cut", "surface_torque", "mode")
@@ -113,6 +114,7 @@ def build_parser() -> argparse.ArgumentParser:
     sub.add_parser("presets", help="list the presets")
     info = sub.add_parser("info", help="groups, scales and stability of a preset")
     info.add_argument("preset", nargs="?", default="field_8p5in_shale")
+    study_cli.add_parsers(sub, _add_model_args)
     return parser
 
 
@@ -393,7 +395,11 @@ def main(argv: Sequence[str] | None = None) -> int:
             for name in available_presets():
                 print(f"{name:22s} {load_preset(name).description.splitlines()[0]}")
             return 0
-        return {"run": _cmd_run, "sweep": _cmd_sweep, "info": _cmd_info}[args.command](args)
+        if args.command == "map":
+            return study_cli.cmd_map(args, _resolve)
+        return {"run": _cmd_run, "sweep": _cmd_sweep, "info": _cmd_info,
+                "map-plot": study_cli.cmd_map_plot,
+                "figures": study_cli.cmd_figures}[args.command](args)
     except DrillSimError as exc:
         print(f"drill_sim: error: {exc}", file=sys.stderr)
         return 2

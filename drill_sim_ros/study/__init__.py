@@ -1,0 +1,1 @@
+"""Studies: regime maps computed on Dask distributed, and the paper's figures (no ROS)."""

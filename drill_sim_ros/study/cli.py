@@ -1,0 +1,137 @@
+"""``drill_sim map``, ``drill_sim map-plot`` and ``drill_sim figures`` (wired in by
+:mod:`drill_sim_ros.cli`, which lends its model options and their resolution)."""
+
+from __future__ import annotations
+
+import argparse
+import time
+from collections.abc import Callable
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from drill_sim_ros.model.errors import DrillSimError
+from drill_sim_ros.study.progress import MapProgress
+
+if TYPE_CHECKING:
+    from drill_sim_ros.study.grid import MapSpec
+
+CONTROLLERS_MISSING = ("--controller: closed-loop controllers are not available yet "
+                       "(no controller is implemented in this version); run the map without it")
+
+
+def add_parsers(sub: Any, add_model_args: Callable[[argparse.ArgumentParser], None]) -> None:
+    """The three sub-commands on the ``drill_sim`` sub-parser ``sub``."""
+    m = sub.add_parser("map", help="regime map over a grid of parameters (Dask), to NetCDF")
+    add_model_args(m)
+    m.add_argument("--vary", action="append", required=True, metavar="NAME=START:STOP:COUNT",
+                   help="a varied axis (repeat for a grid): n, psi, beta, lam, w0, omega0, "
+                        "w0_ratio (= W0/lam, lam held); physical presets also surface_rpm "
+                        "[rpm] and wob_n [N]. Values also as NAME=V1,V2,...")
+    m.add_argument("--out", type=Path, default=Path("map.nc"),
+                   help="NetCDF file (default map.nc); a re-run with the same file resumes")
+    m.add_argument("--scheduler", help="address of an existing Dask scheduler "
+                   "(tcp://HOST:PORT); default: a local cluster on 127.0.0.1")
+    m.add_argument("--workers", type=int, default=None,
+                   help="local worker processes (default: one per core)")
+    m.add_argument("--batch", type=int, default=None, help="points per task (default: "
+                   "about 8 tasks per worker, at most 64 points)")
+    m.add_argument("--controller", default=None, help="closed-loop controller (not "
+                   "available yet)")
+    p = sub.add_parser("map-plot", help="draw a map file (regime map or one variable)")
+    p.add_argument("map", type=Path, help="NetCDF file written by drill_sim map")
+    p.add_argument("-o", "--output", type=Path, default=None, help="PNG (default: MAP.png)")
+    p.add_argument("--var", default="regime", help="variable to draw (default regime)")
+    p.add_argument("--at", action="append", default=[], metavar="NAME=VALUE",
+                   help="for maps of more than two axes: the value of an extra axis "
+                        "(nearest point)")
+    f = sub.add_parser("figures", help="regenerate the paper's figures (PNG gallery)")
+    f.add_argument("-o", "--output", type=Path, default=Path("docs/gallery"),
+                   help="directory of the PNGs (default docs/gallery)")
+    f.add_argument("--cache", type=Path, default=None, help="keep the figures' maps here "
+                   "and resume them (default: compute afresh in a temporary directory)")
+    f.add_argument("--only", action="append", default=None, help="only this figure "
+                   "(repeatable; names as the PNG files without .png)")
+    f.add_argument("--scheduler", help="existing Dask scheduler (tcp://HOST:PORT)")
+    f.add_argument("--workers", type=int, default=None, help="local worker processes")
+
+
+def map_spec_from(args: argparse.Namespace,
+                  resolve: Callable[[argparse.Namespace], Any]) -> MapSpec:
+    """A :class:`MapSpec` from the ``map`` options; ``resolve`` is ``drill_sim run``'s."""
+    from drill_sim_ros.model.presets import load_preset
+    from drill_sim_ros.study.grid import MapSpec, Numerics, parse_vary
+    run = resolve(args)
+    num = Numerics(tau_end=run.tau_end, average_from=run.average_from, dtau=run.dtau,
+                   n_nodes=run.n_nodes, method=run.method, perturb_v=run.perturb_v,
+                   perturb_omega=run.perturb_omega)
+    name = load_preset(args.params).name if args.params else ""
+    return MapSpec(run.params, tuple(parse_vary(v) for v in args.vary), num,
+                   scales=run.scales if run.physical else None, preset=name)
+
+
+def cmd_map(args: argparse.Namespace, resolve: Callable[[argparse.Namespace], Any]) -> int:
+    if args.controller is not None:
+        raise DrillSimError(CONTROLLERS_MISSING)
+    if args.batch is not None and not 1 <= args.batch <= 100_000:
+        raise DrillSimError(f"--batch = {args.batch} must be in [1, 100000]")
+    from drill_sim_ros.study import engine
+    spec = map_spec_from(args, resolve)
+    bar = MapProgress(args.progress or _isatty())
+    try:
+        with engine.connect(args.scheduler, args.workers) as client:
+            result = engine.run_map(spec, args.out, client, progress=bar, batch=args.batch)
+    except KeyboardInterrupt:
+        result = None
+    finally:
+        bar.close()
+    if result is None or result.interrupted:
+        print(f"drill_sim map: interrupted; the points done are kept in {args.out}; "
+              "re-run the same command to resume")
+        return 130
+    done = int(result.dataset["done"].sum())
+    rate = result.computed / result.seconds if result.seconds > 0 else 0.0
+    print(f"drill_sim map: {done}/{result.total} points in {args.out} "
+          f"({result.computed} computed now in {result.seconds:.1f} s, {rate:.2f} points/s)")
+    return 0
+
+
+def cmd_map_plot(args: argparse.Namespace) -> int:
+    from drill_sim_ros.study import plot, store
+    ds = store.load(args.map)
+    out = args.output or args.map.with_suffix(".png")
+    at = dict(_parse_at(text) for text in args.at)
+    plot.plot_file(ds, args.var, out, at)
+    print(f"drill_sim map-plot: wrote {out}")
+    return 0
+
+
+def cmd_figures(args: argparse.Namespace) -> int:
+    from drill_sim_ros.study import figures
+    t0 = time.perf_counter()
+    try:
+        written = figures.make_all(args.output, cache=args.cache, only=args.only,
+                                   scheduler=args.scheduler, workers=args.workers,
+                                   progress=_isatty(), log=print)
+    except KeyboardInterrupt:
+        kept = f"; the maps done are kept in {args.cache}" if args.cache else ""
+        print(f"drill_sim figures: interrupted{kept}")
+        return 130
+    for path in written:
+        print(f"wrote {path}")
+    print(f"drill_sim figures: {len(written)} figures in {time.perf_counter() - t0:.0f} s")
+    return 0
+
+
+def _parse_at(text: str) -> tuple[str, float]:
+    name, sep, value = text.partition("=")
+    try:
+        if not sep:
+            raise ValueError(text)
+        return name.strip(), float(value)
+    except ValueError as exc:
+        raise DrillSimError(f"--at {text!r}: expected NAME=VALUE") from exc
+
+
+def _isatty() -> bool:
+    import sys
+    return sys.stderr.isatty()

@@ -1,0 +1,128 @@
+"""A map as an xarray Dataset in NetCDF-4 (h5netcdf engine), and resuming one.
+
+One data variable per :data:`point.VARIABLES` entry, over the map's axes (coordinates in
+their units), plus ``done`` (1 where the point was computed). The attributes hold the spec
+(``spec_json``) and a fingerprint of the model code (``model_fingerprint``), both
+compared on resume, the numerics, the package version and the regime
+codes. Files are replaced atomically (written beside, then renamed), so an interrupted
+write never leaves a broken map.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+from datetime import UTC, datetime
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+from drill_sim_ros import __version__
+from drill_sim_ros.model.errors import DrillSimError
+from drill_sim_ros.study.grid import AXIS_LABELS, Axis, MapSpec
+from drill_sim_ros.study.point import VARIABLES
+from drill_sim_ros.study.regime import REGIME_NAMES
+
+ENGINE = "h5netcdf"
+# The sources whose change changes a point's figures: a map computed by other ones is not
+# resumed (the figures would mix two models).
+_MODEL_SOURCES = ("model/kernel.py", "model/simulator.py", "model/analysis.py",
+                  "study/point.py", "study/regime.py", "study/grid.py")
+
+
+def model_fingerprint() -> str:
+    """Short SHA-256 of the model and per-point sources."""
+    root = Path(__file__).resolve().parents[1]
+    digest = hashlib.sha256()
+    for name in _MODEL_SOURCES:
+        digest.update((root / name).read_bytes())
+    return digest.hexdigest()[:16]
+
+
+def new_dataset(spec: MapSpec) -> xr.Dataset:
+    """An empty map: every variable NaN, ``done`` all 0."""
+    dims = tuple(a.name for a in spec.axes)
+    coords = {a.name: (a.name, _axis_values(a), {"units": a.units,
+                                                 "long_name": AXIS_LABELS[a.name]})
+              for a in spec.axes}
+    data = {name: (dims, np.full(spec.shape, np.nan), {"units": units, "long_name": text})
+            for name, (units, text) in VARIABLES.items()}
+    data["done"] = (dims, np.zeros(spec.shape, dtype=np.int8),
+                    {"units": "1", "long_name": "1 where the point was computed"})
+    num = spec.numerics
+    attrs = {
+        "title": "drill_sim regime map (Richard, Germay & Detournay 2007 model)",
+        "spec_json": spec.to_json(), "preset": spec.preset,
+        "model_fingerprint": model_fingerprint(),
+        "package": "drill_sim_ros", "package_version": __version__,
+        "created_utc": datetime.now(UTC).isoformat(timespec="seconds"),
+        "tau_end": num.tau_end, "average_from": num.average_from, "dtau": num.dtau,
+        "n_nodes": num.n_nodes, "method": num.method, "perturb_v": num.perturb_v,
+        "perturb_omega": num.perturb_omega,
+        "regime_codes": json.dumps(dict(enumerate(REGIME_NAMES))),
+        "base_params": json.dumps({g: getattr(spec.base, g) for g in
+                                   ("n", "psi", "beta", "lam", "w0", "omega0")}),
+        "averages": "time averages over [average_from, tau_end], stick phases included",
+    }
+    if spec.scales is not None:
+        attrs.update(t_star_s=spec.scales.time_s, l_star_m=spec.scales.length_m,
+                     force_unit_n=spec.scales.force_n, torque_unit_nm=spec.scales.torque_nm)
+    return xr.Dataset(data, coords=coords, attrs=attrs)
+
+
+def _axis_values(axis: Axis) -> np.ndarray:
+    if axis.name == "n":
+        return np.array([round(v) for v in axis.values], dtype=np.int64)
+    return np.array(axis.values, dtype=np.float64)
+
+
+def open_map(spec: MapSpec, path: Path) -> xr.Dataset:
+    """The map at ``path`` if it holds this spec (resume), else a new one. A file holding
+    another map is refused, so nothing is overwritten by mistake."""
+    if not path.exists():
+        return new_dataset(spec)
+    try:
+        ds = xr.load_dataset(path, engine=ENGINE)
+    except (OSError, ValueError) as exc:
+        raise DrillSimError(f"--out {path}: not a readable map ({exc}); choose another "
+                            "--out or delete the file") from exc
+    if ds.attrs.get("spec_json") != spec.to_json():
+        raise DrillSimError(f"--out {path} holds a different map (other axes, base case or "
+                            "numerics); choose another --out or delete the file")
+    if ds.attrs.get("model_fingerprint") != model_fingerprint():
+        raise DrillSimError(f"--out {path} was computed by another version of the model "
+                            "code; choose another --out or delete the file")
+    return ds
+
+
+def save(ds: xr.Dataset, path: Path) -> None:
+    """Write ``ds`` to ``path`` atomically."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(path.name + ".partial")
+    ds.attrs["saved_utc"] = datetime.now(UTC).isoformat(timespec="seconds")
+    ds.to_netcdf(tmp, engine=ENGINE)
+    os.replace(tmp, path)
+
+
+def load(path: Path) -> xr.Dataset:
+    """Read a map written by :func:`save` (into memory; the file is closed)."""
+    if not path.exists():
+        raise DrillSimError(f"map file {path} does not exist")
+    try:
+        return xr.load_dataset(path, engine=ENGINE)
+    except (OSError, ValueError) as exc:
+        raise DrillSimError(f"map file {path} is not a readable NetCDF map ({exc})") from exc
+
+
+def store_results(ds: xr.Dataset, flat_indices: np.ndarray, results: np.ndarray) -> None:
+    """Write rows of :func:`point.evaluate_point` output at ``flat_indices``; mark done."""
+    for j, name in enumerate(VARIABLES):
+        ds[name].values.reshape(-1)[flat_indices] = results[:, j]
+    ds["done"].values.reshape(-1)[flat_indices] = 1
+
+
+def pending(ds: xr.Dataset) -> np.ndarray:
+    """Flat indices of the points not computed yet."""
+    return np.flatnonzero(ds["done"].values.reshape(-1) == 0)

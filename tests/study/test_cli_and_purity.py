@@ -1,0 +1,85 @@
+"""User errors of the study commands, map-plot output, and a core free of ROS."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import matplotlib.image as mpimg
+import numpy as np
+
+from drill_sim_ros.study import engine, store
+from tests.study.helpers import drill_sim, small_spec
+
+
+def _one_line_error(result: subprocess.CompletedProcess[str], *words: str) -> None:
+    assert result.returncode == 2
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and "Traceback" not in result.stderr, result.stderr
+    for word in words:
+        assert word in lines[0], lines[0]
+
+
+def test_bad_vary_name_names_the_allowed_ones(tmp_path: Path) -> None:
+    _one_line_error(drill_sim("map", "--vary", "speed=1:2:3", "--out", str(tmp_path / "m.nc")),
+                    "speed", "omega0", "w0_ratio")
+
+
+def test_si_axis_needs_a_physical_preset(tmp_path: Path) -> None:
+    _one_line_error(drill_sim("map", "--vary", "surface_rpm=40:80:3", "--out",
+                              str(tmp_path / "m.nc")), "surface_rpm", "physical preset")
+
+
+def test_two_weight_axes_refused(tmp_path: Path) -> None:
+    _one_line_error(drill_sim("map", "--vary", "w0=7:8:2", "--vary", "w0_ratio=1.2:1.4:2",
+                              "--out", str(tmp_path / "m.nc")), "w0", "w0_ratio")
+
+
+def test_controller_not_available_yet(tmp_path: Path) -> None:
+    _one_line_error(drill_sim("map", "--vary", "w0=7:8:2", "--controller", "soft_torque",
+                              "--out", str(tmp_path / "m.nc")), "--controller",
+                    "not available yet")
+
+
+def test_map_plot_draws_regimes_and_variables(tmp_path: Path) -> None:
+    out = tmp_path / "map.nc"
+    with engine.connect(workers=1) as client:
+        engine.run_map(small_spec(), out, client)
+    for var in ("regime", "kappa"):
+        png = tmp_path / f"{var}.png"
+        result = drill_sim("map-plot", str(out), "-o", str(png), "--var", var)
+        assert result.returncode == 0, result.stderr
+        image = mpimg.imread(png)
+        assert image.shape[0] > 300 and image.shape[1] > 400
+        assert len(np.unique(image.reshape(-1, image.shape[-1]), axis=0)) > 10
+    _one_line_error(drill_sim("map-plot", str(out), "--var", "nope"), "nope", "kappa")
+    _one_line_error(drill_sim("map-plot", str(tmp_path / "missing.nc")), "missing.nc")
+
+
+def test_dataset_attributes_hold_inputs_and_units(tmp_path: Path) -> None:
+    ds = store.new_dataset(small_spec())
+    assert ds.attrs["spec_json"] == small_spec().to_json()
+    assert ds.attrs["tau_end"] == 60.0 and ds.attrs["dtau"] == 1e-4
+    assert ds["w0_ratio"].attrs["units"] == "1"
+    assert all("units" in ds[v].attrs for v in ds.data_vars)
+
+
+def test_study_imports_no_adapters() -> None:
+    code = ("import sys, drill_sim_ros.study.engine, drill_sim_ros.study.figures, "
+            "drill_sim_ros.study.cli\n"
+            "bad = [m for m in sys.modules if m.split('.')[0] in "
+            "('rclpy', 'mcap', 'mcap_ros2', 'rerun', 'rosbags')]\n"
+            "print(bad); sys.exit(1 if bad else 0)")
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                            timeout=120)
+    assert result.returncode == 0, result.stdout + result.stderr
+
+
+def test_figures_renders_one_figure_and_names_unknown_ones(tmp_path: Path) -> None:
+    result = drill_sim("figures", "-o", str(tmp_path), "--only", "fig8", "--workers", "1")
+    assert result.returncode == 0, result.stderr
+    image = mpimg.imread(tmp_path / "fig8.png")
+    assert image.shape[0] > 400 and image.shape[1] > 600
+    _one_line_error(drill_sim("figures", "-o", str(tmp_path), "--only", "fig99"), "fig99",
+                    "fig11")
