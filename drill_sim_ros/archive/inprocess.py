@@ -5,11 +5,19 @@ sized for about 100 s of the sim's default output; the writer thread sustains we
 sim's rate (see benchmarks/bench_mcap.py), so in lockstep and in free-run the queue never
 fills and ``close()`` drains every queued message. Only a writer that falls ~100 s behind
 drops messages, and each drop is counted in ``dropped``.
+
+Log time: the caller passes each message's simulated time (its header stamp); the file stores
+log time = wall-clock origin + simulated time. The spacing stays that of simulated time (a
+replay at rate 1 paces like the sim), and the file starts at the real date of the run
+(Foxglove, ``ros2 bag info``), like an ``mcap_recorder`` file. The origin defaults to the
+wall clock at the first message minus its simulated time; the stamps are not changed.
 """
 
 from __future__ import annotations
 
 import logging
+import threading
+import time
 
 from rclpy.qos import QoSProfile
 from rclpy.serialization import serialize_message
@@ -28,6 +36,8 @@ class InProcessRecorder:
     node_name: the publishing node, for the log; topics must be added before they are written.
     metadata: written once as an MCAP metadata record named ``drill_sim`` (e.g. the preset,
     so ``mcap_to_rerun`` picks the right scales).
+    log_time_origin_ns: wall-clock ns (Unix epoch) of simulated time 0; None: set from the
+    wall clock at the first message.
     """
 
     def __init__(
@@ -37,8 +47,11 @@ class InProcessRecorder:
         capacity: int = DEFAULT_CAPACITY,
         compression: str = "zstd",
         metadata: dict[str, str] | None = None,
+        log_time_origin_ns: int | None = None,
     ) -> None:
         self.path = path
+        self._origin_ns = log_time_origin_ns
+        self._origin_lock = threading.Lock()
         self.node_name = node_name
         self._topics: set[str] = set()
         writer = Ros2McapWriter(path, compression=compression)
@@ -56,19 +69,31 @@ class InProcessRecorder:
         self._topics.add(topic)
         self._writer.add_channel(topic, msg_type, offered)
 
-    def write(self, topic: str, message: object, log_time_ns: int) -> None:
+    @property
+    def log_time_origin_ns(self) -> int | None:
+        """Wall-clock ns of simulated time 0 in the file's log times (None before a message)."""
+        return self._origin_ns
+
+    def _log_time(self, sim_time_ns: int) -> int:
+        if self._origin_ns is None:
+            with self._origin_lock:          # the first writer on any thread sets it
+                if self._origin_ns is None:
+                    self._origin_ns = time.time_ns() - sim_time_ns
+        return self._origin_ns + sim_time_ns
+
+    def write(self, topic: str, message: object, sim_time_ns: int) -> None:
         """Serialize ``message`` and queue it; never blocks, counts a drop on overflow."""
         if topic not in self._topics:
             self._unknown_topic_drops += 1
             return
-        self._writer.put(topic, serialize_message(message), log_time_ns)
+        self._writer.put(topic, serialize_message(message), self._log_time(sim_time_ns))
 
-    def write_serialized(self, topic: str, data: bytes, log_time_ns: int) -> None:
+    def write_serialized(self, topic: str, data: bytes, sim_time_ns: int) -> None:
         """Queue bytes already in CDR (what the publisher sent); never blocks."""
         if topic not in self._topics:
             self._unknown_topic_drops += 1
             return
-        self._writer.put(topic, data, log_time_ns)
+        self._writer.put(topic, data, self._log_time(sim_time_ns))
 
     @property
     def dropped(self) -> int:

@@ -14,6 +14,9 @@ from __future__ import annotations
 
 import json
 import os
+import shutil
+import subprocess
+import sys
 import uuid
 from pathlib import Path
 
@@ -68,6 +71,37 @@ def disable_analytics() -> Path:
         tmp.write_text(json.dumps(wanted))
         os.replace(tmp, path)
     return path
+
+
+def rerun_cli() -> str | None:
+    """The rerun CLI of this environment (beside the interpreter), else the one on PATH."""
+    beside = Path(sys.executable).with_name("rerun")
+    return str(beside) if beside.exists() else shutil.which("rerun")
+
+
+def read_back(env: dict[str, str] | None = None) -> tuple[dict | None, str]:
+    """What ``rerun analytics config`` loads (it starts no viewer): (config, its stderr).
+
+    Call it only after :func:`disable_analytics`: like any rerun CLI call it would queue a
+    usage event on a first run.
+    """
+    exe = rerun_cli()
+    if exe is None:
+        return None, "no rerun CLI found"
+    done = subprocess.run([exe, "analytics", "config"], env=env, capture_output=True,
+                          text=True, timeout=60, check=False)
+    try:
+        loaded = json.loads(done.stdout)
+    except ValueError:
+        loaded = None
+    return (loaded if isinstance(loaded, dict) else None), done.stderr
+
+
+def rerun_reads_disabled() -> bool:
+    """True when rerun itself reads this user's analytics config as valid and disabled."""
+    loaded, stderr = read_back()
+    return (loaded is not None and loaded.get("analytics_enabled") is False
+            and "failed to load" not in stderr)
 
 
 if __name__ == "__main__":

@@ -28,6 +28,7 @@ from drill_sim_ros.model.presets import DEFAULT_PRESET
 from drill_sim_ros.viz.analytics_off import disable_analytics
 from drill_sim_ros.viz.blueprint import build_blueprint
 from drill_sim_ros.viz.dashboard import Dashboard
+from drill_sim_ros.viz.frames import Extents, view_frames
 from drill_sim_ros.viz.paper_units import PaperUnits
 from drill_sim_ros.viz.recording import (
     DEFAULT_SERVE_PORT,
@@ -148,9 +149,10 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
 def make_dashboard(args: argparse.Namespace) -> Dashboard:
     units = PaperUnits.load(args.preset)
     window = default_window_s(units) if args.window_s is None else args.window_s
-    rec = open_recording(build_blueprint(window), save=args.save, connect=args.connect,
-                         serve_port=args.serve_port if args.serve else None)
-    return Dashboard(rec, units, window)
+    frames = view_frames(units, Extents.typical())     # live: the data is not known yet
+    rec = open_recording(build_blueprint(window, frames), save=args.save,
+                         connect=args.connect, serve_port=args.serve_port if args.serve else None)
+    return Dashboard(rec, units, window, frames)
 
 
 def _interrupt(signum: int, frame: object) -> None:

@@ -1,7 +1,11 @@
 """``mcap_to_rerun FILE.mcap -o FILE.rrd``: a recorded run as the drilling dashboard.
 
 The same views as the live bridge (:class:`~drill_sim_ros.viz.dashboard.Dashboard`), from the
-``/drill/telemetry`` messages of the file. Turns rerun's analytics off first.
+``/drill/telemetry`` messages of the file, on the ``sim_time`` timeline of their own
+``sim_time_s`` field: the MCAP log time (simulated time from a wall-clock start in an in-process
+recording, receipt time in an ``mcap_recorder`` file) is not used, so both files of one run
+give the same dashboard. The file is read twice: first to frame the 2D views by the data.
+Turns rerun's analytics off first.
 """
 
 from __future__ import annotations
@@ -14,7 +18,8 @@ from drill_sim_ros.model.errors import ParameterError
 from drill_sim_ros.model.presets import DEFAULT_PRESET
 from drill_sim_ros.viz.analytics_off import disable_analytics
 from drill_sim_ros.viz.blueprint import build_blueprint
-from drill_sim_ros.viz.dashboard import Dashboard
+from drill_sim_ros.viz.dashboard import Dashboard, data_extents
+from drill_sim_ros.viz.frames import view_frames
 from drill_sim_ros.viz.mcap_telemetry import NoTelemetryError, read_telemetry, recorded_preset
 from drill_sim_ros.viz.paper_units import PaperUnits
 from drill_sim_ros.viz.recording import close_recording, open_recording
@@ -38,9 +43,10 @@ def convert(mcap: Path, output: Path, preset: str | None = None,
     """Write ``output`` from ``mcap``; return the number of telemetry samples logged."""
     units = PaperUnits.load(preset or recorded_preset(mcap) or DEFAULT_PRESET)
     window = default_window_s(units) if window_s is None else window_s
-    rec = open_recording(build_blueprint(window), save=output)
+    frames = view_frames(units, data_extents(read_telemetry(mcap), units, window))
+    rec = open_recording(build_blueprint(window, frames), save=output)
     try:
-        dashboard = Dashboard(rec, units, window)
+        dashboard = Dashboard(rec, units, window, frames)
         for batch in read_telemetry(mcap):
             dashboard.log_batch(batch)
     finally:

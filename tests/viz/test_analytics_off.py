@@ -10,16 +10,11 @@ from __future__ import annotations
 
 import json
 import os
-import shutil
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 
 from drill_sim_ros.viz import analytics_off
-
-RERUN = Path(sys.executable).with_name("rerun")
 
 
 @pytest.fixture
@@ -36,13 +31,12 @@ def isolated(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> dict[str, str]:
 
 def rerun_reads_back(env: dict[str, str]) -> tuple[dict, str]:
     """What `rerun analytics config` loads: (the parsed config, its stderr)."""
-    exe = str(RERUN) if RERUN.exists() else shutil.which("rerun")
-    if exe is None:
+    if analytics_off.rerun_cli() is None:
         pytest.fail("the rerun CLI of rerun-sdk is not installed")
     run_env = {k: v for k, v in os.environ.items() if k not in ("CI", "FORCE_RERUN_ANALYTICS")}
-    done = subprocess.run([exe, "analytics", "config"], env={**run_env, **env},
-                          capture_output=True, text=True, timeout=60, check=True)
-    return json.loads(done.stdout), done.stderr
+    loaded, stderr = analytics_off.read_back({**run_env, **env})
+    assert loaded is not None, stderr
+    return loaded, stderr
 
 
 def queued_events(env: dict[str, str]) -> list[Path]:
