@@ -11,7 +11,6 @@ import signal
 import time
 
 import pytest
-from std_srvs.srv import Trigger
 
 from drill_sim_ros import topics
 from drill_sim_ros.viz.mcap_telemetry import recorded_preset
@@ -23,7 +22,7 @@ from tests.archive.helpers import (
     stop,
     wait_for,
 )
-from tests.archive.ros_fixtures import ros_node
+from tests.archive.ros_fixtures import ros_node, step_sim
 
 pytestmark = pytest.mark.ros
 
@@ -37,15 +36,6 @@ def _sim_command(*params: str) -> list[str]:
     return ["sim_node", "--ros-args", *[a for p in args for a in ("-p", p)]]
 
 
-def _step(node, count: int) -> None:
-    client = node.create_client(Trigger, f"/{topics.NODE_NAME}/step")
-    assert client.wait_for_service(timeout_sec=30), "sim_node's ~/step never appeared"
-    for _ in range(count):
-        future = client.call_async(Trigger.Request())
-        assert wait_for(future.done, 10), "~/step did not answer"
-        assert future.result().success, future.result().message
-
-
 def _check(path) -> None:
     counts = counts_mcap_ros2(path)
     assert counts == counts_rosbags(path) == statistics_counts(path)
@@ -56,7 +46,7 @@ def test_lockstep_in_process_recording_is_exact(tmp_path) -> None:
     path = tmp_path / "inprocess.mcap"
     with running(_sim_command(f"record.path:={path}"), tmp_path / "sim.log") as sim, \
             ros_node("test_stepper") as node:
-        _step(node, STEPS)
+        step_sim(node, STEPS)
         assert stop(sim, signal.SIGINT) == 0, (tmp_path / "sim.log").read_text()
     _check(path)
     assert "0 dropped" in (tmp_path / "sim.log").read_text()
@@ -75,7 +65,7 @@ def test_lockstep_sim_recorded_over_dds_is_exact(tmp_path) -> None:
             ros_node("test_stepper") as node:
         assert wait_for(lambda: _recorder_ready(node), 30), "recorder never subscribed"
         time.sleep(0.3)
-        _step(node, STEPS)
+        step_sim(node, STEPS)
         time.sleep(0.5)
         assert stop(recorder, signal.SIGINT) == 0, (tmp_path / "rec.log").read_text()
         stop(sim, signal.SIGINT)

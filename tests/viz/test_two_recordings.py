@@ -15,27 +15,17 @@ import numpy as np
 import pytest
 from mcap.reader import make_reader
 from mcap_ros2.decoder import DecoderFactory
-from std_srvs.srv import Trigger
 
 from drill_sim_ros import topics
 from drill_sim_ros.viz.mcap_to_rerun import convert
 from tests.archive.helpers import running, stop, wait_for
-from tests.archive.ros_fixtures import ros_node
+from tests.archive.ros_fixtures import ros_node, step_sim
 from tests.viz.rrd_read import read_recording
 
 pytestmark = pytest.mark.ros
 STEPS = 300                       # 3 s of simulated time at 100 Hz
 SAMPLE_TOPICS = [t for t in topics.MSG_TYPES
                  if t not in (topics.CMD_SURFACE_RPM, topics.CMD_WOB, topics.DIAGNOSTICS)]
-
-
-def _step(node, count: int) -> None:
-    client = node.create_client(Trigger, f"/{topics.NODE_NAME}/step")
-    assert client.wait_for_service(timeout_sec=30), "sim_node's ~/step never appeared"
-    for _ in range(count):
-        future = client.call_async(Trigger.Request())
-        assert wait_for(future.done, 10), "~/step did not answer"
-        assert future.result().success, future.result().message
 
 
 def _record_twice(tmp: Path) -> tuple[Path, Path, int, int]:
@@ -49,7 +39,7 @@ def _record_twice(tmp: Path) -> tuple[Path, Path, int, int]:
         assert wait_for(lambda: all(node.count_subscribers(t) > 0 for t in SAMPLE_TOPICS),
                         30), "the recorder never subscribed"
         time.sleep(0.3)
-        _step(node, STEPS)
+        step_sim(node, STEPS)
         time.sleep(0.5)
         assert stop(recorder, signal.SIGINT) == 0, (tmp / "rec.log").read_text()
         assert stop(sim, signal.SIGINT) == 0, (tmp / "sim.log").read_text()
