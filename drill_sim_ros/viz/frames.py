@@ -86,8 +86,9 @@ def box_frame(x_lo: float, x_hi: float, y_lo: float, y_hi: float,
 
 
 def polar_frame(r_max: float) -> Frame2D:
-    """A square box of radius r_max (rounded to a half or whole unit), equal scales."""
-    step = 0.5 if r_max <= 3.0 else 1.0
+    """A square box of radius r_max (rounded out to a step), equal scales; the step (at
+    least 1) is also the spacing of the reference circles."""
+    step = 0.5 if r_max <= 3.0 else max(1.0, nice_step(r_max, ticks=4))
     r = math.ceil(r_max / step - 1e-9) * step
     return Frame2D((-r, r), (-r, r), step, step, 1.0 / (2.0 * r), 1.0 / (2.0 * r),
                    tick_labels=False)

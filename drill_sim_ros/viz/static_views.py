@@ -95,7 +95,8 @@ def log_bottom_hole_reference(rec: rr.RecordingStream, units: PaperUnits,
     upward ray (one per circle, never on top of each other)."""
     r_max = frame.x_range[1]
     angle = np.linspace(0.0, 2.0 * np.pi, 181)
-    radii = np.arange(1.0, r_max + 1e-9, 1.0)
+    ring = max(1.0, frame.x_step)
+    radii = np.arange(ring, r_max + 1e-9, ring)
     rims = radii if radii[-1] == r_max else np.append(radii, r_max)
     circles = [frame.stored(r * np.cos(angle), r * np.sin(angle)) for r in rims]
     blades = 2.0 * np.pi * np.arange(units.n) / units.n
