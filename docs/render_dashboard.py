@@ -11,6 +11,8 @@ rerun's analytics are turned off and read back from rerun itself before the view
 from __future__ import annotations
 
 import argparse
+import os
+import signal
 import socket
 import subprocess
 import sys
@@ -43,11 +45,24 @@ def wait_listening(port: int, timeout_s: float) -> None:
 
 
 def serve(rrd: Path, web_port: int, grpc_port: int) -> subprocess.Popen:
-    """rerun's web viewer for ``rrd``, bound to 127.0.0.1 (HTTP and gRPC)."""
+    """rerun's web viewer for ``rrd``, bound to 127.0.0.1 (HTTP and gRPC), in its own
+    process group (the CLI wrapper starts the viewer binary as a child). BROWSER=true: the
+    viewer's own attempt to open a browser does nothing; the screenshot browser is ours."""
     rerun = Path(sys.executable).with_name("rerun")
     return subprocess.Popen([str(rerun), "--web-viewer", "--bind", LOOPBACK,
                              "--web-viewer-port", str(web_port), "--port", str(grpc_port),
-                             str(rrd)], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+                             str(rrd)], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                            env={**os.environ, "BROWSER": "true"}, start_new_session=True)
+
+
+def stop(viewer: subprocess.Popen) -> None:
+    """End the viewer's process group (the wrapper and the binary), then reap the wrapper."""
+    try:
+        os.killpg(viewer.pid, signal.SIGTERM)
+        viewer.wait(timeout=10)
+    except (ProcessLookupError, subprocess.TimeoutExpired):
+        os.killpg(viewer.pid, signal.SIGKILL)
+        viewer.wait(timeout=5)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -79,8 +94,7 @@ def main(argv: list[str] | None = None) -> int:
         subprocess.run(["node", str(SHOT_JS), url, str(args.wait_s), *shots], check=True,
                        timeout=args.wait_s + 120)
     finally:
-        viewer.terminate()
-        viewer.wait(timeout=10)
+        stop(viewer)
     return 0
 
 
