@@ -13,11 +13,19 @@ With ``split_size_bytes`` or ``split_duration_s`` the run goes into numbered fil
 (``run_0000.mcap``, ...) like ``mcap_recorder``'s, each complete with the run metadata, so
 the summary kept in memory (about 1 kB per chunk) is bounded by the split. If writing fails
 (a full disk), :attr:`error` says why from then on, and :meth:`close` finishes what it can.
+
+Log time: the caller passes each message's simulated time (its header stamp); the file stores
+log time = wall-clock origin + simulated time. The spacing stays that of simulated time (a
+replay at rate 1 paces like the sim), and the file starts at the real date of the run
+(Foxglove, ``ros2 bag info``), like an ``mcap_recorder`` file. The origin defaults to the
+wall clock at the first message minus its simulated time; the stamps are not changed.
 """
 
 from __future__ import annotations
 
 import logging
+import threading
+import time
 
 from rclpy.qos import QoSProfile
 from rclpy.serialization import serialize_message
@@ -38,6 +46,8 @@ class InProcessRecorder:
     node_name: the publishing node, for the log; topics must be added before they are written.
     metadata: written once per file as an MCAP metadata record named ``drill_sim`` (e.g. the
     preset, so ``mcap_to_rerun`` picks the right scales).
+    log_time_origin_ns: wall-clock ns (Unix epoch) of simulated time 0; None: set from the
+    wall clock at the first message.
     """
 
     def __init__(
@@ -51,7 +61,10 @@ class InProcessRecorder:
         split_size_bytes: int | None = None,
         split_duration_s: float | None = None,
         overwrite_hint: str = OVERWRITE_PARAMETER_HINT,
+        log_time_origin_ns: int | None = None,
     ) -> None:
+        self._origin_ns = log_time_origin_ns
+        self._origin_lock = threading.Lock()
         self.node_name = node_name
         self._topics: set[str] = set()
         records = {RUN_METADATA: {k: str(v) for k, v in metadata.items()}} if metadata else {}
@@ -80,19 +93,31 @@ class InProcessRecorder:
         self._topics.add(topic)
         self._writer.add_channel(topic, msg_type, offered)
 
-    def write(self, topic: str, message: object, log_time_ns: int) -> None:
+    @property
+    def log_time_origin_ns(self) -> int | None:
+        """Wall-clock ns of simulated time 0 in the file's log times (None before a message)."""
+        return self._origin_ns
+
+    def _log_time(self, sim_time_ns: int) -> int:
+        if self._origin_ns is None:
+            with self._origin_lock:          # the first writer on any thread sets it
+                if self._origin_ns is None:
+                    self._origin_ns = time.time_ns() - sim_time_ns
+        return self._origin_ns + sim_time_ns
+
+    def write(self, topic: str, message: object, sim_time_ns: int) -> None:
         """Serialize ``message`` and queue it; never blocks, counts a drop on overflow."""
         if topic not in self._topics:
             self._unknown_topic_drops += 1
             return
-        self._writer.put(topic, serialize_message(message), log_time_ns)
+        self._writer.put(topic, serialize_message(message), self._log_time(sim_time_ns))
 
-    def write_serialized(self, topic: str, data: bytes, log_time_ns: int) -> None:
+    def write_serialized(self, topic: str, data: bytes, sim_time_ns: int) -> None:
         """Queue bytes already in CDR (what the publisher sent); never blocks."""
         if topic not in self._topics:
             self._unknown_topic_drops += 1
             return
-        self._writer.put(topic, data, log_time_ns)
+        self._writer.put(topic, data, self._log_time(sim_time_ns))
 
     @property
     def dropped(self) -> int:

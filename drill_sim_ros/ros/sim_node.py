@@ -151,6 +151,7 @@ class SimNode(Node):
         self._lock = HandoffLock()
         self._status = StatusLine()
         self._session: SimSession | None = None       # made by start()
+        self._initial_pending = False
         self._pacer = Pacer(1)
         self._rate = RateMeter(time.monotonic_ns(), 0.0)
         self._paused = False
@@ -196,7 +197,7 @@ class SimNode(Node):
             self._pacer = Pacer(self._wall_period_ns(self._rtf))
             self._sinks.recorder = self._open_recorder(self._values["record.path"])
             self._publish_run_info()
-            self._emit(session.current())      # t = 0: what a controller first reacts to
+            self._initial_pending = True       # t = 0 goes out before the first period
         self._first_spin.reset()
         if self._values["run_seconds"] > 0:
             self._stop_timer.reset()
@@ -323,6 +324,9 @@ class SimNode(Node):
         """Simulate ``periods`` and hand the block to the sinks; False on a numerical fault
         (call with the lock held)."""
         try:
+            if self._initial_pending:          # the state at t = 0, what a controller first
+                self._initial_pending = False  # reacts to, just before the first period
+                self._emit(self._session.current())
             block = self._session.run(periods)
         except NumericalFault as exc:
             self._on_fault(exc)

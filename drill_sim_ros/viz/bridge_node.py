@@ -32,6 +32,7 @@ from drill_sim_ros.ros.messages import RUN_INFO_QOS
 from drill_sim_ros.viz.analytics_off import disable_analytics
 from drill_sim_ros.viz.blueprint import build_blueprint
 from drill_sim_ros.viz.dashboard import Dashboard
+from drill_sim_ros.viz.frames import Extents, view_frames
 from drill_sim_ros.viz.paper_units import PaperUnits
 from drill_sim_ros.viz.recording import (
     DEFAULT_SERVE_PORT,
@@ -207,9 +208,10 @@ def check_sinks(args: argparse.Namespace, logger: Any) -> None:
 def make_dashboard(args: argparse.Namespace) -> Dashboard:
     units = run_units(args.preset)
     window = default_window_s(units) if args.window_s is None else args.window_s
-    rec = open_recording(build_blueprint(window), save=args.save, connect=args.connect,
-                         serve_port=args.serve_port if args.serve else None)
-    return Dashboard(rec, units, window)
+    frames = view_frames(units, Extents.typical())     # live: the data is not known yet
+    rec = open_recording(build_blueprint(window, frames), save=args.save,
+                         connect=args.connect, serve_port=args.serve_port if args.serve else None)
+    return Dashboard(rec, units, window, frames)
 
 
 def _interrupt(signum: int, frame: object) -> None:

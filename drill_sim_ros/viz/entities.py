@@ -39,17 +39,19 @@ PHASE_MARKERS: tuple[tuple[str, str, float, int, str], ...] = (
     (WOB_OFF_BOTTOM, "wob_n", 1e-3, 3, "off bottom"),
 )
 
-# ---- 2D views (image coordinates: the stored y is the plotted quantity negated) --------
+# ---- 2D views (stored positions: Frame2D.stored, i.e. scaled per axis, y negated) ------
 PHASE_PORTRAIT = "/phase_portrait"
-PHASE_TRAJECTORY = "/phase_portrait/trajectory"  # (v/v0, -omega/omega0), Fig. 5
+PHASE_TRAJECTORY = "/phase_portrait/trajectory"  # segments to (v/v0, omega/omega0), Fig. 5
 PHASE_REFERENCE = "/phase_portrait/reference"
 BOTTOM_HOLE = "/bottom_hole"
-BOTTOM_HOLE_PATTERN = "/bottom_hole/pattern"     # r = max(delta, 0)/delta0 at bit angle, Fig. 7
+BOTTOM_HOLE_LAST = "/bottom_hole/last_turn"      # r = max(delta, 0)/delta0 at bit angle, Fig. 7
+BOTTOM_HOLE_PREVIOUS = "/bottom_hole/previous_turn"
 BOTTOM_HOLE_REFERENCE = "/bottom_hole/reference"
 ES_DIAGRAM = "/es_diagram"
-ES_RUNNING = "/es_diagram/running_average"        # (S, -E), eq. 48, Fig. 12
+ES_RUNNING = "/es_diagram/running_average"        # segments to (S, E), eq. 48, Fig. 12
 ES_FRICTION_LINE = "/es_diagram/friction_line"    # eq. 50
 ES_POINTS = "/es_diagram/reference_points"        # cutting point and trivial solution
+ES_REFERENCE = "/es_diagram/reference"            # axes, ticks
 
 # ---- severity ----------------------------------------------------------------------------
 SEVERITY = "/severity"
@@ -58,8 +60,7 @@ STICK_FRACTION = "/severity/stick_fraction"
 INFO = "/info"
 
 # Every path that carries one row per telemetry sample.
-PER_SAMPLE = (*(s[0] for s in SCALAR_SERIES), PHASE_TRAJECTORY, BOTTOM_HOLE_PATTERN, SSI,
-              STICK_FRACTION)
+PER_SAMPLE = (*(s[0] for s in SCALAR_SERIES), PHASE_TRAJECTORY, SSI, STICK_FRACTION)
 
 MODE_COLORS = ((31, 119, 180), (255, 127, 14), (214, 39, 40), (148, 103, 189))
 """RGB per mode: cutting blue, lost contact orange, stuck red, off bottom purple."""

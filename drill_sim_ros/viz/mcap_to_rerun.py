@@ -1,12 +1,15 @@
 """``mcap_to_rerun FILE.mcap -o FILE.rrd``: a recorded run as the drilling dashboard.
 
 The same views as the live bridge (:class:`~drill_sim_ros.viz.dashboard.Dashboard`), from the
-``/drill/telemetry`` messages of the file. Turns rerun's analytics off first.
+``/drill/telemetry`` messages of the file, on the ``sim_time`` timeline of their own
+``sim_time_s`` field: the MCAP log time (simulated time from a wall-clock start in an in-process
+recording, receipt time in an ``mcap_recorder`` file) is not used, so both files of one run
+give the same dashboard. The file is read twice: first to frame the 2D views by the data.
 
 A damaged or cut recording gives what ``mcap_reindex`` would keep (every intact chunk), with
 one warning naming what was skipped, and exit code 1. The .rrd is written beside its target
 and moved in place only when complete: an error or SIGINT/SIGTERM/SIGHUP leaves no partial
-file. An existing .rrd is refused unless ``--overwrite``.
+file. An existing .rrd is refused unless ``--overwrite``. Turns rerun's analytics off first.
 """
 
 from __future__ import annotations
@@ -26,7 +29,8 @@ from drill_sim_ros.model.errors import ParameterError
 from drill_sim_ros.model.presets import DEFAULT_PRESET
 from drill_sim_ros.viz.analytics_off import disable_analytics
 from drill_sim_ros.viz.blueprint import build_blueprint
-from drill_sim_ros.viz.dashboard import Dashboard
+from drill_sim_ros.viz.dashboard import Dashboard, data_extents
+from drill_sim_ros.viz.frames import view_frames
 from drill_sim_ros.viz.mcap_telemetry import (
     NoTelemetryError,
     read_telemetry,
@@ -65,11 +69,12 @@ def convert(mcap: Path, output: Path, preset: str | None = None,
     first = next(batches)                # NoTelemetryError before anything else is said
     units = recorded_units(mcap, preset)
     window = default_window_s(units) if window_s is None else window_s
+    frames = view_frames(units, data_extents(read_telemetry(mcap), units, window))
     temporary = temporary_beside(output, overwrite)
     try:
-        rec = open_recording(build_blueprint(window), save=temporary)
+        rec = open_recording(build_blueprint(window, frames), save=temporary)
         try:
-            dashboard = Dashboard(rec, units, window)
+            dashboard = Dashboard(rec, units, window, frames)
             dashboard.log_batch(first)
             for batch in batches:
                 dashboard.log_batch(batch)

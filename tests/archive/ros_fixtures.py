@@ -9,6 +9,10 @@ from contextlib import contextmanager
 import rclpy
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
+from std_srvs.srv import Trigger
+
+from drill_sim_ros import topics
+from tests.archive.helpers import wait_for
 
 
 @contextmanager
@@ -35,3 +39,13 @@ def ros_node(name: str) -> Iterator[Node]:
         executor.shutdown()
         node.destroy_node()
         rclpy.try_shutdown(context=context)
+
+
+def step_sim(node: Node, count: int) -> None:
+    """Call sim_node's ~/step ``count`` times, each answered within 10 s."""
+    client = node.create_client(Trigger, f"/{topics.NODE_NAME}/step")
+    assert client.wait_for_service(timeout_sec=30), "sim_node's ~/step never appeared"
+    for _ in range(count):
+        future = client.call_async(Trigger.Request())
+        assert wait_for(future.done, 10), "~/step did not answer"
+        assert future.result().success, future.result().message

@@ -29,7 +29,7 @@ def test_serialized_bytes_are_recorded_unchanged(tmp_path: Path) -> None:
 
     path = tmp_path / "raw.mcap"
     payloads = [serialize_message(Float64(data=float(i))) for i in range(50)]
-    recorder = InProcessRecorder(str(path))
+    recorder = InProcessRecorder(str(path), log_time_origin_ns=0)
     recorder.add_topic("/x", "std_msgs/msg/Float64", QoSProfile(depth=10))
     for i, data in enumerate(payloads):
         recorder.write_serialized("/x", data, 1000 + i)

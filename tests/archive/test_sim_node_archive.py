@@ -11,7 +11,6 @@ import signal
 import time
 
 import pytest
-from std_srvs.srv import Trigger
 
 from drill_sim_ros import topics
 from drill_sim_ros.model.presets import load_preset
@@ -24,7 +23,7 @@ from tests.archive.helpers import (
     stop,
     wait_for,
 )
-from tests.archive.ros_fixtures import ros_node
+from tests.archive.ros_fixtures import ros_node, step_sim
 
 pytestmark = pytest.mark.ros
 
@@ -37,15 +36,6 @@ SAMPLE_TOPICS = [t for t in topics.MSG_TYPES
 def _sim_command(*params: str) -> list[str]:
     args = ["lockstep:=true", "status_line:=false", *params]
     return ["sim_node", "--ros-args", *[a for p in args for a in ("-p", p)]]
-
-
-def _step(node, count: int) -> None:
-    client = node.create_client(Trigger, f"/{topics.NODE_NAME}/step")
-    assert client.wait_for_service(timeout_sec=30), "sim_node's ~/step never appeared"
-    for _ in range(count):
-        future = client.call_async(Trigger.Request())
-        assert wait_for(future.done, 10), "~/step did not answer"
-        assert future.result().success, future.result().message
 
 
 def _check(path, samples: int | None) -> None:
@@ -69,7 +59,7 @@ def test_lockstep_in_process_recording_is_exact(tmp_path) -> None:
     path = tmp_path / "inprocess.mcap"
     with running(_sim_command(f"record.path:={path}"), tmp_path / "sim.log") as sim, \
             ros_node("test_stepper") as node:
-        _step(node, STEPS)
+        step_sim(node, STEPS)
         assert stop(sim, signal.SIGINT) == 0, (tmp_path / "sim.log").read_text()
     _check(path, STEPS + 1)                     # the t = 0 sample, then one per step
     assert "0 dropped" in (tmp_path / "sim.log").read_text()
@@ -88,8 +78,8 @@ def test_lockstep_sim_recorded_over_dds_is_exact(tmp_path) -> None:
             ros_node("test_stepper") as node:
         assert wait_for(lambda: _recorder_ready(node), 30), "recorder never subscribed"
         time.sleep(0.3)
-        _step(node, STEPS)
+        step_sim(node, STEPS)
         time.sleep(0.5)
         assert stop(recorder, signal.SIGINT) == 0, (tmp_path / "rec.log").read_text()
         stop(sim, signal.SIGINT)
-    _check(path, None)
+    _check(path, STEPS + 1)                     # t = 0 goes out with the first step

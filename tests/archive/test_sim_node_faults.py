@@ -15,8 +15,8 @@ from drill_sim_ros import topics
 from drill_sim_ros.archive.reader import ArchiveReader
 from drill_sim_ros.viz.mcap_telemetry import recorded_preset
 from tests.archive.helpers import BIN, counts_mcap_ros2, running, stop, wait_for
-from tests.archive.ros_fixtures import ros_node
-from tests.archive.test_sim_node_archive import SAMPLE_TOPICS, _sim_command, _step
+from tests.archive.ros_fixtures import ros_node, step_sim
+from tests.archive.test_sim_node_archive import SAMPLE_TOPICS, _sim_command
 
 pytestmark = pytest.mark.ros
 # 0.5 s of log time: every sample topic (/clock included) at 100 Hz, and /diagnostics
@@ -118,7 +118,7 @@ def test_in_process_recording_splits_by_simulated_duration(tmp_path) -> None:
     steps = 40                    # 0.4 s of simulated time at 100 Hz: four 0.1 s files
     with running(_sim_command(f"record.path:={path}", "record.split_duration_s:=0.1"),
                  tmp_path / "sim.log") as sim, ros_node("test_stepper") as node:
-        _step(node, steps)
+        step_sim(node, steps)
         assert stop(sim, signal.SIGINT) == 0, (tmp_path / "sim.log").read_text()
     parts = sorted(tmp_path.glob("run_*.mcap"))
     assert [p.name for p in parts][:4] == [f"run_{i:04d}.mcap" for i in range(4)]

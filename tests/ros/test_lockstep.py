@@ -42,11 +42,12 @@ def lockstep_run() -> dict[str, list[bytes]]:
                 assert pubs[topic].wait_for_all_acked(Duration(seconds=5))
             response = ros.call(probe, Trigger, f"/{topics.NODE_NAME}/step", Trigger.Request())
             assert response.success, response.message
-            assert ros.spin_until(lambda s=step: probe.count(topics.TELEMETRY) == s + 1, 5.0), \
+            # t = 0 goes out just before the first period, then one sample per step
+            assert ros.spin_until(lambda s=step: probe.count(topics.TELEMETRY) == s + 2, 5.0), \
                 "the step's telemetry is published before the answer"
-        assert ros.spin_until(lambda: all(probe.count(t) == STEPS for t in RECORDED), 5.0)
+        assert ros.spin_until(lambda: all(probe.count(t) == STEPS + 1 for t in RECORDED), 5.0)
         ros.spin_for(0.2)
-        assert all(probe.count(t) == STEPS for t in RECORDED), "no step publishes twice"
+        assert all(probe.count(t) == STEPS + 1 for t in RECORDED), "no step publishes twice"
         return {t: probe.messages(t) for t in RECORDED}
 
 
@@ -58,6 +59,8 @@ def test_same_commands_give_identical_bytes_run_after_run():
     # step k publishes the state at the end of period k, stamped (k + 1) periods: sample k - 1
     # (the start of period k) still has the old value, sample k the new one.
     rows = [deserialize_message(raw, Float64MultiArray).data for raw in first[topics.TELEMETRY]]
+    assert rows[0][F["sim_time_s"]] == 0.0
+    rows = rows[1:]                             # sample k: the end of the period of step k
     assert [row[F["sim_time_s"]] for row in rows] == pytest.approx(
         [0.01 * (k + 1) for k in range(STEPS)], abs=1e-12)
     applied = [row[F["applied_wob_n"]] for row in rows]

@@ -30,10 +30,11 @@ VIEW_ORIGINS = {"/timeseries/wob", "/timeseries/torque", "/timeseries/rop", "/ti
                 "/timeseries/mode", "/phase_portrait", "/bottom_hole", "/es_diagram",
                 "/severity", "/info"}
 STUCK, OFF_BOTTOM = 2, 3
+MIN_MAX = 5      # rerun's AggregationPolicy.MinMax: min and max of the samples in a pixel
 
 
 def phase_portrait(rows: np.ndarray, preset: Preset) -> np.ndarray:
-    """Stored (x, y) = (v/v0, -omega/omega0), Fig. 5."""
+    """(v/v0, -omega/omega0), Fig. 5 (y down; the view scales each axis)."""
     triv, ts, ls = trivial_solution(preset.params), preset.scales.time_s, preset.scales.length_m
     v = rows[:, F["rop_m_s"]] * ts / ls
     omega = rows[:, F["bit_rpm"]] * 2.0 * math.pi / 60.0 * ts
@@ -41,11 +42,34 @@ def phase_portrait(rows: np.ndarray, preset: Preset) -> np.ndarray:
 
 
 def bottom_hole(rows: np.ndarray, preset: Preset) -> np.ndarray:
-    """Stored (r cos theta, -r sin theta), r = max(delta, 0)/delta0, Fig. 7."""
+    """(r cos theta, -r sin theta), r = max(delta, 0)/delta0, Fig. 7 (y down)."""
     delta0 = trivial_solution(preset.params).depth_of_cut
     r = np.maximum(rows[:, F["depth_of_cut_m"]] / preset.scales.length_m, 0.0) / delta0
     theta = rows[:, F["bit_angle_rad"]] % (2.0 * math.pi)
     return np.column_stack((r * np.cos(theta), -r * np.sin(theta)))
+
+
+def revolutions(rows: np.ndarray) -> list[np.ndarray]:
+    """Row indices of each whole bit revolution (angle in [2 pi k, 2 pi (k + 1))), each
+    closed by the first row of the next one; the last, unfinished one is left out."""
+    turn = np.floor(rows[:, F["bit_angle_rad"]] / (2.0 * math.pi))
+    out, first = [], 0
+    for i in range(1, len(rows)):
+        if turn[i] != turn[i - 1]:
+            out.append(np.arange(first, i + 1))
+            first = i
+    return out
+
+
+def stored_points(data: object) -> np.ndarray:
+    """Every stored 2D position of an entity (points or strips, temporal and static)."""
+    parts = []
+    for columns in (data.columns, data.static):
+        for row in columns.get("Points2D:positions", []):
+            parts.append(np.array(row, dtype=np.float64).reshape(-1, 2))
+        for row in columns.get("LineStrips2D:strips", []):
+            parts += [np.array(s, dtype=np.float64).reshape(-1, 2) for s in row]
+    return np.vstack(parts)
 
 
 def window(rows: np.ndarray, i: int, window_s: float) -> np.ndarray:

@@ -9,7 +9,7 @@ from drill_sim_ros import topics
 from drill_sim_ros.model.presets import load_preset
 from tests.viz import expected as ex
 from tests.viz.bridge_process import BridgeProcess, private_topic, remap_telemetry
-from tests.viz.rrd_read import read_recording, view_origins
+from tests.viz.rrd_read import read_recording, series_aggregation, tick_scale, view_origins
 from tests.viz.sim_telemetry import telemetry_rows
 
 pytestmark = pytest.mark.ros
@@ -48,8 +48,8 @@ def test_blueprint_is_stored_and_every_view_has_data(live: dict) -> None:
 
 def test_every_published_sample_is_logged_once(live: dict) -> None:
     rows = live["rows"]
-    for path in [*ex.SCALARS, "/phase_portrait/trajectory", "/bottom_hole/pattern",
-                 "/severity/ssi", "/severity/stick_fraction"]:
+    for path in [*ex.SCALARS, "/phase_portrait/trajectory", "/severity/ssi",
+                 "/severity/stick_fraction"]:
         t_ns = live["data"][path].time_ns
         assert len(t_ns) == len(rows), path
         assert np.all(np.abs(t_ns - rows[:, F["sim_time_s"]] * 1e9) <= 1.0), path
@@ -60,12 +60,21 @@ def test_values_round_trip(live: dict) -> None:
     for path, (field, factor) in ex.SCALARS.items():
         np.testing.assert_allclose(data[path].scalars(), rows[:, F[field]] * factor,
                                    rtol=1e-15, atol=0.0, err_msg=path)
-    expected = ex.phase_portrait(rows, live["preset"])
-    np.testing.assert_allclose(data["/phase_portrait/trajectory"].points(), expected,
+    scale = np.array([tick_scale(data, "/phase_portrait/reference/x_ticks", 0),
+                      tick_scale(data, "/phase_portrait/reference/y_ticks", 1)])
+    expected = ex.phase_portrait(rows, live["preset"]) * scale
+    np.testing.assert_allclose(data["/phase_portrait/trajectory"].segment_ends(), expected,
                                rtol=1e-6, atol=1e-6 * np.abs(expected).max())
+    turns = ex.revolutions(rows)
+    assert len(data["/bottom_hole/last_turn"].time_ns) == len(turns) > 3
     stick = rows[:, F["mode"]] == ex.STUCK
     np.testing.assert_array_equal(data["/timeseries/rpm/stick"].scalars(),
                                   rows[stick, F["bit_rpm"]])
+
+
+def test_live_series_keep_min_and_max(live: dict) -> None:
+    for path in ex.SCALARS:
+        assert series_aggregation(live["data"], path) == ex.MIN_MAX, path
 
 
 def test_status_line_reports_the_final_count(live: dict) -> None:

@@ -14,7 +14,13 @@ from drill_sim_ros import topics
 from drill_sim_ros.model.presets import DEFAULT_PRESET, load_preset
 from drill_sim_ros.viz.mcap_to_rerun import recorded_units
 from tests.viz import expected as ex
-from tests.viz.rrd_read import read_recording, view_origins
+from tests.viz.rrd_read import (
+    read_recording,
+    series_aggregation,
+    tick_scale,
+    view_bounds,
+    view_origins,
+)
 from tests.viz.sim_telemetry import telemetry_rows, write_mcap
 
 PRESET = "field_8p5in_shale"
@@ -59,8 +65,7 @@ def test_blueprint_is_stored_and_every_view_has_data(run: dict) -> None:
 
 
 @pytest.mark.parametrize("path", [*ex.SCALARS, "/phase_portrait/trajectory",
-                                  "/bottom_hole/pattern", "/severity/ssi",
-                                  "/severity/stick_fraction"])
+                                  "/severity/ssi", "/severity/stick_fraction"])
 def test_sample_counts_equal_message_count(run: dict, path: str) -> None:
     data = run["data"][path]
     assert len(data.time_ns) == run["count"]
@@ -84,16 +89,56 @@ def test_phase_markers_sit_on_stick_and_off_bottom_samples(run: dict) -> None:
         np.testing.assert_array_equal(got, rows[sel, F[field]] * factor)
 
 
-def test_phase_portrait_and_bottom_hole_points(run: dict) -> None:
-    for path, want in (("/phase_portrait/trajectory", ex.phase_portrait),
-                       ("/bottom_hole/pattern", ex.bottom_hole)):
-        expected = want(run["rows"], run["preset"])
-        got = run["data"][path].points()
-        np.testing.assert_allclose(got, expected, rtol=1e-6, atol=1e-6 * np.abs(expected).max())
-    colors = np.array(run["data"]["/phase_portrait/trajectory"].columns["Points2D:colors"])
+def test_every_time_series_keeps_min_and_max_per_pixel(run: dict) -> None:
+    for path in [*ex.SCALARS, "/severity/ssi", "/severity/stick_fraction"]:
+        assert series_aggregation(run["data"], path) == ex.MIN_MAX, path
+
+
+def test_phase_portrait_is_a_path_coloured_by_mode_on_its_ticks(run: dict) -> None:
+    data = run["data"]
+    trajectory = data["/phase_portrait/trajectory"]
+    scale = np.array([tick_scale(data, "/phase_portrait/reference/x_ticks", 0),
+                      tick_scale(data, "/phase_portrait/reference/y_ticks", 1)])
+    expected = ex.phase_portrait(run["rows"], run["preset"]) * scale
+    ends = trajectory.segment_ends()
+    np.testing.assert_allclose(ends, expected, rtol=1e-6, atol=1e-6 * np.abs(expected).max())
+    np.testing.assert_array_equal(trajectory.segment_starts()[1:], ends[:-1])  # unbroken
+    colors = np.array([c[0] for c in trajectory.columns["LineStrips2D:colors"]])
     stuck = run["rows"][:, F["mode"]] == ex.STUCK
     assert len(np.unique(colors[stuck])) == 1
     assert not np.isin(colors[~stuck], colors[stuck]).any()
+
+
+def test_bottom_hole_shows_the_last_two_revolutions(run: dict) -> None:
+    data, rows = run["data"], run["rows"]
+    turns = ex.revolutions(rows)
+    last, previous = data["/bottom_hole/last_turn"], data["/bottom_hole/previous_turn"]
+    assert len(turns) > 10 and len(last.time_ns) == len(turns)
+    unit = np.abs(data["/bottom_hole/reference"].static["LineStrips2D:strips"][0][0]).max()
+    pattern = ex.bottom_hole(rows, run["preset"]) * unit        # circle 1 = delta0
+    times = np.round(rows[:, F["sim_time_s"]] * 1e9).astype(np.int64)
+    for k, strips in enumerate(last.strips()):
+        want = pattern[turns[k]]
+        assert abs(last.time_ns[k] - times[turns[k][-1]]) <= 1
+        got = np.vstack([strips[0], *[s[1:] for s in strips[1:]]])   # joints shared
+        np.testing.assert_allclose(got, want, rtol=1e-5, atol=1e-6)
+    np.testing.assert_array_equal(previous.time_ns, last.time_ns[1:])
+    for k, strips in enumerate(previous.strips()):            # the turn before, pale
+        np.testing.assert_allclose(np.vstack(strips), np.vstack(last.strips()[k]))
+
+
+def test_2d_views_are_framed_by_their_data(run: dict) -> None:
+    data, bounds = run["data"], view_bounds(run["rrd"])
+    for origin, paths in (("/phase_portrait", ["/phase_portrait/trajectory"]),
+                          ("/bottom_hole", ["/bottom_hole/last_turn"]),
+                          ("/es_diagram", ["/es_diagram/running_average",
+                                           "/es_diagram/reference_points"])):
+        (x_lo, x_hi), (y_lo, y_hi) = bounds[origin]
+        points = np.vstack([ex.stored_points(data[p]) for p in paths])
+        assert np.all((points[:, 0] >= x_lo) & (points[:, 0] <= x_hi)), origin
+        assert np.all((points[:, 1] >= y_lo) & (points[:, 1] <= y_hi)), origin
+        spread = np.ptp(points, axis=0) / np.array([x_hi - x_lo, y_hi - y_lo])
+        assert spread.max() > 0.5, f"{origin}: the data fill {spread} of the view"
 
 
 def test_severity_matches_analysis_severity_over_the_window(run: dict) -> None:
@@ -111,8 +156,10 @@ def test_severity_matches_analysis_severity_over_the_window(run: dict) -> None:
 def test_es_running_average_matches_eq_48_in_si(run: dict) -> None:
     rows, data, window_s = run["rows"], run["data"], run["window_s"]
     es = data["/es_diagram/running_average"]
+    scale = np.array([tick_scale(data, "/es_diagram/reference/x_ticks", 0),
+                      -tick_scale(data, "/es_diagram/reference/y_ticks", 1)])   # y down
     t_ns = es.time_ns
-    points = es.points()
+    points = es.segment_ends() / scale
     index = {t: k for k, t in enumerate(t_ns)}
     times = np.round(rows[:, F["sim_time_s"]] * 1e9).astype(np.int64)
     checked = 0
@@ -123,18 +170,20 @@ def test_es_running_average_matches_eq_48_in_si(run: dict) -> None:
                 .mean() > 0):
             assert k is None
             continue
-        assert points[k] == pytest.approx([strength, -energy], rel=1e-5)
+        assert points[k] == pytest.approx([strength, energy], rel=1e-5)
         checked += 1
     assert checked > 0
 
 
 def test_friction_line_follows_eq_50(run: dict) -> None:
-    static = run["data"]["/es_diagram/friction_line"].static
-    (strip,) = static["LineStrips2D:strips"][0]
-    (s1, e1), (s2, e2) = strip
+    data = run["data"]
+    sx = tick_scale(data, "/es_diagram/reference/x_ticks", 0)
+    sy = tick_scale(data, "/es_diagram/reference/y_ticks", 1)
+    (strip,) = data["/es_diagram/friction_line"].static["LineStrips2D:strips"][0]
+    (s1, e1), (s2, e2) = np.array(strip) / np.array([sx, -sy])
     beta = run["preset"].params.beta
-    assert (s1, -e1) == pytest.approx((1.0, 1.0))
-    assert -e2 == pytest.approx(1.0 - beta + beta * s2, rel=1e-6)
+    assert (s1, e1) == pytest.approx((1.0, 1.0), rel=1e-6)
+    assert e2 == pytest.approx(1.0 - beta + beta * s2, rel=1e-6)
 
 
 def test_missing_telemetry_is_a_clear_error(tmp_path: Path) -> None:
@@ -150,11 +199,13 @@ def test_preset_comes_from_the_file_metadata(tmp_path: Path) -> None:
     mcap, rrd = tmp_path / "fig5.mcap", tmp_path / "fig5.rrd"
     write_mcap(mcap, rows, metadata={"preset": "fig5_8a"})
     assert run_cli(str(mcap), "-o", str(rrd)).returncode == 0
-    info = read_recording(rrd)["/info"].static["TextDocument:text"][0][0]
-    assert "fig5_8a" in info
-    expected = ex.phase_portrait(rows, load_preset("fig5_8a"))
-    np.testing.assert_allclose(read_recording(rrd)["/phase_portrait/trajectory"].points(),
-                               expected, rtol=1e-6, atol=1e-6)
+    data = read_recording(rrd)
+    assert "fig5_8a" in data["/info"].static["TextDocument:text"][0][0]
+    scale = np.array([tick_scale(data, "/phase_portrait/reference/x_ticks", 0),
+                      tick_scale(data, "/phase_portrait/reference/y_ticks", 1)])
+    expected = ex.phase_portrait(rows, load_preset("fig5_8a")) * scale
+    np.testing.assert_allclose(data["/phase_portrait/trajectory"].segment_ends(), expected,
+                               rtol=1e-6, atol=1e-6)
 
 
 def test_the_scales_come_from_the_recorded_run_info(tmp_path, capsys):

@@ -9,6 +9,8 @@ from pathlib import Path
 import pytest
 
 from drill_sim_ros.viz.blueprint import build_blueprint
+from drill_sim_ros.viz.frames import Extents, view_frames
+from drill_sim_ros.viz.paper_units import PaperUnits
 from drill_sim_ros.viz.recording import close_recording, open_recording
 from tests.viz.bridge_process import BridgeProcess
 
@@ -44,7 +46,8 @@ def wait_listening(port: int, timeout_s: float) -> set[str]:
 
 def test_open_recording_serves_on_loopback_only() -> None:
     port = free_port()
-    rec = open_recording(build_blueprint(10.0), serve_port=port)
+    frames = view_frames(PaperUnits.load("fig5_8a"), Extents.typical())
+    rec = open_recording(build_blueprint(10.0, frames), serve_port=port)
     try:
         assert wait_listening(port, 10.0) == {"0100007F"}   # 127.0.0.1, no 0.0.0.0 or ::
     finally:
