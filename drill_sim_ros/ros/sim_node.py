@@ -41,6 +41,7 @@ from drill_sim_ros import topics
 from drill_sim_ros.model.errors import DrillSimError, NumericalFault, ParameterError
 from drill_sim_ros.model.presets import load_preset
 from drill_sim_ros.ros import messages
+from drill_sim_ros.ros.command_types import ForeignCommandTypes
 from drill_sim_ros.ros.conversions import stamp
 from drill_sim_ros.ros.engine import EXIT_WAIT, R_SAMPLES, TickLoop
 from drill_sim_ros.ros.frame import SAMPLE_TOPICS, FramePublisher, SampleFrame
@@ -115,6 +116,8 @@ class SimNode(Node):
         self._closing = False
         self._fault: str | None = None
         self.recording_failed = False
+        self._foreign_commands = ForeignCommandTypes(
+            {t: topics.MSG_TYPES[t] for t in (topics.CMD_SURFACE_RPM, topics.CMD_WOB)})
         self.rejected_commands = 0
         self._last_row: np.ndarray | None = None     # SI, TELEMETRY_FIELDS; lock held
         self._pubs = {t: self.create_publisher(messages.type_of(t), t, self._qos(t),
@@ -394,6 +397,8 @@ class SimNode(Node):
     def _publish_diagnostics(self) -> None:
         """/diagnostics: the figures are read under the lock, the message is built and
         serialized outside it, so the ticker waits for a copy, not for the formatting."""
+        for reason in self._foreign_commands.new_reasons(self):
+            self.get_logger().warning(reason)
         with self._lock.urgent():
             time_ns = max(0, self._session.sim_time_ns - self._session.period_ns)
             figures = self._figures(time_ns)
