@@ -121,17 +121,19 @@ class RotatingWriter:
         if self._writer is not None:
             self._close_current()
 
+    # Read from other threads (status, /diagnostics) while the writer thread may rotate:
+    # take the current writer once.
     @property
     def message_count(self) -> int:
-        current = self._writer.message_count if self._writer is not None else 0
-        return self._finished_messages + current
+        writer = self._writer
+        return self._finished_messages + (writer.message_count if writer is not None else 0)
 
     @property
     def messages_on_disk(self) -> int:
-        current = self._writer.messages_on_disk if self._writer is not None else 0
-        return self._finished_on_disk + current
+        writer = self._writer
+        return self._finished_on_disk + (writer.messages_on_disk if writer is not None else 0)
 
     @property
     def bytes_written(self) -> int:
-        current = self._writer.bytes_written if self._writer is not None else 0
-        return self._finished_bytes + current
+        writer = self._writer
+        return self._finished_bytes + (writer.bytes_written if writer is not None else 0)

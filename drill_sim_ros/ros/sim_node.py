@@ -49,6 +49,7 @@ from drill_sim_ros.model.top_drive import TopDrivePhysical
 from drill_sim_ros.realtime.pacing import Pacer, RateMeter
 from drill_sim_ros.realtime.ticker import HandoffLock, Ticker
 from drill_sim_ros.ros import messages
+from drill_sim_ros.ros.command_types import ForeignCommandTypes
 from drill_sim_ros.ros.diagnostics import Figures, diagnostics
 from drill_sim_ros.ros.frame import SAMPLE_TOPICS
 from drill_sim_ros.ros.messages import RUN_INFO_QOS, stamp_ns
@@ -173,6 +174,8 @@ class SimNode(Node):
             sub = self.create_subscription(messages.type_of(topic), topics.node_relative(topic),
                                            callback, COMMAND_QOS, raw=True)
             self._command_names[topic] = sub.topic_name
+        self._foreign_commands = ForeignCommandTypes(
+            {name: topics.MSG_TYPES[topic] for topic, name in self._command_names.items()})
         self.create_service(Trigger, "~/reset", self._on_reset)
         self.create_service(SetBool, "~/pause", self._on_pause)
         self.create_service(Trigger, "~/step", self._on_step)
@@ -486,6 +489,8 @@ class SimNode(Node):
         serialized outside it, so the ticker waits for a copy, not for the formatting."""
         if self._session is None:
             return
+        for reason in self._foreign_commands.new_reasons(self):
+            self.get_logger().warning(reason)
         with self._lock.urgent():
             time_ns = self._session.sim_time_ns
             figures = self._figures(time_ns)

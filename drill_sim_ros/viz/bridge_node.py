@@ -218,7 +218,8 @@ def _interrupt(signum: int, frame: object) -> None:
     raise KeyboardInterrupt(f"signal {signum}")
 
 
-CLOSE_TIMEOUT_S = 1.5       # stop within 2 s even when a viewer stopped reading
+FILE_CLOSE_TIMEOUT_S = 10.0     # a .rrd gets everything queued, and its footer
+VIEWER_CLOSE_TIMEOUT_S = 1.5    # stop within 2 s even when a viewer stopped reading
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -251,8 +252,8 @@ def main(argv: list[str] | None = None) -> int:
             node.finish()
             node.destroy_node()
         rclpy.try_shutdown()
-        problem = None if dashboard is None else close_recording(dashboard.rec,
-                                                                 CLOSE_TIMEOUT_S)
+        timeout_s = VIEWER_CLOSE_TIMEOUT_S if args.connect else FILE_CLOSE_TIMEOUT_S
+        problem = None if dashboard is None else close_recording(dashboard.rec, timeout_s)
     if problem is not None:
         logger.error(f"not everything reached the viewer: {problem}")
         return 1

@@ -61,10 +61,14 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
 
 
 def convert(mcap: Path, output: Path, preset: str | None = None,
-            window_s: float | None = None, overwrite: bool = False) -> tuple[int, ArchiveReader]:
-    """Write ``output`` from ``mcap``; return the telemetry samples logged and the reader
-    (its ``problem`` and ``lost_data``). Nothing is left at ``output`` unless it succeeds."""
-    reader = ArchiveReader(mcap)
+            window_s: float | None = None, overwrite: bool = False,
+            reader: ArchiveReader | None = None) -> int:
+    """Write ``output`` from ``mcap``; return the number of telemetry samples logged.
+
+    Nothing is left at ``output`` unless it succeeds. Pass ``reader`` to learn afterwards what
+    a damaged file lost (its ``problem`` and ``lost_data``).
+    """
+    reader = reader or ArchiveReader(mcap)
     batches = read_telemetry(reader)
     first = next(batches)                # NoTelemetryError before anything else is said
     units = recorded_units(mcap, preset)
@@ -83,7 +87,7 @@ def convert(mcap: Path, output: Path, preset: str | None = None,
         commit(temporary, output, overwrite)
     finally:
         temporary.unlink(missing_ok=True)
-    return dashboard.samples, reader
+    return dashboard.samples
 
 
 def recorded_units(mcap: Path, preset: str | None) -> PaperUnits:
@@ -110,8 +114,9 @@ def main(argv: list[str] | None = None) -> int:
     logging.basicConfig(level=logging.ERROR, format="mcap_to_rerun: %(message)s")
     try:
         with stop_on_signals():
-            count, reader = convert(args.mcap, args.output, args.preset, args.window_s,
-                                     args.overwrite)
+            reader = ArchiveReader(args.mcap)
+            count = convert(args.mcap, args.output, args.preset, args.window_s,
+                            args.overwrite, reader)
     except (OSError, NoTelemetryError, ParameterError, ArchiveError) as exc:
         print(f"mcap_to_rerun: {exc}", file=sys.stderr)
         return 2 if isinstance(exc, (ArchiveError, ParameterError, OSError)) else 1

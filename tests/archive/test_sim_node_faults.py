@@ -6,6 +6,7 @@ from __future__ import annotations
 import os
 import signal
 import subprocess
+import time
 
 import pytest
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
@@ -132,3 +133,18 @@ def test_in_process_recording_splits_by_simulated_duration(tmp_path) -> None:
         for topic in SAMPLE_TOPICS:
             totals[topic] += counts[topic]
     assert totals == dict.fromkeys(SAMPLE_TOPICS, steps + 1)      # the t = 0 sample too
+
+
+def test_a_command_of_the_wrong_type_is_named_once(tmp_path) -> None:
+    from std_msgs.msg import Int32
+
+    log = tmp_path / "sim.log"
+    with running(_sim_command(), log) as sim, ros_node("test_wrong_type") as node:
+        pub = node.create_publisher(Int32, topics.CMD_WOB, QoSProfile(depth=10))
+        pub.publish(Int32(data=5))
+        wanted = f"publishes std_msgs/msg/Int32 on {topics.CMD_WOB}"
+        assert wait_for(lambda: wanted in log.read_text(), 30), log.read_text()
+        time.sleep(2.5)                                       # two more graph checks
+        assert log.read_text().count(wanted) == 1
+        assert "/test_wrong_type" in log.read_text()
+        assert stop(sim, signal.SIGINT) == 0

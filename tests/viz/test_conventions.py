@@ -32,5 +32,5 @@ def test_conversion_leaves_no_global_recording(tmp_path: Path) -> None:
     from tests.viz.sim_telemetry import default_rows, write_mcap
 
     write_mcap(tmp_path / "a.mcap", default_rows(2.0))
-    assert convert(tmp_path / "a.mcap", tmp_path / "a.rrd")[0] == 201
+    assert convert(tmp_path / "a.mcap", tmp_path / "a.rrd") == 201
     assert rr.get_global_data_recording() is None

@@ -66,7 +66,7 @@ def recordings(tmp_path_factory: pytest.TempPathFactory) -> dict:
     out = {"before": before, "after": after, "inprocess": inprocess, "dds": dds}
     for name in ("inprocess", "dds"):
         rrd = tmp / f"{name}.rrd"
-        out[f"{name}_samples"] = convert(out[name], rrd)[0]
+        out[f"{name}_samples"] = convert(out[name], rrd)
         out[f"{name}_data"] = read_recording(rrd)
     return out
 
