@@ -1,4 +1,4 @@
-"""Offline command line: ``drill_sim run | sweep | presets | info``.
+"""Offline command line: ``drill_sim run | sweep | presets | info | closed-loop``.
 
 ``drill_sim run`` integrates the RGD07 model without ROS and prints a summary (or one JSON
 object with ``--json``). The run is dimensionless unless ``--params`` names a physical
@@ -18,6 +18,7 @@ from dataclasses import dataclass, fields
 from pathlib import Path
 from typing import Any, TextIO
 
+from drill_sim_ros.control import closed_loop_cli
 from drill_sim_ros.model import analysis, telemetry
 from drill_sim_ros.model import kernel as k
 from drill_sim_ros.model.errors import DrillSimError
@@ -111,6 +112,7 @@ def build_parser() -> argparse.ArgumentParser:
     sweep.add_argument("--values", required=True,
                        help="comma-separated values, or start:stop:count")
     sub.add_parser("presets", help="list the presets")
+    closed_loop_cli.add_parser(sub)
     info = sub.add_parser("info", help="groups, scales and stability of a preset")
     info.add_argument("preset", nargs="?", default="field_8p5in_shale")
     return parser
@@ -392,7 +394,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             for name in available_presets():
                 print(f"{name:22s} {load_preset(name).description.splitlines()[0]}")
             return 0
-        return {"run": _cmd_run, "sweep": _cmd_sweep, "info": _cmd_info}[args.command](args)
+        return {"run": _cmd_run, "sweep": _cmd_sweep, "info": _cmd_info,
+                "closed-loop": closed_loop_cli.cmd_closed_loop}[args.command](args)
     except DrillSimError as exc:
         print(f"drill_sim: error: {exc}", file=sys.stderr)
         return 2
