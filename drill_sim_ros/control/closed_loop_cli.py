@@ -34,7 +34,8 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--mode", choices=CONTROL_MODES, help="speed: the controller sends the "
                    "drive's speed setpoint; torque: it sends the motor torque (default speed)")
     p.add_argument("--t-end", type=float, help="simulated seconds (default 180)")
-    p.add_argument("--enable-at", type=float, help="switch-on time, s (default 60)")
+    p.add_argument("--enable-at", type=float, help="switch-on time, s (default 60, or a third "
+                   "of a shorter --t-end)")
     p.add_argument("--scenario", type=Path, help="scenario YAML (see "
                    "drill_sim_ros/control/scenario.py); the options above override it")
     p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
@@ -60,8 +61,11 @@ def _scenario(args: argparse.Namespace) -> Scenario:
             sep = ""
         if not sep:
             raise DrillSimError(f"--set {item!r} must be NAME=NUMBER")
+    enable_at_s = args.enable_at
+    if enable_at_s is None and args.t_end is not None and args.t_end < base.enable_at_s:
+        enable_at_s = args.t_end / 3.0          # a short run: switch on after a third
     return base.with_(preset=args.params, controller=args.controller, mode=args.mode,
-                      duration_s=args.t_end, enable_at_s=args.enable_at, params=params)
+                      duration_s=args.t_end, enable_at_s=enable_at_s, params=params)
 
 
 def _run(scenario: Scenario, ros: bool, label: str) -> ClosedLoopRun:
