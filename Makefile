@@ -69,6 +69,7 @@ bench: venv
 	$(PY) benchmarks/bench_node.py
 	$(PY) benchmarks/bench_mcap.py
 	$(PY) benchmarks/bench_bridge.py
+	$(PY) benchmarks/bench_closed_loop.py
 
 # The ament_python install tree that `ros2 run drill_sim_ros sim_node` uses.
 colcon: venv

@@ -17,7 +17,8 @@ from drill_sim_ros.model.errors import DrillSimError
 from drill_sim_ros.terminal import StatusLine
 
 LABELS = {"ssi_before_mean": "SSI before switch-on (mean)", "ssi_mean": "SSI after (mean)",
-          "ssi_max": "SSI after (max)", "stick_fraction": "stick fraction",
+          "ssi_max": "SSI after (max)", "ssi_last": "SSI last 20 s",
+          "stick_fraction": "stick fraction after",
           "utr": "UTR", "time_to_suppress_s": "time to suppress [s]",
           "rop_m_h": "mean ROP [m/h]", "mse_mpa": "MSE at the bit [MPa]",
           "quill_torque_peak_nm": "quill torque peak [N m]",
@@ -89,9 +90,9 @@ def _table(columns: dict[str, dict[str, Any]]) -> str:
             return str(value)
         return f"{value:.4g}" if math.isfinite(value) else "-"
     names = list(columns)
-    lines = [f"{'':30s}" + "".join(f"{n:>16s}" for n in names)]
+    lines = [f"{'':30s}" + "".join(f"{n:>22s}" for n in names)]
     for key in SCORE_FIELDS:
-        lines.append(f"{LABELS[key]:30s}" + "".join(f"{cell(columns[n][key]):>16s}"
+        lines.append(f"{LABELS[key]:30s}" + "".join(f"{cell(columns[n][key]):>22s}"
                                                     for n in names))
     return "\n".join(lines)
 

@@ -3,7 +3,8 @@
 ROS-free; from telemetry rows (``TELEMETRY_FIELDS``, SI) of a run, after the switch-on:
 
 * SSI over whole 20 s windows (``model.analysis.stick_slip_index``, the one SSI:
-  (max - min) / (2 mean) of bit rpm), mean and max, and the same before the switch-on;
+  (max - min) / (2 mean) of bit rpm), mean and max, that of the last window (settled), and
+  the mean before the switch-on;
 * stick fraction (share of samples with the bit stuck), UTR = (omega_0 - min) / omega_0
   (``model.analysis.severity_of``, omega_0 the mean setpoint of the schedule);
 * time to suppress: from the switch-on to the last stuck sample (0 if none; None when the
@@ -31,7 +32,7 @@ from drill_sim_ros.model.telemetry import TELEMETRY_INDEX
 F = TELEMETRY_INDEX
 STUCK = 2
 WINDOW_S = 20.0
-SCORE_FIELDS = ("ssi_before_mean", "ssi_mean", "ssi_max", "stick_fraction", "utr",
+SCORE_FIELDS = ("ssi_before_mean", "ssi_mean", "ssi_max", "ssi_last", "stick_fraction", "utr",
                 "time_to_suppress_s", "rop_m_h", "mse_mpa", "quill_torque_peak_nm",
                 "quill_torque_rms_nm", "motor_energy_mj", "saturation_count")
 
@@ -86,6 +87,7 @@ def score(rows: np.ndarray, enable_at_s: float, schedule: Schedule, rig: RigPhys
     return {
         "ssi_before_mean": _mean(before), "ssi_mean": _mean(ssi),
         "ssi_max": float(np.max(ssi)) if np.isfinite(ssi).all() else None,
+        "ssi_last": float(ssi[-1]) if np.isfinite(ssi[-1]) else None,
         "stick_fraction": float(stuck.mean()), "utr": sev.utr,
         "time_to_suppress_s": _time_to_suppress(ta, stuck, enable_at_s, end_s),
         "rop_m_h": float(rop.mean() * 3600.0),

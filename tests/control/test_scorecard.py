@@ -81,3 +81,4 @@ def test_ssi_is_model_analysis_on_the_same_windows() -> None:
     np.testing.assert_allclose(window_ssi(t, bit, 20.0, 100.0), by_hand, rtol=1e-12)
     assert card["ssi_mean"] == pytest.approx(np.mean(by_analysis), rel=1e-12)
     assert card["ssi_max"] == pytest.approx(np.max(by_analysis), rel=1e-12)
+    assert card["ssi_last"] == pytest.approx(by_analysis[-1], rel=1e-12)
