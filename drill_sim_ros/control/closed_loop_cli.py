@@ -110,7 +110,7 @@ def cmd_closed_loop(args: argparse.Namespace) -> int:
                         "no control")
         columns["no control"] = score(baseline.rows, scenario.enable_at_s, schedule, rig,
                                       scenario.period_s)
-    label = f"{scenario.controller} ({scenario.mode})"
+    label = f"{scenario.controller.split(':')[-1]} ({scenario.mode})"
     columns[label] = score(controlled.rows, scenario.enable_at_s, schedule, rig,
                            scenario.period_s)
     rate = scenario.periods / controlled.wall_s if controlled.wall_s > 0 else math.nan

@@ -4,6 +4,8 @@ user's class as ``module:Class`` (ROS-free)."""
 from __future__ import annotations
 
 import importlib
+import os
+import sys
 from typing import Any
 
 from drill_sim_ros.control.controllers import SoftTorque, Stiff, TopDriveController, ZTorque
@@ -29,13 +31,16 @@ BUILTIN: dict[str, type[TopDriveController]] = {
 
 def controller_class(name: str) -> type:
     """The class of ``name``: a built-in (none, stiff, soft_torque, z_torque) or
-    ``package.module:Class``; ParameterError naming the choices otherwise."""
+    ``package.module:Class`` importable from the working directory or ``PYTHONPATH``;
+    ParameterError naming the choices otherwise."""
     if name in BUILTIN:
         return BUILTIN[name]
     module_name, sep, class_name = name.partition(":")
     if not sep or not module_name or not class_name:
         raise ParameterError(f"controller {name!r} is not one of {sorted(BUILTIN)} nor of "
                              "the form package.module:Class")
+    if os.getcwd() not in sys.path:          # a user's module in the working directory
+        sys.path.append(os.getcwd())
     try:
         module = importlib.import_module(module_name)
     except ImportError as exc:
