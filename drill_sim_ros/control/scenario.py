@@ -59,6 +59,8 @@ class Scenario:
         if not (math.isfinite(self.enable_at_s) and 0.0 <= self.enable_at_s <= self.duration_s):
             raise ParameterError(f"scenario: 'enable_at_s' = {self.enable_at_s!r} must lie in "
                                  f"[0, duration_s = {self.duration_s:g}]")
+        if self.mode not in ("speed", "torque"):
+            raise ParameterError(f"scenario: 'mode' = {self.mode!r} must be speed or torque")
         if not isinstance(self.params, dict):
             raise ParameterError(f"scenario: 'params' must be a mapping, got {self.params!r}")
 
