@@ -63,7 +63,7 @@ lint: venv
 	$(BIN)/ruff check drill_sim_ros tests benchmarks
 
 # Benchmarks print figures (no pass/fail): kernel ns/step, node CPU and real-time factor,
-# MCAP throughput, rerun bridge CPU.
+# MCAP throughput, rerun bridge CPU, recording loss, maps, closed loop, lockstep.
 bench: venv
 	$(PY) benchmarks/bench_kernel.py
 	$(PY) benchmarks/bench_node.py
@@ -71,6 +71,8 @@ bench: venv
 	$(PY) benchmarks/bench_bridge.py
 	$(PY) benchmarks/bench_recording_faults.py
 	$(PY) benchmarks/bench_map.py
+	$(PY) benchmarks/bench_closed_loop.py
+	$(PY) benchmarks/bench_lockstep.py
 
 # The paper's figures and the field map (docs/gallery/*.png), computed on a local Dask
 # cluster; FIGURES_CACHE keeps the maps as NetCDF so a re-run resumes them.

@@ -27,6 +27,7 @@ setup(
         "console_scripts": [
             "drill_sim = drill_sim_ros.cli:main",
             "sim_node = drill_sim_ros.ros.sim_node:main",
+            "top_drive_controller = drill_sim_ros.ros.controller_node:main",
             "mcap_recorder = drill_sim_ros.archive.recorder_node:main",
             "mcap_replay = drill_sim_ros.archive.replay_node:main",
             "mcap_reindex = drill_sim_ros.archive.reindex:main",

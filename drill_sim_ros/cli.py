@@ -1,4 +1,5 @@
-"""Offline command line: ``drill_sim run | sweep | presets | info | map | map-plot | figures``.
+"""Offline command line: ``drill_sim run | sweep | presets | info | closed-loop | map |
+map-plot | figures``.
 
 ``drill_sim run`` integrates the RGD07 model without ROS and prints a summary (or one JSON
 object with ``--json``). The run is dimensionless unless ``--params`` names a physical
@@ -18,6 +19,7 @@ from dataclasses import dataclass, fields
 from pathlib import Path
 from typing import Any, TextIO
 
+from drill_sim_ros.control import closed_loop_cli
 from drill_sim_ros.model import analysis, telemetry
 from drill_sim_ros.model import kernel as k
 from drill_sim_ros.model.errors import DrillSimError
@@ -112,6 +114,7 @@ def build_parser() -> argparse.ArgumentParser:
     sweep.add_argument("--values", required=True,
                        help="comma-separated values, or start:stop:count")
     sub.add_parser("presets", help="list the presets")
+    closed_loop_cli.add_parser(sub)
     info = sub.add_parser("info", help="groups, scales and stability of a preset")
     info.add_argument("preset", nargs="?", default="field_8p5in_shale")
     study_cli.add_parsers(sub, _add_model_args)
@@ -398,6 +401,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         if args.command == "map":
             return study_cli.cmd_map(args, _resolve)
         return {"run": _cmd_run, "sweep": _cmd_sweep, "info": _cmd_info,
+                "closed-loop": closed_loop_cli.cmd_closed_loop,
                 "map-plot": study_cli.cmd_map_plot,
                 "figures": study_cli.cmd_figures}[args.command](args)
     except DrillSimError as exc:

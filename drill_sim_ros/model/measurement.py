@@ -60,6 +60,11 @@ class RigSensors:
         self._spec = [self.specs.get(name, SignalSpec()) for name in SIGNALS]
         self.reset()
 
+    @property
+    def perfect(self) -> bool:
+        """True when every sensor is perfect (the measurement is the truth)."""
+        return all(spec == SignalSpec() for spec in self._spec)
+
     def reset(self) -> None:
         """Forget the delay lines and restart the noise sequence."""
         self._rng = [np.random.Generator(np.random.PCG64([self.seed, i]))

@@ -9,6 +9,7 @@ dimensionless one; absent: the paper's kinematic drive).
 
 from __future__ import annotations
 
+import math
 import os
 import sys
 from dataclasses import dataclass, field
@@ -26,10 +27,13 @@ from drill_sim_ros.model.params import (
     dimensionless_from_dict,
     physical_from_dict,
     scale,
+    structure,
 )
 from drill_sim_ros.model.top_drive import TopDrive, top_drive_from_dict
 
 DEFAULT_PRESET = "field_8p5in_shale"
+GRAVITY_M_S2 = 9.80665
+MUD_DENSITY_KG_M3 = 1200.0
 PACKAGE = "drill_sim_ros"
 
 
@@ -120,3 +124,15 @@ def load_preset(name_or_path: str = DEFAULT_PRESET) -> Preset:
         return preset_from_dict(path.stem, data)
     except ParameterError as exc:
         raise ParameterError(f"{path}: {exc}") from exc
+
+
+def submerged_string_weight_n(preset: Preset | None,
+                              mud_density_kg_m3: float = MUD_DENSITY_KG_M3) -> float:
+    """Buoyed weight of pipe + BHA: steel mass x g x (1 - rho_mud / rho_steel); 0 if none."""
+    if preset is None or preset.physical is None:
+        return 0.0
+    phys = preset.physical
+    pipe_m3 = math.pi * (phys.pipe_outer_radius_m**2 - phys.pipe_inner_radius_m**2) \
+        * phys.pipe_length_m
+    mass_kg = pipe_m3 * phys.density_kg_m3 + structure(phys).mass_kg
+    return mass_kg * GRAVITY_M_S2 * (1.0 - mud_density_kg_m3 / phys.density_kg_m3)

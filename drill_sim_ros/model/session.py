@@ -107,6 +107,7 @@ class SimSession:
         self.submerged_weight_n = cfg.submerged_weight_n
         self.command_stamp_ns: int | None = None    # stamp of the command in force, if any
         self.sensors = cfg.sensors or RigSensors()
+        self._perfect_sensors = self.sensors.perfect
         self._factors = field_scales(self.scales)
         self._samples = np.empty((2, k.N_COLS))   # kernel rows of a run (grows as needed)
         self.sim.advance_into(self._samples, 0, self.steps)  # load the compiled kernel now
@@ -157,7 +158,8 @@ class SimSession:
             self.command_stamp_ns / NS_PER_S
         rows = si_rows(samples, self.sim.offsets, self._factors, stamps_ns / NS_PER_S,
                        self.submerged_weight_n, command_s)
-        rows[:, MEASURED] = self.sensors.measure(surface_truth(rows))
+        if not self._perfect_sensors:          # si_rows gives the truth, perfect sensors
+            rows[:, MEASURED] = self.sensors.measure(surface_truth(rows))
         return Block(rows, stamps_ns, self.sim.offsets)
 
     def _advanced(self, count: int) -> None:

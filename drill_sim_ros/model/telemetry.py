@@ -8,6 +8,7 @@ RGD07 eqs. 19-24) become SI; sim_node, the recorder and ``drill_sim run --trace`
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 
 from drill_sim_ros.model import kernel as k
 from drill_sim_ros.model.params import RPM_PER_RAD_S, Scales
@@ -88,15 +89,41 @@ def si_rows(samples: np.ndarray, offsets: tuple[float, float], factors: np.ndarr
     the command in force over these samples.
     """
     out = np.empty((samples.shape[0], N_FIELDS))
-    out[:, _SOURCE_FIELDS] = samples[:, _SOURCE_KERNEL_COLUMNS]
-    out[:, _DEPTH] += offsets[0]
-    out[:, _ANGLES] += offsets[1]
-    out *= factors
-    out[:, F["sim_time_s"]] = sim_times_s
-    out[:, F["hook_load_n"]] = submerged_weight_n - out[:, F["applied_wob_n"]]
-    out[:, F["command_stamp_s"]] = command_stamp_s
-    out[:, MEASURED] = surface_truth(out)          # perfect sensors (see model.measurement)
+    _fill_si(samples, float(offsets[0]), float(offsets[1]), factors,
+             np.ascontiguousarray(sim_times_s, dtype=np.float64), float(submerged_weight_n),
+             float(command_stamp_s), out)
     return out
+
+
+_TIME, _HOOK, _COMMAND = F["sim_time_s"], F["hook_load_n"], F["command_stamp_s"]
+_APPLIED_WOB = F["applied_wob_n"]
+_SURFACE_RPM, _MOTOR, _STRING = F["surface_rpm"], F["motor_torque_nm"], F["surface_torque_nm"]
+_MEASURED = np.array(MEASURED, dtype=np.int64)
+_ANGLE_FIELDS = np.array(_ANGLES, dtype=np.int64)
+
+
+@njit(cache=True)
+def _fill_si(samples: np.ndarray, depth_offset: float, angle_offset: float,
+             factors: np.ndarray, sim_times_s: np.ndarray, submerged_weight_n: float,
+             command_stamp_s: float, out: np.ndarray) -> None:
+    """:func:`si_rows` into ``out``, element by element in the same operations and order
+    (offset added, then the factor; fields without a source are 1 x their value)."""
+    for i in range(samples.shape[0]):
+        row = out[i]
+        for j in range(_SOURCE_FIELDS.size):
+            row[_SOURCE_FIELDS[j]] = samples[i, _SOURCE_KERNEL_COLUMNS[j]]
+        row[_DEPTH] = row[_DEPTH] + depth_offset
+        for j in range(_ANGLE_FIELDS.size):
+            row[_ANGLE_FIELDS[j]] = row[_ANGLE_FIELDS[j]] + angle_offset
+        for j in range(row.size):
+            row[j] = row[j] * factors[j]
+        row[_TIME] = sim_times_s[i]
+        row[_HOOK] = submerged_weight_n - row[_APPLIED_WOB]
+        row[_COMMAND] = command_stamp_s
+        # perfect sensors (see model.measurement), as surface_truth gives them
+        row[_MEASURED[0]] = row[_SURFACE_RPM] / RPM_PER_RAD_S
+        row[_MEASURED[1]] = row[_MOTOR]
+        row[_MEASURED[2]] = row[_STRING]
 
 
 def surface_truth(rows: np.ndarray) -> np.ndarray:

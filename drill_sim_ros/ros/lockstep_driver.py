@@ -2,10 +2,14 @@
 
 The sim (``lockstep:=true -p lockstep_trigger:=command``) advances exactly one period per
 message on ``drill/cmd/top_drive`` and then publishes the state at the end of that period.
-:class:`LockstepDriver` closes the loop: for every telemetry sample it receives it calls
-``policy(row)`` (one SI row, ``TELEMETRY_FIELDS`` order) and publishes the :class:`Command`
-it returns, stamped with the sample's stamp. Its first command (when the sim's subscription
-matches) reacts to the sim's initial state at t = 0, so the loop starts whether or not the
+:class:`LockstepDriver` closes the loop: for every sample it receives it calls
+``policy(sample)`` and publishes the :class:`Command` it returns, stamped with the sample's
+stamp. The sample is, by ``sample_topic``, one SI telemetry row (``drill/telemetry``,
+``TELEMETRY_FIELDS`` order: the whole truth, for tests and tools) or the rig's surface
+measurement (``drill/surface/measured`` as a
+:class:`~drill_sim_ros.control.command.SurfaceMeasurement`: what a controller may read).
+Its first command (when the sim's subscription and publisher have matched) reacts to the
+sim's initial state at t = 0 (``policy(None)``), so the loop starts whether or not the
 t = 0 sample arrived.
 Nothing is lost: both directions are reliable and deep, and each side waits for the other.
 """
@@ -14,7 +18,6 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -25,25 +28,18 @@ from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
 
 from drill_sim_ros import topics
+from drill_sim_ros.control.command import Command, SurfaceMeasurement
 from drill_sim_ros.model.telemetry import NS_PER_S, TELEMETRY_INDEX
-from drill_sim_ros.ros.messages import stamp
+from drill_sim_ros.ros.messages import stamp, stamp_ns
+
+__all__ = ["LOCKSTEP_QOS", "Command", "LockstepDriver", "Policy", "top_drive_command"]
 
 LOCKSTEP_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1000,
                           reliability=ReliabilityPolicy.RELIABLE)
 _TIME = TELEMETRY_INDEX["sim_time_s"]
 
-
-@dataclass(frozen=True)
-class Command:
-    """What one drill/cmd/top_drive message commands; None commands nothing."""
-
-    speed_rad_s: float | None = None       # speed setpoint (kinematic and speed modes)
-    motor_torque_nm: float | None = None   # motor torque (torque mode)
-    wob_n: float | None = None             # applied WOB
-
-
 # A policy: the sample it reacts to (None: the initial state at t = 0) -> the command.
-Policy = Callable[[np.ndarray | None], Command]
+Policy = Callable[[Any], Command]
 
 
 def top_drive_command(command: Command, reacts_to_ns: int) -> JointState:
@@ -57,48 +53,75 @@ def top_drive_command(command: Command, reacts_to_ns: int) -> JointState:
     return msg
 
 
+def telemetry_sample(raw: bytes) -> tuple[np.ndarray, int]:
+    """A drill/telemetry payload: (SI row, stamp ns)."""
+    row = np.asarray(deserialize_message(raw, Float64MultiArray).data)
+    return row, round(row[_TIME] * NS_PER_S)
+
+
+def measured_sample(raw: bytes) -> tuple[SurfaceMeasurement, int]:
+    """A drill/surface/measured payload (joints top_drive, quill: MEASURED_JOINTS):
+    (measurement, stamp ns)."""
+    msg = deserialize_message(raw, JointState)
+    time_ns = stamp_ns(msg.header.stamp)
+    return SurfaceMeasurement(time_s=time_ns / 1e9, drive_speed_rad_s=msg.velocity[0],
+                              motor_torque_nm=msg.effort[0],
+                              string_torque_nm=msg.effort[1]), time_ns
+
+
+SAMPLE_DECODERS = {topics.TELEMETRY: telemetry_sample, topics.SURFACE_MEASURED: measured_sample}
+
+
 class LockstepDriver(Node):
-    """Runs ``periods`` periods of a sim in command lockstep; ``rows`` keeps every sample
-    received (their raw payloads in ``payloads``); ``done`` once the last one is in."""
+    """Runs ``periods`` periods of a sim in command lockstep (0: until stopped); with
+    ``keep``, ``rows`` keeps every sample received (their raw payloads in ``payloads``);
+    ``done`` once the last one is in."""
 
     def __init__(self, policy: Policy, periods: int, name: str = "lockstep_driver",
+                 sample_topic: str = topics.TELEMETRY, keep: bool = True,
                  **node_kwargs: Any) -> None:
         super().__init__(name, **node_kwargs)
         self._policy = policy
         self.periods = periods
         self.sent = 0
-        self.rows: list[np.ndarray] = []
+        self.received = 0
+        self.keep = keep
+        self.rows: list[Any] = []
         self.payloads: list[bytes] = []
         self._reacted_ns = -1
+        self._decode = SAMPLE_DECODERS[sample_topic]
         self._pub = self.create_publisher(JointState, topics.node_relative(
             topics.CMD_TOP_DRIVE), LOCKSTEP_QOS)
-        self.create_subscription(Float64MultiArray, topics.node_relative(topics.TELEMETRY),
-                                 self._on_sample, LOCKSTEP_QOS, raw=True)
+        msg_type = JointState if sample_topic == topics.SURFACE_MEASURED else Float64MultiArray
+        self._sub = self.create_subscription(msg_type, topics.node_relative(sample_topic),
+                                             self._on_sample, LOCKSTEP_QOS, raw=True)
         self._start = self.create_timer(0.05, self._start_when_matched)
 
     @property
     def done(self) -> bool:
-        return len(self.rows) >= self.periods
+        return self.periods > 0 and self.received >= self.periods
 
     def _start_when_matched(self) -> None:
         """The first command reacts to the initial state (t = 0)."""
-        if self._pub.get_subscription_count() == 0 or self._reacted_ns >= 0:
+        if self._pub.get_subscription_count() == 0 or self._sub.get_publisher_count() == 0 \
+                or self._reacted_ns >= 0:
             return
         self.destroy_timer(self._start)
         self._command(None, 0)
 
     def _on_sample(self, raw: bytes) -> None:
-        row = np.asarray(deserialize_message(raw, Float64MultiArray).data)
-        stamp_ns = round(row[_TIME] * NS_PER_S)
-        if stamp_ns <= self._reacted_ns:
-            return                       # the t = 0 sample, already reacted to
-        self.rows.append(row)
-        self.payloads.append(raw)
-        if len(self.rows) < self.periods:
-            self._command(row, stamp_ns)
+        sample, time_ns = self._decode(raw)
+        if time_ns <= max(self._reacted_ns, 0):
+            return       # the t = 0 sample: the first command reacts to None, always
+        self.received += 1
+        if self.keep:
+            self.rows.append(sample)
+            self.payloads.append(raw)
+        if self.periods <= 0 or self.received < self.periods:
+            self._command(sample, time_ns)
 
-    def _command(self, row: np.ndarray | None, stamp_ns: int) -> None:
-        command = self._policy(row)
-        self._reacted_ns = stamp_ns
-        self._pub.publish(top_drive_command(command, stamp_ns))
+    def _command(self, sample: Any, time_ns: int) -> None:
+        command = self._policy(sample)
+        self._reacted_ns = time_ns
+        self._pub.publish(top_drive_command(command, time_ns))
         self.sent += 1

@@ -25,13 +25,11 @@ from rclpy.impl.implementation_singleton import rclpy_implementation
 
 from drill_sim_ros.model.errors import ParameterError
 from drill_sim_ros.model.measurement import MAX_DELAY_PERIODS, SIGNALS
-from drill_sim_ros.model.params import UNIT_SCALES, structure
-from drill_sim_ros.model.presets import DEFAULT_PRESET, Preset
+from drill_sim_ros.model.params import UNIT_SCALES
+from drill_sim_ros.model.presets import DEFAULT_PRESET, Preset, submerged_string_weight_n
 from drill_sim_ros.model.top_drive import MODES, TopDrive, TopDrivePhysical
 
 RCLError = rclpy_implementation.RCLError
-GRAVITY_M_S2 = 9.80665
-MUD_DENSITY_KG_M3 = 1200.0
 DOUBLE, INTEGER, BOOL, STRING = "double", "int", "bool", "string"
 
 
@@ -50,18 +48,6 @@ class ParamSpec:
 
     def default_for(self, preset: Preset | None) -> Any:
         return self.default(preset) if callable(self.default) else self.default
-
-
-def submerged_string_weight_n(preset: Preset | None,
-                              mud_density_kg_m3: float = MUD_DENSITY_KG_M3) -> float:
-    """Buoyed weight of pipe + BHA: steel mass x g x (1 - rho_mud / rho_steel); 0 if none."""
-    if preset is None or preset.physical is None:
-        return 0.0
-    phys = preset.physical
-    pipe_m3 = math.pi * (phys.pipe_outer_radius_m**2 - phys.pipe_inner_radius_m**2) \
-        * phys.pipe_length_m
-    mass_kg = pipe_m3 * phys.density_kg_m3 + structure(phys).mass_kg
-    return mass_kg * GRAVITY_M_S2 * (1.0 - mud_density_kg_m3 / phys.density_kg_m3)
 
 
 def _preset_wob_n(preset: Preset | None) -> float:

@@ -1,0 +1,1 @@
+"""Reference top-drive controllers and the closed-loop bench (ROS-free)."""

@@ -1,0 +1,150 @@
+"""The closed-loop bench in process: a controller and the session, period by period.
+
+ROS-free. :func:`run_in_process` steps :class:`~drill_sim_ros.model.session.SimSession`
+exactly as sim_node does in command-triggered lockstep (``lockstep:=true -p
+lockstep_trigger:=command``), so both give the same telemetry bit for bit:
+
+1. the session is built from the same settings sim_node takes from its parameters
+   (:func:`session_config`, :func:`sim_node_parameters`), and its t = 0 sample is taken
+   (sim_node publishes it at start; the sensors' noise and delay lines see it);
+2. the controller's first command reacts to no measurement (the initial state, stamp 0);
+3. each command is applied with sim_node's limits (:func:`apply_command`: speed and WOB
+   within [0, limit], motor torque within +-the drive's limit) and stamped with the sample it
+   reacts to; then exactly one period runs under it (zero-order hold), and the sample at the
+   END of that period is what the controller reacts to next.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from drill_sim_ros.control.command import Command, measurement_of_row
+from drill_sim_ros.control.registry import make_controller
+from drill_sim_ros.control.rig import RigPhysics, rig_physics
+from drill_sim_ros.control.scenario import Scenario
+from drill_sim_ros.model.errors import ParameterError
+from drill_sim_ros.model.measurement import SIGNALS
+from drill_sim_ros.model.params import RPM_PER_RAD_S
+from drill_sim_ros.model.presets import Preset, submerged_string_weight_n
+from drill_sim_ros.model.session import SessionConfig, SimSession
+from drill_sim_ros.model.telemetry import N_FIELDS
+from drill_sim_ros.model.top_drive import TopDrivePhysical
+
+PERTURB_V = 1e-3        # sim_node's model.perturb_v default
+WINDOW_S = 20.0         # sim_node's diagnostics.window_s default
+
+
+@dataclass(frozen=True)
+class Limits:
+    """sim_node's command limits at their defaults (limits.*, top_drive.max_torque_nm)."""
+
+    max_surface_rpm: float
+    max_wob_n: float
+    max_torque_nm: float
+
+    @staticmethod
+    def of(preset: Preset, rig: RigPhysics) -> Limits:
+        wob_n = preset.scales.wob_n(preset.params.w0)
+        return Limits(rig.max_surface_rpm, max(10.0 * wob_n, 1.0), rig.max_torque_nm)
+
+
+@dataclass
+class ClosedLoopRun:
+    """Telemetry rows (periods + 1, N_FIELDS), the first the t = 0 sample; wall time."""
+
+    scenario: Scenario
+    rows: np.ndarray
+    wall_s: float
+    clamped_commands: int = 0
+
+
+def drive_of(preset: Preset, mode: str) -> TopDrivePhysical:
+    """The preset's drive in SI, in ``mode``."""
+    d = preset.top_drive.physical(preset.scales)
+    return TopDrivePhysical(mode=mode, inertia_kg_m2=d.inertia_kg_m2, kp_nm_s=d.kp_nm_s,
+                            ki_nm=d.ki_nm, max_torque_nm=d.max_torque_nm)
+
+
+def session_config(scenario: Scenario, preset: Preset) -> SessionConfig:
+    """The session sim_node builds from :func:`sim_node_parameters` of ``scenario``."""
+    schedule = scenario.setpoints(preset)
+    return SessionConfig(
+        preset=preset, publish_rate_hz=scenario.control_rate_hz, dtau_max=preset.dtau,
+        n_nodes=preset.n_nodes or 2048, perturb_v=PERTURB_V,
+        applied_wob_n=schedule.wob_at(0.0), surface_rpm=schedule.rpm_at(0.0),
+        window_s=WINDOW_S, submerged_weight_n=submerged_string_weight_n(preset),
+        top_drive=drive_of(preset, scenario.mode), sensors=scenario.rig_sensors())
+
+
+def sim_node_parameters(scenario: Scenario, preset: Preset) -> dict[str, object]:
+    """sim_node's parameters for the same session as :func:`session_config` (the rest at
+    their defaults, which :func:`session_config` mirrors)."""
+    schedule = scenario.setpoints(preset)
+    out: dict[str, object] = {
+        "model.preset": scenario.preset, "publish_rate_hz": float(scenario.control_rate_hz),
+        "model.applied_wob_n": schedule.wob_at(0.0), "model.surface_rpm": schedule.rpm_at(0.0),
+        "top_drive.mode": scenario.mode, "sensors.seed": int(scenario.sensors.get("seed", 0))}
+    for signal in SIGNALS:
+        for key, value in (scenario.sensors.get(signal) or {}).items():
+            out[f"sensors.{signal}.{key}"] = value
+    return out
+
+
+def clamp(value: float, low: float, high: float) -> float:
+    """sim_node's clamp_command: a finite command within [low, high]."""
+    if not math.isfinite(value):
+        raise ParameterError(f"the controller commanded {value!r}; commands must be finite")
+    return min(max(value, low), high)
+
+
+def apply_command(session: SimSession, command: Command, reacts_to_ns: int,
+                  limits: Limits) -> None:
+    """What sim_node does with a drill/cmd/top_drive message (``_on_top_drive``)."""
+    if command.speed_rad_s is not None:
+        session.set_surface_rpm(clamp(command.speed_rad_s * RPM_PER_RAD_S, 0.0,
+                                      limits.max_surface_rpm))
+    if command.motor_torque_nm is not None:
+        session.set_motor_torque_nm(clamp(command.motor_torque_nm, -limits.max_torque_nm,
+                                          limits.max_torque_nm))
+    if command.wob_n is not None:
+        session.set_wob_n(clamp(command.wob_n, 0.0, limits.max_wob_n))
+    session.command_stamp_ns = reacts_to_ns
+
+
+def build_controller(scenario: Scenario, preset: Preset) -> object:
+    """The scenario's controller, tuned from the preset's physics."""
+    return make_controller(scenario.controller, rig=rig_physics(preset),
+                           schedule=scenario.setpoints(preset), mode=scenario.mode,
+                           period_s=scenario.period_s, enable_at_s=scenario.enable_at_s,
+                           **scenario.params)
+
+
+def run_in_process(scenario: Scenario,
+                   progress: Callable[[int, int], None] | None = None) -> ClosedLoopRun:
+    """Run ``scenario``: its telemetry, the t = 0 sample first (see the module doc)."""
+    preset = scenario.load_preset()
+    rig = rig_physics(preset)
+    controller = build_controller(scenario, preset)
+    limits = Limits.of(preset, rig)
+    session = SimSession(session_config(scenario, preset))
+    periods = scenario.periods
+    rows = np.empty((periods + 1, N_FIELDS))
+    rows[0] = session.current().rows[0]
+    start = time.perf_counter()
+    command, stamp_ns = controller.update(None), 0
+    for i in range(periods):
+        apply_command(session, command, stamp_ns, limits)
+        block = session.run(1)
+        rows[i + 1] = block.rows[0]
+        stamp_ns = int(block.stamps_ns[0])
+        if i + 1 < periods:
+            command = controller.update(measurement_of_row(block.rows[0], stamp_ns))
+        if progress is not None and (i + 1) % 1000 == 0:
+            progress(i + 1, periods)
+    wall_s = time.perf_counter() - start
+    return ClosedLoopRun(scenario, rows, wall_s, int(getattr(controller, "clamped_commands", 0)))

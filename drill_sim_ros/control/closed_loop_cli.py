@@ -1,0 +1,132 @@
+"""``drill_sim closed-loop``: a controller against the sim, scored (in process or over DDS)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+from pathlib import Path
+from typing import Any
+
+from drill_sim_ros.control.bench import ClosedLoopRun, run_in_process
+from drill_sim_ros.control.controllers import CONTROL_MODES
+from drill_sim_ros.control.rig import rig_physics
+from drill_sim_ros.control.scenario import Scenario, load_scenario
+from drill_sim_ros.control.scorecard import SCORE_FIELDS, score
+from drill_sim_ros.model.errors import DrillSimError
+from drill_sim_ros.terminal import StatusLine
+
+LABELS = {"ssi_before_mean": "SSI before switch-on (mean)", "ssi_mean": "SSI after (mean)",
+          "ssi_max": "SSI after (max)", "ssi_last": "SSI last 20 s",
+          "stick_fraction": "stick fraction after",
+          "utr": "UTR", "time_to_suppress_s": "time to suppress [s]",
+          "rop_m_h": "mean ROP [m/h]", "mse_mpa": "MSE at the bit [MPa]",
+          "quill_torque_peak_nm": "quill torque peak [N m]",
+          "quill_torque_rms_nm": "quill torque RMS [N m]",
+          "motor_energy_mj": "motor energy [MJ]", "saturation_count": "saturated samples"}
+
+
+def add_parser(sub: Any) -> None:
+    p = sub.add_parser("closed-loop", help="a top-drive controller against the sim, scored")
+    p.add_argument("--params", help="physical preset (default: the scenario's, else "
+                   "field_8p5in_shale)")
+    p.add_argument("--controller", help="none | stiff | soft_torque | z_torque | "
+                   "package.module:Class (default: the scenario's, else stiff)")
+    p.add_argument("--mode", choices=CONTROL_MODES, help="speed: the controller sends the "
+                   "drive's speed setpoint; torque: it sends the motor torque (default speed)")
+    p.add_argument("--t-end", type=float, help="simulated seconds (default 180)")
+    p.add_argument("--enable-at", type=float, help="switch-on time, s (default 60, or a third "
+                   "of a shorter --t-end)")
+    p.add_argument("--scenario", type=Path, help="scenario YAML (see "
+                   "drill_sim_ros/control/scenario.py); the options above override it")
+    p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
+                   help="a controller parameter, e.g. --set damping_ratio=0.3 (repeatable)")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.add_argument("--plot", type=Path, help="PNG of bit rpm and quill torque against time, "
+                   "beside the uncontrolled run")
+    p.add_argument("--no-baseline", action="store_true", help="skip the uncontrolled run "
+                   "(by default it runs too, for the comparison)")
+    p.add_argument("--ros", action="store_true", help="run sim_node and the "
+                   "top_drive_controller node as processes over loopback DDS, score the "
+                   "recording")
+
+
+def _scenario(args: argparse.Namespace) -> Scenario:
+    base = load_scenario(args.scenario) if args.scenario else Scenario()
+    params = dict(base.params)
+    for item in args.set:
+        name, sep, value = item.partition("=")
+        try:
+            params[name.strip()] = float(value)
+        except ValueError:
+            sep = ""
+        if not sep:
+            raise DrillSimError(f"--set {item!r} must be NAME=NUMBER")
+    enable_at_s = args.enable_at
+    if enable_at_s is None and args.t_end is not None and args.t_end < base.enable_at_s:
+        enable_at_s = args.t_end / 3.0          # a short run: switch on after a third
+    return base.with_(preset=args.params, controller=args.controller, mode=args.mode,
+                      duration_s=args.t_end, enable_at_s=enable_at_s, params=params)
+
+
+def _run(scenario: Scenario, ros: bool, label: str) -> ClosedLoopRun:
+    line = StatusLine()
+    def progress(done: int, total: int) -> None:
+        line.show(f"{label}: {done:,}/{total:,} periods ({100 * done / total:4.1f}%)")
+    try:
+        if ros:
+            from drill_sim_ros.ros.closed_loop import run_over_dds
+            return run_over_dds(scenario, progress)
+        return run_in_process(scenario, progress)
+    finally:
+        line.close()
+
+
+def _table(columns: dict[str, dict[str, Any]]) -> str:
+    def cell(value: Any) -> str:
+        if value is None:
+            return "-"
+        if isinstance(value, int):
+            return str(value)
+        return f"{value:.4g}" if math.isfinite(value) else "-"
+    names = list(columns)
+    lines = [f"{'':30s}" + "".join(f"{n:>22s}" for n in names)]
+    for key in SCORE_FIELDS:
+        lines.append(f"{LABELS[key]:30s}" + "".join(f"{cell(columns[n][key]):>22s}"
+                                                    for n in names))
+    return "\n".join(lines)
+
+
+def cmd_closed_loop(args: argparse.Namespace) -> int:
+    scenario = _scenario(args)
+    preset = scenario.load_preset()
+    rig = rig_physics(preset)
+    schedule = scenario.setpoints(preset)
+    controlled = _run(scenario, args.ros, scenario.controller)
+    columns = {}
+    baseline = None
+    if not args.no_baseline and scenario.controller != "none":
+        baseline = _run(scenario.with_(controller="none", mode="speed", params={}), False,
+                        "no control")
+        columns["no control"] = score(baseline.rows, scenario.enable_at_s, schedule, rig,
+                                      scenario.period_s)
+    label = f"{scenario.controller.split(':')[-1]} ({scenario.mode})"
+    columns[label] = score(controlled.rows, scenario.enable_at_s, schedule, rig,
+                           scenario.period_s)
+    rate = scenario.periods / controlled.wall_s if controlled.wall_s > 0 else math.nan
+    if args.plot:
+        from drill_sim_ros.control.plot import plot_runs
+        plot_runs(args.plot, controlled.rows, None if baseline is None else baseline.rows,
+                  scenario.enable_at_s, f"{preset.name}: {label}, switched on at "
+                  f"{scenario.enable_at_s:g} s")
+    if args.json:
+        print(json.dumps({"scenario": scenario.to_dict(), "path": "ros" if args.ros else
+                          "in-process", "periods": scenario.periods,
+                          "periods_per_s": rate, "score": columns[label],
+                          "baseline": columns.get("no control")}))
+    else:
+        print(_table(columns))
+        print(f"{scenario.periods:,} periods of {scenario.period_s * 1e3:g} ms "
+              f"{'over DDS' if args.ros else 'in process'}: {rate:,.0f} periods/s "
+              f"({rate * scenario.period_s:,.0f}x real time)")
+    return 0

@@ -1,0 +1,68 @@
+"""Controllers by name: the references of :mod:`~drill_sim_ros.control.controllers`, or a
+user's class as ``module:Class`` (ROS-free)."""
+
+from __future__ import annotations
+
+import importlib
+import os
+import sys
+from typing import Any
+
+from drill_sim_ros.control.controllers import SoftTorque, Stiff, TopDriveController, ZTorque
+from drill_sim_ros.model.errors import ParameterError
+
+
+class NoControl(Stiff):
+    """The rig as delivered: the drive's own speed loop on the operator's setpoint."""
+
+    name = "none"
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        if self.mode != "speed":
+            raise ParameterError("controller 'none' is the drive's own speed loop: use "
+                                 "--mode speed (in torque mode a controller must close the "
+                                 "loop, e.g. stiff)")
+
+
+BUILTIN: dict[str, type[TopDriveController]] = {
+    cls.name: cls for cls in (NoControl, Stiff, SoftTorque, ZTorque)}
+
+
+def controller_class(name: str) -> type:
+    """The class of ``name``: a built-in (none, stiff, soft_torque, z_torque) or
+    ``package.module:Class`` importable from the working directory or ``PYTHONPATH``;
+    ParameterError naming the choices otherwise."""
+    if name in BUILTIN:
+        return BUILTIN[name]
+    module_name, sep, class_name = name.partition(":")
+    if not sep or not module_name or not class_name:
+        raise ParameterError(f"controller {name!r} is not one of {sorted(BUILTIN)} nor of "
+                             "the form package.module:Class")
+    if os.getcwd() not in sys.path:          # a user's module in the working directory
+        sys.path.append(os.getcwd())
+    try:
+        module = importlib.import_module(module_name)
+    except ImportError as exc:
+        raise ParameterError(f"controller {name!r}: cannot import {module_name!r} ({exc})"
+                             ) from exc
+    cls = getattr(module, class_name, None)
+    if not isinstance(cls, type):
+        raise ParameterError(f"controller {name!r}: {module_name!r} has no class "
+                             f"{class_name!r}")
+    return cls
+
+
+def make_controller(name: str, **kwargs: Any) -> Any:
+    """An instance of :func:`controller_class` ``(name)`` built with ``kwargs`` (rig,
+    schedule, mode, period_s, enable_at_s and its own parameters); it must have
+    ``reset()`` and ``update(measurement) -> Command``."""
+    cls = controller_class(name)
+    try:
+        controller = cls(**kwargs)
+    except TypeError as exc:
+        raise ParameterError(f"controller {name!r} cannot be built: {exc}") from exc
+    for method in ("reset", "update"):
+        if not callable(getattr(controller, method, None)):
+            raise ParameterError(f"controller {name!r} has no {method}() method")
+    return controller

@@ -1,0 +1,62 @@
+"""The rig's physics a controller is tuned from (SI, ROS-free).
+
+From a physical preset (RGD07 eq. 1 and the top drive of ``model.top_drive``):
+
+* C, the torsional stiffness of the drill pipe, G J_p / L (N m/rad);
+* I, the lumped inertia of eq. 1: BHA + a third of the pipe (kg m^2);
+* J, the top drive's inertia referred to the quill (kg m^2);
+* Z = J_p sqrt(G rho), the torsional characteristic impedance of the drill pipe (N m s/rad):
+  the torque a torsional wave carries per unit of angular speed, so a top end that turns at
+  -T/Z absorbs an arriving wave without reflection (the principle of the impedance-matching
+  soft-torque systems, Dwars 2015, SPE/IADC-173037-MS);
+* omega_1 = sqrt(C/I) = 1/t*, the string's first torsional mode on a fixed top (eq. 19).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from drill_sim_ros.model.errors import ParameterError
+from drill_sim_ros.model.params import structure
+from drill_sim_ros.model.presets import Preset
+
+
+@dataclass(frozen=True)
+class RigPhysics:
+    """What the tuning rules use, SI."""
+
+    stiffness_nm_rad: float          # C
+    bit_inertia_kg_m2: float         # I (eq. 1)
+    drive_inertia_kg_m2: float       # J
+    impedance_nm_s: float            # Z = J_p sqrt(G rho)
+    max_torque_nm: float             # the drive's motor torque limit (inf: none)
+    bit_area_m2: float               # pi a^2, for the specific energy
+    max_surface_rpm: float = 300.0   # sim_node's default limits.max_surface_rpm
+
+    @property
+    def first_mode_rad_s(self) -> float:
+        """omega_1 = sqrt(C / I), the torsional mode of the bit on the pipe (1/t*)."""
+        return math.sqrt(self.stiffness_nm_rad / self.bit_inertia_kg_m2)
+
+    @property
+    def lumped_impedance_nm_s(self) -> float:
+        """sqrt(C I): the damping coefficient at the top that damps the lumped mode with a
+        damping ratio of 1/2 (see ``SoftTorque``); for a uniform pipe alone it is Z."""
+        return math.sqrt(self.stiffness_nm_rad * self.bit_inertia_kg_m2)
+
+
+def rig_physics(preset: Preset) -> RigPhysics:
+    """The physics of a physical preset; ParameterError for a dimensionless one."""
+    phys = preset.physical
+    if phys is None:
+        raise ParameterError(f"preset '{preset.name}' is dimensionless; the controllers are "
+                             "tuned in SI and need a physical preset (e.g. field_8p5in_shale)")
+    s = structure(phys)
+    pipe_polar_m4 = 0.5 * math.pi * (phys.pipe_outer_radius_m**4 - phys.pipe_inner_radius_m**4)
+    drive = preset.top_drive.physical(preset.scales)
+    return RigPhysics(
+        stiffness_nm_rad=s.stiffness_nm_per_rad, bit_inertia_kg_m2=s.inertia_kg_m2,
+        drive_inertia_kg_m2=drive.inertia_kg_m2,
+        impedance_nm_s=pipe_polar_m4 * math.sqrt(phys.shear_modulus_pa * phys.density_kg_m3),
+        max_torque_nm=drive.max_torque_nm, bit_area_m2=math.pi * phys.bit_radius_m**2)

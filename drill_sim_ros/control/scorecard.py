@@ -1,0 +1,107 @@
+"""The scorecard of a closed-loop run: how much stick-slip is left, and at what cost.
+
+ROS-free; from telemetry rows (``TELEMETRY_FIELDS``, SI) of a run, after the switch-on:
+
+* SSI over whole 20 s windows (``model.analysis.stick_slip_index``, the one SSI:
+  (max - min) / (2 mean) of bit rpm), mean and max, that of the last window (settled), and
+  the mean before the switch-on;
+* stick fraction (share of samples with the bit stuck), UTR = (omega_0 - min) / omega_0
+  (``model.analysis.severity_of``, omega_0 the mean setpoint of the schedule);
+* time to suppress: from the switch-on to the last stuck sample (0 if none; None when the
+  bit still sticks in the last 20 s);
+* mean ROP (m/h); mechanical specific energy at the bit (Teale 1965: <WOB>/A +
+  <TOB omega_bit>/(A <ROP>), MPa);
+* peak and RMS string torque at the quill (N m), motor energy (the motor's work
+  sum tau_m omega_drive P, MJ), saturation count (samples at the motor torque limit or with
+  the speed setpoint at 0 or at the rpm limit).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from drill_sim_ros.control.rig import RigPhysics
+from drill_sim_ros.control.schedule import Schedule
+from drill_sim_ros.model import analysis
+from drill_sim_ros.model.params import RPM_PER_RAD_S
+from drill_sim_ros.model.telemetry import TELEMETRY_INDEX
+
+F = TELEMETRY_INDEX
+STUCK = 2
+WINDOW_S = 20.0
+SCORE_FIELDS = ("ssi_before_mean", "ssi_mean", "ssi_max", "ssi_last", "stick_fraction", "utr",
+                "time_to_suppress_s", "rop_m_h", "mse_mpa", "quill_torque_peak_nm",
+                "quill_torque_rms_nm", "motor_energy_mj", "saturation_count")
+
+
+def window_ssi(time_s: np.ndarray, bit_rpm: np.ndarray, start_s: float, end_s: float,
+               window_s: float = WINDOW_S) -> np.ndarray:
+    """SSI of each whole window [start + k w, start + (k + 1) w) within [start, end]; the
+    span itself when no whole window fits."""
+    count = math.floor((end_s - start_s) / window_s + 1e-9)
+    edges = [(start_s + k * window_s, start_s + (k + 1) * window_s) for k in range(count)]
+    edges = edges or [(start_s, end_s)]
+    lo, hi, mean = [], [], []
+    for a, b in edges:
+        part = bit_rpm[(time_s > a) & (time_s <= b + 1e-9)]
+        if part.size:
+            lo.append(part.min())
+            hi.append(part.max())
+            mean.append(part.mean())
+    return analysis.stick_slip_index(lo, hi, mean)
+
+
+def _mean(values: np.ndarray) -> float | None:
+    return float(np.mean(values)) if values.size and np.isfinite(values).all() else None
+
+
+def score(rows: np.ndarray, enable_at_s: float, schedule: Schedule, rig: RigPhysics,
+          period_s: float) -> dict[str, Any]:
+    """The scorecard of ``rows`` (see the module doc); None where a figure is undefined."""
+    rows = rows[rows[:, F["sim_time_s"]] > 0.0]          # the t = 0 sample is no period
+    t = rows[:, F["sim_time_s"]]
+    end_s = float(t[-1])
+    after = rows[t > enable_at_s]
+    ta = after[:, F["sim_time_s"]]
+    bit = after[:, F["bit_rpm"]]
+    stuck = after[:, F["mode"]] == STUCK
+    ssi = window_ssi(ta, bit, enable_at_s, end_s)
+    before = window_ssi(t, rows[:, F["bit_rpm"]], 0.0, enable_at_s) if enable_at_s >= \
+        WINDOW_S else np.array([])
+    omega0_rpm = float(np.mean([schedule.rpm_at(x) for x in ta]))
+    sev = analysis.severity_of(float(bit.min()), float(bit.max()), float(bit.mean()),
+                               omega0_rpm)
+    rop = after[:, F["rop_m_s"]]
+    quill = after[:, F["surface_torque_nm"]]
+    motor = after[:, F["motor_torque_nm"]]
+    drive_rad_s = after[:, F["surface_rpm"]] / RPM_PER_RAD_S
+    bit_power_w = after[:, F["tob_nm"]] * bit / RPM_PER_RAD_S
+    mse_pa = (after[:, F["wob_n"]].mean() + bit_power_w.mean() / rop.mean()) / rig.bit_area_m2 \
+        if rop.mean() > 0 else math.nan
+    setpoint = after[:, F["speed_setpoint_rpm"]]
+    saturated = (np.abs(motor) >= rig.max_torque_nm * (1 - 1e-9)) | (setpoint <= 0.0) | \
+        (setpoint >= rig.max_surface_rpm)
+    return {
+        "ssi_before_mean": _mean(before), "ssi_mean": _mean(ssi),
+        "ssi_max": float(np.max(ssi)) if np.isfinite(ssi).all() else None,
+        "ssi_last": float(ssi[-1]) if np.isfinite(ssi[-1]) else None,
+        "stick_fraction": float(stuck.mean()), "utr": sev.utr,
+        "time_to_suppress_s": _time_to_suppress(ta, stuck, enable_at_s, end_s),
+        "rop_m_h": float(rop.mean() * 3600.0),
+        "mse_mpa": mse_pa * 1e-6 if math.isfinite(mse_pa) else None,
+        "quill_torque_peak_nm": float(np.max(np.abs(quill))),
+        "quill_torque_rms_nm": float(np.sqrt(np.mean(quill**2))),
+        "motor_energy_mj": float(np.sum(motor * drive_rad_s) * period_s * 1e-6),
+        "saturation_count": int(saturated.sum()),
+    }
+
+
+def _time_to_suppress(t: np.ndarray, stuck: np.ndarray, enable_at_s: float,
+                      end_s: float) -> float | None:
+    if not stuck.any():
+        return 0.0
+    last_s = float(t[stuck][-1])
+    return None if last_s > end_s - WINDOW_S else last_s - enable_at_s

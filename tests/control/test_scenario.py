@@ -1,0 +1,47 @@
+"""Scenario files and setpoint schedules: by hand, round trip, errors that name the input."""
+
+from __future__ import annotations
+
+import pytest
+
+from drill_sim_ros.control.scenario import load_scenario, save_scenario, scenario_from_dict
+from drill_sim_ros.control.schedule import schedule_from_list
+from drill_sim_ros.model.errors import ParameterError
+
+
+def test_steps_and_ramps() -> None:
+    s = schedule_from_list([{"t_s": 0, "rpm": 50}, {"t_s": 10, "rpm": 70},
+                            {"t_s": 20, "rpm": 90, "ramp_s": 10}, {"t_s": 25, "wob_n": 1e3}],
+                           60.0, 5e4)
+    assert [s.rpm_at(t) for t in (0, 9.99, 10, 20, 25, 30, 99)] == \
+        pytest.approx([50, 50, 70, 70, 80, 90, 90])
+    assert s.wob_at(24.9) == 5e4 and s.wob_at(25) == 1e3
+
+
+def test_round_trip(tmp_path) -> None:
+    scenario = scenario_from_dict({"controller": "z_torque", "mode": "torque",
+                                   "duration_s": 30, "enable_at_s": 5,
+                                   "params": {"impedance_nm_s": 250.0},
+                                   "schedule": [{"t_s": 10, "rpm": 70, "ramp_s": 2}],
+                                   "sensors": {"seed": 4,
+                                               "string_torque_nm": {"noise_std": 10.0}}})
+    path = tmp_path / "s.yaml"
+    save_scenario(scenario, path)
+    assert load_scenario(path) == scenario
+    assert scenario.rig_sensors().seed == 4
+    assert scenario.periods == 3000
+
+
+@pytest.mark.parametrize(("data", "names"), [
+    ({"controler": "stiff"}, "controler"),
+    ({"duration_s": -1}, "duration_s"),
+    ({"duration_s": 10, "enable_at_s": 20}, "enable_at_s"),
+    ({"schedule": [{"t_s": 10, "rpm": 1}, {"t_s": 5, "rpm": 2}]}, "t_s"),
+    ({"schedule": [{"t_s": 0, "rpm": -3}]}, "rpm"),
+    ({"sensors": {"bit_rpm": {"noise_std": 1}}}, "bit_rpm"),
+])
+def test_errors_name_the_bad_input(data, names) -> None:
+    with pytest.raises(ParameterError, match=names):
+        scenario = scenario_from_dict(data)
+        scenario.setpoints(scenario.load_preset())
+        scenario.rig_sensors()
