@@ -8,7 +8,7 @@ lockstep_trigger:=command``), so both give the same telemetry bit for bit:
    (:func:`session_config`, :func:`sim_node_parameters`), and its t = 0 sample is taken
    (sim_node publishes it at start; the sensors' noise and delay lines see it);
 2. the controller's first command reacts to no measurement (the initial state, stamp 0);
-3. each command is applied with sim_node's limits (:func:`apply_command`: speed and WOB
+3. each command is applied with sim_node's limits (``control.command.apply_command``: speed and WOB
    within [0, limit], motor torque within +-the drive's limit) and stamped with the sample it
    reacts to; then exactly one period runs under it (zero-order hold), and the sample at the
    END of that period is what the controller reacts to next.
@@ -16,20 +16,18 @@ lockstep_trigger:=command``), so both give the same telemetry bit for bit:
 
 from __future__ import annotations
 
-import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
-from drill_sim_ros.control.command import Command, measurement_of_row
+from drill_sim_ros.control.command import CommandLimits, apply_command, measurement_of_row
 from drill_sim_ros.control.registry import make_controller
 from drill_sim_ros.control.rig import RigPhysics, rig_physics
 from drill_sim_ros.control.scenario import Scenario
 from drill_sim_ros.model.errors import ParameterError
 from drill_sim_ros.model.measurement import SIGNALS
-from drill_sim_ros.model.params import RPM_PER_RAD_S
 from drill_sim_ros.model.presets import Preset, submerged_string_weight_n
 from drill_sim_ros.model.session import SessionConfig, SimSession
 from drill_sim_ros.model.telemetry import N_FIELDS
@@ -39,18 +37,10 @@ PERTURB_V = 1e-3        # sim_node's model.perturb_v default
 WINDOW_S = 20.0         # sim_node's diagnostics.window_s default
 
 
-@dataclass(frozen=True)
-class Limits:
+def command_limits(preset: Preset, rig: RigPhysics) -> CommandLimits:
     """sim_node's command limits at their defaults (limits.*, top_drive.max_torque_nm)."""
-
-    max_surface_rpm: float
-    max_wob_n: float
-    max_torque_nm: float
-
-    @staticmethod
-    def of(preset: Preset, rig: RigPhysics) -> Limits:
-        wob_n = preset.scales.wob_n(preset.params.w0)
-        return Limits(rig.max_surface_rpm, max(10.0 * wob_n, 1.0), rig.max_torque_nm)
+    wob_n = preset.scales.wob_n(preset.params.w0)
+    return CommandLimits(rig.max_surface_rpm, max(10.0 * wob_n, 1.0), rig.max_torque_nm)
 
 
 @dataclass
@@ -95,27 +85,6 @@ def sim_node_parameters(scenario: Scenario, preset: Preset) -> dict[str, object]
     return out
 
 
-def clamp(value: float, low: float, high: float) -> float:
-    """sim_node's clamp_command: a finite command within [low, high]."""
-    if not math.isfinite(value):
-        raise ParameterError(f"the controller commanded {value!r}; commands must be finite")
-    return min(max(value, low), high)
-
-
-def apply_command(session: SimSession, command: Command, reacts_to_ns: int,
-                  limits: Limits) -> None:
-    """What sim_node does with a drill/cmd/top_drive message (``_on_top_drive``)."""
-    if command.speed_rad_s is not None:
-        session.set_surface_rpm(clamp(command.speed_rad_s * RPM_PER_RAD_S, 0.0,
-                                      limits.max_surface_rpm))
-    if command.motor_torque_nm is not None:
-        session.set_motor_torque_nm(clamp(command.motor_torque_nm, -limits.max_torque_nm,
-                                          limits.max_torque_nm))
-    if command.wob_n is not None:
-        session.set_wob_n(clamp(command.wob_n, 0.0, limits.max_wob_n))
-    session.command_stamp_ns = reacts_to_ns
-
-
 def build_controller(scenario: Scenario, preset: Preset) -> object:
     """The scenario's controller, tuned from the preset's physics."""
     return make_controller(scenario.controller, rig=rig_physics(preset),
@@ -130,7 +99,7 @@ def run_in_process(scenario: Scenario,
     preset = scenario.load_preset()
     rig = rig_physics(preset)
     controller = build_controller(scenario, preset)
-    limits = Limits.of(preset, rig)
+    limits = command_limits(preset, rig)
     session = SimSession(session_config(scenario, preset))
     periods = scenario.periods
     rows = np.empty((periods + 1, N_FIELDS))
@@ -138,7 +107,10 @@ def run_in_process(scenario: Scenario,
     start = time.perf_counter()
     command, stamp_ns = controller.update(None), 0
     for i in range(periods):
-        apply_command(session, command, stamp_ns, limits)
+        for applied, why in apply_command(session, command, limits):
+            if not applied:
+                raise ParameterError(f"the controller commanded {why}; commands must be finite")
+        session.command_stamp_ns = stamp_ns
         block = session.run(1)
         rows[i + 1] = block.rows[0]
         stamp_ns = int(block.stamps_ns[0])

@@ -7,10 +7,13 @@ answers with a :class:`Command`, the content of one ``drill/cmd/top_drive`` mess
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
+from drill_sim_ros.model.params import RPM_PER_RAD_S
+from drill_sim_ros.model.session import SimSession
 from drill_sim_ros.model.telemetry import TELEMETRY_INDEX
 
 F = TELEMETRY_INDEX
@@ -42,3 +45,57 @@ def measurement_of_row(row: np.ndarray, time_ns: int) -> SurfaceMeasurement:
                               drive_speed_rad_s=float(row[F["drive_speed_measured_rad_s"]]),
                               motor_torque_nm=float(row[F["motor_torque_measured_nm"]]),
                               string_torque_nm=float(row[F["string_torque_measured_nm"]]))
+
+
+@dataclass(frozen=True)
+class CommandLimits:
+    """The bounds a command is clamped to (sim_node's ``limits.*`` and
+    ``top_drive.max_torque_nm``; inf: none)."""
+
+    max_surface_rpm: float
+    max_wob_n: float
+    max_torque_nm: float = math.inf
+
+
+def clamp_command(value: float, limit: float, unit: str, low: float = 0.0
+                  ) -> tuple[float | None, str | None]:
+    """A setpoint command within [``low``, ``limit``]: (the value to apply, None) when it is
+    inside, (the bound it saturates at, why) when it is finite and beyond, (None, why) when
+    it is not finite (rejected)."""
+    if not math.isfinite(value):
+        return None, f"{value!r} is not finite"
+    if value < low:
+        return low, f"{value!r} {unit} is below {low!r} {unit}"
+    if value > limit:
+        return limit, f"{value!r} {unit} exceeds the limit {limit!r} {unit}"
+    return value, None
+
+
+def apply_command(session: SimSession, command: Command, limits: CommandLimits
+                  ) -> list[tuple[bool, str]]:
+    """Set what ``command`` commands on ``session`` (from its next period), each value
+    clamped to ``limits``; a non-finite value is not applied (the last setpoint stays).
+    Returns ``(applied, why)`` for each value that was clamped (applied) or rejected. The one
+    implementation behind sim_node's commands and the in-process bench."""
+    problems: list[tuple[bool, str]] = []
+
+    def bounded(value: float, high: float, unit: str, low: float = 0.0) -> float | None:
+        applied, why = clamp_command(value, high, unit, low)
+        if why is not None:
+            problems.append((applied is not None, why))
+        return applied
+
+    if command.speed_rad_s is not None:
+        rpm = bounded(command.speed_rad_s * RPM_PER_RAD_S, limits.max_surface_rpm, "rev/min")
+        if rpm is not None:
+            session.set_surface_rpm(rpm)
+    if command.motor_torque_nm is not None:
+        torque = bounded(command.motor_torque_nm, limits.max_torque_nm, "N m",
+                         -limits.max_torque_nm)
+        if torque is not None:
+            session.set_motor_torque_nm(torque)
+    if command.wob_n is not None:
+        wob = bounded(command.wob_n, limits.max_wob_n, "N")
+        if wob is not None:
+            session.set_wob_n(wob)
+    return problems

@@ -39,6 +39,7 @@ from std_msgs.msg import Float64, String
 from std_srvs.srv import SetBool, Trigger
 
 from drill_sim_ros import topics
+from drill_sim_ros.control.command import Command, CommandLimits, apply_command
 from drill_sim_ros.model.errors import DrillSimError, NumericalFault, ParameterError
 from drill_sim_ros.model.measurement import SIGNALS, RigSensors, SignalSpec
 from drill_sim_ros.model.params import RPM_PER_RAD_S
@@ -115,18 +116,9 @@ def rig_sensors(values: dict[str, Any]) -> RigSensors:
     return RigSensors(specs, seed=values["sensors.seed"])
 
 
-def clamp_command(value: float, limit: float, unit: str, low: float = 0.0
-                  ) -> tuple[float | None, str | None]:
-    """A setpoint command within [``low``, ``limit``]: (the value to apply, None) when it is
-    inside, (the bound it saturates at, why) when it is finite and beyond, (None, why) when
-    it is not finite (rejected)."""
-    if not math.isfinite(value):
-        return None, f"{value!r} is not finite"
-    if value < low:
-        return low, f"{value!r} {unit} is below {low!r} {unit}"
-    if value > limit:
-        return limit, f"{value!r} {unit} exceeds the limit {limit!r} {unit}"
-    return value, None
+# (joint, interface) of drill/cmd/top_drive -> the Command field it sets
+COMMAND_INTERFACES = {("top_drive", "velocity"): "speed_rad_s",
+                      ("top_drive", "effort"): "motor_torque_nm", ("hook", "effort"): "wob_n"}
 
 
 def joint_commands(msg: JointState) -> dict[tuple[str, str], float]:
@@ -358,15 +350,15 @@ class SimNode(Node):
 
     # ---- commands ----------------------------------------------------------------------
     def _on_surface_rpm(self, raw: bytes) -> None:
-        value = deserialize_message(raw, Float64).data
+        rpm = deserialize_message(raw, Float64).data
         with self._lock.urgent():
-            self._set_surface_rpm(topics.CMD_SURFACE_RPM, value)
+            self._apply(topics.CMD_SURFACE_RPM, Command(speed_rad_s=rpm / RPM_PER_RAD_S))
             self._record_command(topics.CMD_SURFACE_RPM, raw)
 
     def _on_wob(self, raw: bytes) -> None:
-        value = deserialize_message(raw, Float64).data
+        wob_n = deserialize_message(raw, Float64).data
         with self._lock.urgent():
-            self._set_wob_n(topics.CMD_WOB, value)
+            self._apply(topics.CMD_WOB, Command(wob_n=wob_n))
             self._record_command(topics.CMD_WOB, raw)
 
     def _on_top_drive(self, raw: bytes) -> None:
@@ -374,17 +366,14 @@ class SimNode(Node):
         advance exactly one period under it."""
         msg = deserialize_message(raw, JointState)
         topic = topics.CMD_TOP_DRIVE
+        values = joint_commands(msg)
+        for joint, interface in set(values) - set(COMMAND_INTERFACES):
+            self._reject(topic, f"joint {joint!r} takes no {interface} command "
+                                "(top_drive: velocity, effort; hook: effort)")
+        command = Command(**{name: values[key] for key, name in COMMAND_INTERFACES.items()
+                             if key in values})
         with self._lock.urgent():
-            for (joint, interface), value in joint_commands(msg).items():
-                if (joint, interface) == ("top_drive", "velocity"):
-                    self._set_surface_rpm(topic, value * RPM_PER_RAD_S)
-                elif (joint, interface) == ("top_drive", "effort"):
-                    self._set_motor_torque_nm(topic, value)
-                elif (joint, interface) == ("hook", "effort"):
-                    self._set_wob_n(topic, value)
-                else:
-                    self._reject(topic, f"joint {joint!r} takes no {interface} command "
-                                        "(top_drive: velocity, effort; hook: effort)")
+            self._apply(topic, command)
             self._session.command_stamp_ns = stamp_ns(msg.header.stamp)
             self._record_command(topic, raw)
             if self._command_steps():
@@ -395,40 +384,21 @@ class SimNode(Node):
         return (self._lockstep and self._values["lockstep_trigger"] == "command"
                 and self._fault is None and not self._closing)
 
-    def _set_surface_rpm(self, topic: str, rpm: float) -> None:
-        value = self._clamped(topic, rpm, "limits.max_surface_rpm", "rev/min")
-        if value is not None:
-            self._session.set_surface_rpm(value)
-
-    def _set_wob_n(self, topic: str, wob_n: float) -> None:
-        value = self._clamped(topic, wob_n, "limits.max_wob_n", "N")
-        if value is not None:
-            self._session.set_wob_n(value)
-
-    def _set_motor_torque_nm(self, topic: str, torque_nm: float) -> None:
-        """The torque mode's motor torque, within +-top_drive.max_torque_nm."""
-        limit = self._values["top_drive.max_torque_nm"] or math.inf
-        value = self._clamped(topic, torque_nm, limit, "N m", low=-limit)
-        if value is not None:
-            self._session.set_motor_torque_nm(value)
-
-    def _clamped(self, topic: str, value: float, limit: str | float, unit: str,
-                 low: float = 0.0) -> float | None:
-        """The setpoint to apply at the next step, clamped to [``low``, the limit] (counted
-        as saturated), or None for a non-finite one (rejected; the last setpoint stays)."""
-        high = self._values[limit] if isinstance(limit, str) else limit
-        applied, problem = clamp_command(value, high, unit, low)
-        if problem is None:
-            return applied
-        if applied is None:
-            self._reject(topic, problem)
-        else:
+    def _apply(self, topic: str, command: Command) -> None:
+        """``command`` from the next period, clamped to the limits (counted as saturated);
+        a non-finite value is rejected and the last setpoint stays (lock held)."""
+        limit_nm = self._values["top_drive.max_torque_nm"] or math.inf
+        limits = CommandLimits(self._values["limits.max_surface_rpm"],
+                               self._values["limits.max_wob_n"], limit_nm)
+        for applied, why in apply_command(self._session, command, limits):
+            if not applied:
+                self._reject(topic, why)
+                continue
             self.saturated_commands += 1
             self.get_logger().warning(
-                f"saturated {topic}: {problem}; applying {applied:.10g} {unit} "
+                f"saturated {topic}: {why}; applying the limit "
                 f"({self.saturated_commands} saturated so far)",
                 throttle_duration_sec=WARN_THROTTLE_S)
-        return applied
 
     def _reject(self, topic: str, problem: str) -> None:
         self.rejected_commands += 1

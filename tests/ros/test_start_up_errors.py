@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import pytest
 
+from drill_sim_ros.control.command import clamp_command
 from drill_sim_ros.model.errors import ParameterError
 from drill_sim_ros.ros.parameters import check_params_files, recording_options, yaml_defaults
-from drill_sim_ros.ros.sim_node import clamp_command
 
 
 def test_a_saturated_command_shows_its_value_exactly() -> None:
