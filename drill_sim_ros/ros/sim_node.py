@@ -319,15 +319,20 @@ class SimNode(Node):
         """Simulate ``periods`` and hand the block to the sinks; False on a numerical fault
         (call with the lock held)."""
         try:
-            if self._initial_pending:          # the state at t = 0, what a controller first
-                self._initial_pending = False  # reacts to, just before the first period
-                self._emit(self._session.current())
+            self._emit_initial()
             block = self._session.run(periods)
         except NumericalFault as exc:
             self._on_fault(exc)
             return False
         self._emit(block)
         return True
+
+    def _emit_initial(self) -> None:
+        """The state at t = 0, what a controller first reacts to, once: just before the first
+        period or the first command, whichever comes first (lock held)."""
+        if self._initial_pending:
+            self._initial_pending = False
+            self._emit(self._session.current())
 
     def _emit(self, block: Block) -> None:
         """Hand ``block`` to the sinks (call with the lock held)."""
@@ -387,6 +392,7 @@ class SimNode(Node):
     def _apply(self, topic: str, command: Command) -> None:
         """``command`` from the next period, clamped to the limits (counted as saturated);
         a non-finite value is rejected and the last setpoint stays (lock held)."""
+        self._emit_initial()                 # t = 0 is the state before any command
         limit_nm = self._values["top_drive.max_torque_nm"] or math.inf
         limits = CommandLimits(self._values["limits.max_surface_rpm"],
                                self._values["limits.max_wob_n"], limit_nm)
