@@ -27,6 +27,7 @@ from rclpy.utilities import remove_ros_args
 from std_msgs.msg import Float64MultiArray, String
 
 from drill_sim_ros import topics
+from drill_sim_ros.archive.output import OutputError, check_output
 from drill_sim_ros.model.presets import DEFAULT_PRESET
 from drill_sim_ros.ros.messages import RUN_INFO_QOS
 from drill_sim_ros.viz.analytics_off import disable_analytics
@@ -137,6 +138,8 @@ class RerunBridge(Node):
 def parse_args(argv: list[str]) -> argparse.Namespace:
     parser = argparse.ArgumentParser(prog="rerun_bridge", description=__doc__.splitlines()[0])
     parser.add_argument("--save", metavar="FILE.rrd", help="write the recording to this file")
+    parser.add_argument("--overwrite", action="store_true",
+                        help="replace an existing --save file (default: refuse)")
     parser.add_argument("--connect", metavar="URL", nargs="?", const=DEFAULT_VIEWER_URL,
                         help=f"stream to a viewer (default URL {DEFAULT_VIEWER_URL})")
     parser.add_argument("--serve", action="store_true",
@@ -189,11 +192,17 @@ class StartError(Exception):
 
 
 def check_sinks(args: argparse.Namespace, logger: Any) -> None:
-    """Refuse a busy --serve port; drop (or refuse) a --connect with no viewer listening.
+    """Refuse an existing --save file (unless --overwrite) and a busy --serve port; drop (or
+    refuse) a --connect with no viewer listening.
 
     rerun buffers everything for a viewer that is not there yet (about 21 MB a minute at the
     sim's rate), so the bridge never streams to an address where nothing listens.
     """
+    if args.save:
+        try:
+            check_output(args.save, args.overwrite)
+        except OutputError as exc:
+            raise StartError(f"--save: {exc}") from None
     if args.serve and (busy := port_free(args.serve_port)) is not None:
         raise StartError(f"--serve-port {args.serve_port}: cannot listen on 127.0.0.1 "
                          f"({busy})")

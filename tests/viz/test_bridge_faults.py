@@ -73,3 +73,13 @@ def test_no_viewer_beside_save_warns_and_the_signal_finishes_the_rrd(tmp_path, s
     assert code == 0, bridge.output()
     assert bridge.output().count("no viewer listening") == 1
     assert len(read_recording(rrd)["/timeseries/rop/bit"].time_ns) == len(rows)
+
+
+def test_an_existing_save_file_is_refused_unless_overwrite(tmp_path) -> None:
+    kept = tmp_path / "kept.rrd"
+    kept.write_bytes(b"an earlier run")
+    done = _bridge("--save", str(kept))
+    assert done.returncode == 2 and "Traceback" not in done.stderr
+    lines = [line for line in (done.stdout + done.stderr).splitlines() if line.strip()]
+    assert len(lines) == 1 and "exists" in lines[0] and "--overwrite" in lines[0], lines
+    assert kept.read_bytes() == b"an earlier run"
