@@ -10,6 +10,9 @@ from __future__ import annotations
 
 from typing import Any
 
+# What the graph gives as the node name of an endpoint discovered before its node.
+UNKNOWN = "_NODE_NAME_UNKNOWN_"
+
 
 class ForeignCommandTypes:
     """Remembers which (topic, type) pairs were already reported."""
@@ -26,6 +29,8 @@ class ForeignCommandTypes:
                 key = (topic, info.topic_type)
                 if info.topic_type == wanted or key in self._reported:
                     continue
+                if not info.node_name or info.node_name.startswith(UNKNOWN):
+                    continue                # discovered before its node: name it next time
                 self._reported.add(key)
                 reasons.append(f"{info.node_namespace.rstrip('/')}/{info.node_name} publishes "
                                f"{info.topic_type} on {topic}; the sim takes only {wanted}, so "
