@@ -56,7 +56,8 @@ class Maps:
         if path.exists():
             attrs = store.load(path).attrs
             if (attrs.get("spec_json") != spec.to_json()
-                    or attrs.get("model_fingerprint") != store.model_fingerprint()):
+                    or attrs.get("model_fingerprint")
+                    != store.model_fingerprint(spec.control is not None)):
                 path.unlink()              # the figure or the model changed: start afresh
         bar = MapProgress(self.progress)
         try:
