@@ -51,6 +51,10 @@ class ClosedLoopRun:
     rows: np.ndarray
     wall_s: float
     clamped_commands: int = 0
+    # the kernel's running statistics (``kernel.A_*``) at the end, and after period
+    # ``snapshot_after`` when asked (differences of the sums are window sums)
+    accumulators: np.ndarray | None = None
+    snapshot: np.ndarray | None = None
 
 
 def drive_of(preset: Preset, mode: str) -> TopDrivePhysical:
@@ -94,8 +98,11 @@ def build_controller(scenario: Scenario, preset: Preset) -> object:
 
 
 def run_in_process(scenario: Scenario,
-                   progress: Callable[[int, int], None] | None = None) -> ClosedLoopRun:
-    """Run ``scenario``: its telemetry, the t = 0 sample first (see the module doc)."""
+                   progress: Callable[[int, int], None] | None = None,
+                   snapshot_after: int | None = None) -> ClosedLoopRun:
+    """Run ``scenario``: its telemetry, the t = 0 sample first (see the module doc); the
+    kernel's accumulators at the end and, if ``snapshot_after`` is given, after that many
+    periods (0: before the first)."""
     preset = scenario.load_preset()
     rig = rig_physics(preset)
     controller = build_controller(scenario, preset)
@@ -106,6 +113,7 @@ def run_in_process(scenario: Scenario,
     rows[0] = session.current().rows[0]
     start = time.perf_counter()
     command, stamp_ns = controller.update(None), 0
+    snapshot = session.sim.accumulators if snapshot_after == 0 else None
     for i in range(periods):
         for applied, why in apply_command(session, command, limits):
             if not applied:
@@ -114,9 +122,12 @@ def run_in_process(scenario: Scenario,
         block = session.run(1)
         rows[i + 1] = block.rows[0]
         stamp_ns = int(block.stamps_ns[0])
+        if snapshot_after == i + 1:
+            snapshot = session.sim.accumulators
         if i + 1 < periods:
             command = controller.update(measurement_of_row(block.rows[0], stamp_ns))
         if progress is not None and (i + 1) % 1000 == 0:
             progress(i + 1, periods)
     wall_s = time.perf_counter() - start
-    return ClosedLoopRun(scenario, rows, wall_s, int(getattr(controller, "clamped_commands", 0)))
+    return ClosedLoopRun(scenario, rows, wall_s, int(getattr(controller, "clamped_commands", 0)),
+                         session.sim.accumulators, snapshot)

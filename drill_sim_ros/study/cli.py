@@ -15,10 +15,6 @@ from drill_sim_ros.study.progress import MapProgress
 if TYPE_CHECKING:
     from drill_sim_ros.study.grid import MapSpec
 
-CONTROLLERS_MISSING = ("--controller: closed-loop controllers are not available yet "
-                       "(no controller is implemented in this version); run the map without it")
-
-
 def add_parsers(sub: Any, add_model_args: Callable[[argparse.ArgumentParser], None]) -> None:
     """The three sub-commands on the ``drill_sim`` sub-parser ``sub``."""
     m = sub.add_parser("map", help="regime map over a grid of parameters (Dask), to NetCDF")
@@ -35,8 +31,15 @@ def add_parsers(sub: Any, add_model_args: Callable[[argparse.ArgumentParser], No
                    help="local worker processes (default: one per core)")
     m.add_argument("--batch", type=int, default=None, help="points per task (default: "
                    "about 8 tasks per worker, at most 64 points)")
-    m.add_argument("--controller", default=None, help="closed-loop controller (not "
-                   "available yet)")
+    c = m.add_argument_group("closed loop (physical presets; axes surface_rpm and wob_n)")
+    c.add_argument("--controller", default=None, help="run every point closed-loop with this "
+                   "controller in process (none | stiff | soft_torque | z_torque | "
+                   "package.module:Class); default: the open-loop model")
+    c.add_argument("--mode", choices=("speed", "torque"), default="speed",
+                   help="the controller sends the speed setpoint or the motor torque "
+                        "(default speed)")
+    c.add_argument("--enable-at", type=float, default=0.0, metavar="S",
+                   help="switch-on time of the controller, s (default 0)")
     p = sub.add_parser("map-plot", help="draw a map file (regime map or one variable)")
     p.add_argument("map", type=Path, help="NetCDF file written by drill_sim map")
     p.add_argument("-o", "--output", type=Path, default=None, help="PNG (default: MAP.png)")
@@ -59,19 +62,23 @@ def map_spec_from(args: argparse.Namespace,
                   resolve: Callable[[argparse.Namespace], Any]) -> MapSpec:
     """A :class:`MapSpec` from the ``map`` options; ``resolve`` is ``drill_sim run``'s."""
     from drill_sim_ros.model.presets import load_preset
-    from drill_sim_ros.study.grid import MapSpec, Numerics, parse_vary
+    from drill_sim_ros.study.grid import Control, MapSpec, Numerics, parse_vary
+    control = None
+    if args.controller is not None:
+        from drill_sim_ros.control.registry import controller_class
+        controller_class(args.controller)            # a bad name fails here, in one line
+        control = Control(args.controller, args.mode, args.enable_at)
     run = resolve(args)
     num = Numerics(tau_end=run.tau_end, average_from=run.average_from, dtau=run.dtau,
                    n_nodes=run.n_nodes, method=run.method, perturb_v=run.perturb_v,
                    perturb_omega=run.perturb_omega)
     name = load_preset(args.params).name if args.params else ""
     return MapSpec(run.params, tuple(parse_vary(v) for v in args.vary), num,
-                   scales=run.scales if run.physical else None, preset=name)
+                   scales=run.scales if run.physical else None, preset=name,
+                   control=control)
 
 
 def cmd_map(args: argparse.Namespace, resolve: Callable[[argparse.Namespace], Any]) -> int:
-    if args.controller is not None:
-        raise DrillSimError(CONTROLLERS_MISSING)
     if args.batch is not None and not 1 <= args.batch <= 100_000:
         raise DrillSimError(f"--batch = {args.batch} must be in [1, 100000]")
     from drill_sim_ros.study import engine

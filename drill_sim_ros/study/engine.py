@@ -64,9 +64,17 @@ def evaluate_batch(spec: MapSpec, indices: np.ndarray) -> BatchResult:
     t0 = time.perf_counter()
     values = np.empty((len(indices), N_VARS))
     for row, flat in enumerate(indices):
-        values[row] = evaluate_point(spec.point(int(flat)), spec.numerics)
+        values[row] = evaluate_spec_point(spec, int(flat))
     return BatchResult(np.asarray(indices), values, os.getpid(), cold,
                        time.perf_counter() - t0)
+
+
+def evaluate_spec_point(spec: MapSpec, flat: int) -> np.ndarray:
+    """Point ``flat`` of ``spec``: open loop, or closed loop when the map has a controller."""
+    if spec.control is not None:
+        from drill_sim_ros.study.closed_loop import evaluate_closed_point
+        return evaluate_closed_point(spec, flat)
+    return evaluate_point(spec.point(flat), spec.numerics)
 
 
 def warm_up() -> int:

@@ -65,6 +65,22 @@ class Numerics:
 
 
 @dataclass(frozen=True)
+class Control:
+    """A controller in the loop of every point (``drill_sim map --controller``): the
+    closed-loop bench of :mod:`drill_sim_ros.control.bench`, switched on at ``enable_at_s``."""
+
+    controller: str
+    mode: str = "speed"
+    enable_at_s: float = 0.0
+
+    def __post_init__(self) -> None:
+        if self.mode not in ("speed", "torque"):
+            raise ParameterError(f"--mode {self.mode!r} must be speed or torque")
+        if not (math.isfinite(self.enable_at_s) and self.enable_at_s >= 0.0):
+            raise ParameterError(f"--enable-at = {self.enable_at_s!r} must be a number >= 0 s")
+
+
+@dataclass(frozen=True)
 class MapSpec:
     """A grid of runs: ``base`` with the ``axes`` varied, each point run with ``numerics``."""
 
@@ -73,9 +89,12 @@ class MapSpec:
     numerics: Numerics = field(default_factory=Numerics)
     scales: Scales | None = None       # set for physical presets (SI axes allowed)
     preset: str = ""
+    control: Control | None = None     # None: the open-loop model (constant surface speed)
 
     def __post_init__(self) -> None:
         validate_axes(self.axes, physical=self.scales is not None)
+        if self.control is not None:
+            validate_control(self)
         if self.size > MAX_POINTS:
             raise ParameterError(f"the map has {self.size} points; at most {MAX_POINTS}")
 
@@ -99,7 +118,9 @@ class MapSpec:
                            "axes": [[a.name, list(a.values)] for a in self.axes],
                            "numerics": asdict(self.numerics),
                            "scales": None if self.scales is None else asdict(self.scales),
-                           "preset": self.preset}, sort_keys=True)
+                           "preset": self.preset,
+                           **({} if self.control is None else
+                              {"control": asdict(self.control)})}, sort_keys=True)
 
 
 def validate_axes(axes: tuple[Axis, ...], physical: bool) -> None:
@@ -122,6 +143,29 @@ def validate_axes(axes: tuple[Axis, ...], physical: bool) -> None:
                                  "vary only one of them")
     if len(set(names)) != len(names):
         raise ParameterError(f"--vary names a quantity twice: {names}")
+
+
+def validate_control(spec: MapSpec) -> None:
+    """A controlled map runs the bench on a physical preset as it is, at each point's surface
+    rpm and WOB: only those two axes, within the run."""
+    if spec.scales is None or not spec.preset:
+        raise ParameterError("--controller needs a physical preset (--params, e.g. "
+                             "field_8p5in_shale): the controllers are tuned in SI")
+    other = [a.name for a in spec.axes if a.name not in PHYSICAL_AXES]
+    if other:
+        raise ParameterError(f"--controller: --vary {', '.join(other)} is not a surface input; "
+                             f"a controlled map varies only {' and '.join(PHYSICAL_AXES)}")
+    from drill_sim_ros.model.presets import load_preset
+    preset = load_preset(spec.preset).params
+    changed = [g for g in GROUPS if g not in ("w0", "omega0")
+               and getattr(spec.base, g) != getattr(preset, g)]
+    if changed:
+        raise ParameterError(f"--controller runs the preset {spec.preset} as it is: "
+                             f"{', '.join(changed)} cannot be changed (only rpm and WOB)")
+    end_s = spec.numerics.tau_end * spec.scales.time_s
+    if spec.control.enable_at_s > end_s:
+        raise ParameterError(f"--enable-at = {spec.control.enable_at_s:g} s must lie in "
+                             f"[0, the run's {end_s:g} s]")
 
 
 def point_params(base: DimensionlessParams, values: dict[str, float],

@@ -75,11 +75,13 @@ def _label_cell(mask: np.ndarray) -> tuple[int, int]:
 
 
 def draw_variable(ax: plt.Axes, da: xr.DataArray, levels: int = 6, cmap: str = "viridis",
-                  label: str | None = None) -> None:
-    """One variable in colour, with labelled contours."""
+                  label: str | None = None, vmin: float | None = None,
+                  vmax: float | None = None) -> None:
+    """One variable in colour (limits ``vmin``, ``vmax``: default the data's), with
+    labelled contours."""
     y, x = da.dims
     xs, ys, values = da[x].values, da[y].values, da.values
-    mesh = ax.pcolormesh(xs, ys, values, shading="nearest", cmap=cmap)
+    mesh = ax.pcolormesh(xs, ys, values, shading="nearest", cmap=cmap, vmin=vmin, vmax=vmax)
     plt.colorbar(mesh, ax=ax, label=label or _var_label(str(da.name)))
     if np.isfinite(values).sum() >= 4 and np.nanmax(values) > np.nanmin(values):
         cs = ax.contour(xs, ys, values, levels=levels, colors="k", linewidths=0.6)

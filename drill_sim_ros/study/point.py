@@ -45,6 +45,7 @@ VARIABLES: dict[str, tuple[str, str]] = {
     "bounce_tau": ("t*", "time the bit first left the rock (NaN: never)"),
     "torsional_period": ("t*", "period of the bit-speed cycle in the window (NaN: < 2 cycles)"),
     "axial_amplitude": ("L*/t*", "half the range of the axial velocity in the window"),
+    "rop_m_h": ("m/h", "mean rate of penetration (controlled maps; NaN in open-loop maps)"),
 }
 N_VARS = len(VARIABLES)
 COLUMN = {name: i for i, name in enumerate(VARIABLES)}
@@ -89,7 +90,6 @@ def _figures(p: DimensionlessParams, num: Numerics, acc: np.ndarray, tau: np.nda
     stick, bounce = analysis.first_event_tau(acc)
     delta0 = analysis.trivial_solution(p).depth_of_cut
     amplitude = 0.5 * float(v.max() - v.min()) if v.size else math.nan
-    out = np.full(N_VARS, math.nan)
     values = {
         "kappa": avg.kappa,
         "kappa_from_depth": analysis.kappa_from_depth(avg.mean_depth_of_cut, delta0, p.lam),
@@ -104,11 +104,16 @@ def _figures(p: DimensionlessParams, num: Numerics, acc: np.ndarray, tau: np.nda
         "torsional_period": torsional_period(tau, omega),
         "axial_amplitude": amplitude,
     }
+    values["regime"] = classify(avg.stick_fraction, values["bounce_tau"], avg.kappa,
+                                amplitude, num.perturb_v, trivial_kappa(p.w0, p.lam))
+    return row_of(values)
+
+
+def row_of(values: dict[str, float]) -> np.ndarray:
+    """A row in :data:`VARIABLES` order; NaN for the variables not in ``values``."""
+    out = np.full(N_VARS, math.nan)
     for name, value in values.items():
         out[COLUMN[name]] = value
-    out[COLUMN["regime"]] = classify(avg.stick_fraction, out[COLUMN["bounce_tau"]],
-                                     avg.kappa, amplitude, num.perturb_v,
-                                     trivial_kappa(p.w0, p.lam))
     return out
 
 

@@ -30,13 +30,27 @@ ENGINE = "h5netcdf"
 # resumed (the figures would mix two models).
 _MODEL_SOURCES = ("model/kernel.py", "model/simulator.py", "model/analysis.py",
                   "study/point.py", "study/regime.py", "study/grid.py")
+# and, for a controlled map, the bench, the controllers and the session they step
+_CONTROL_SOURCES = ("study/closed_loop.py", "model/session.py", "model/top_drive.py",
+                    "model/telemetry.py", "control/bench.py", "control/command.py",
+                    "control/controllers.py", "control/registry.py", "control/rig.py",
+                    "control/scenario.py", "control/schedule.py", "control/scorecard.py")
+# what a controlled map leaves undefined, and what it computes otherwise (attributes)
+CONTROLLED_NOTE = ("closed loop (control/bench.py run_in_process at each point's rpm and WOB; "
+                   "the bench's numerics, not --dtau/--nodes/--perturb-v): ssi, utr, "
+                   "stick_fraction, rop_m_h from the scorecard over the window (ssi: mean of "
+                   "whole 20 s windows; stick_fraction: share of 10 ms samples); kappa, eta "
+                   "and the means from the kernel's sums over the window; omega_min/max, "
+                   "torsional_period, axial_amplitude from the 10 ms telemetry; every "
+                   "variable is defined")
+OPEN_LOOP_NOTE = "open loop (constant surface speed): rop_m_h is not computed (NaN)"
 
 
-def model_fingerprint() -> str:
-    """Short SHA-256 of the model and per-point sources."""
+def model_fingerprint(controlled: bool = False) -> str:
+    """Short SHA-256 of the model and per-point sources (and the closed loop's)."""
     root = Path(__file__).resolve().parents[1]
     digest = hashlib.sha256()
-    for name in _MODEL_SOURCES:
+    for name in _MODEL_SOURCES + (_CONTROL_SOURCES if controlled else ()):
         digest.update((root / name).read_bytes())
     return digest.hexdigest()[:16]
 
@@ -55,7 +69,7 @@ def new_dataset(spec: MapSpec) -> xr.Dataset:
     attrs = {
         "title": "drill_sim regime map (Richard, Germay & Detournay 2007 model)",
         "spec_json": spec.to_json(), "preset": spec.preset,
-        "model_fingerprint": model_fingerprint(),
+        "model_fingerprint": model_fingerprint(spec.control is not None),
         "package": "drill_sim_ros", "package_version": __version__,
         "created_utc": datetime.now(UTC).isoformat(timespec="seconds"),
         "tau_end": num.tau_end, "average_from": num.average_from, "dtau": num.dtau,
@@ -65,7 +79,11 @@ def new_dataset(spec: MapSpec) -> xr.Dataset:
         "base_params": json.dumps({g: getattr(spec.base, g) for g in
                                    ("n", "psi", "beta", "lam", "w0", "omega0")}),
         "averages": "time averages over [average_from, tau_end], stick phases included",
+        "controller": "" if spec.control is None else spec.control.controller,
+        "loop": OPEN_LOOP_NOTE if spec.control is None else CONTROLLED_NOTE,
     }
+    if spec.control is not None:
+        attrs.update(control_mode=spec.control.mode, enable_at_s=spec.control.enable_at_s)
     if spec.scales is not None:
         attrs.update(t_star_s=spec.scales.time_s, l_star_m=spec.scales.length_m,
                      force_unit_n=spec.scales.force_n, torque_unit_nm=spec.scales.torque_nm)
@@ -91,7 +109,7 @@ def open_map(spec: MapSpec, path: Path) -> xr.Dataset:
     if ds.attrs.get("spec_json") != spec.to_json():
         raise DrillSimError(f"--out {path} holds a different map (other axes, base case or "
                             "numerics); choose another --out or delete the file")
-    if ds.attrs.get("model_fingerprint") != model_fingerprint():
+    if ds.attrs.get("model_fingerprint") != model_fingerprint(spec.control is not None):
         raise DrillSimError(f"--out {path} was computed by another version of the model "
                             "code; choose another --out or delete the file")
     return ds

@@ -36,10 +36,22 @@ def test_two_weight_axes_refused(tmp_path: Path) -> None:
                               "--out", str(tmp_path / "m.nc")), "w0", "w0_ratio")
 
 
-def test_controller_not_available_yet(tmp_path: Path) -> None:
+def test_controller_needs_a_physical_preset(tmp_path: Path) -> None:
     _one_line_error(drill_sim("map", "--vary", "w0=7:8:2", "--controller", "soft_torque",
                               "--out", str(tmp_path / "m.nc")), "--controller",
-                    "not available yet")
+                    "physical preset")
+
+
+def test_controller_refuses_dimensionless_axes(tmp_path: Path) -> None:
+    _one_line_error(drill_sim("map", "--params", "field_8p5in_shale", "--vary", "psi=50:60:2",
+                              "--controller", "soft_torque", "--out", str(tmp_path / "m.nc")),
+                    "--controller", "psi", "surface_rpm")
+
+
+def test_controller_unknown_name(tmp_path: Path) -> None:
+    _one_line_error(drill_sim("map", "--params", "field_8p5in_shale", "--vary",
+                              "surface_rpm=40:80:2", "--controller", "softer",
+                              "--out", str(tmp_path / "m.nc")), "softer", "soft_torque")
 
 
 def test_map_plot_draws_regimes_and_variables(tmp_path: Path) -> None:
