@@ -298,9 +298,26 @@ def check_params_files(args: list[str]) -> None:
                                  f"{' '.join(str(exc).split())}") from None
 
 
+def check_parameter_rules(args: list[str]) -> None:
+    """Each ``-p`` / ``--param`` after ``--ros-args`` must be ``NAME:=VALUE`` (one
+    ParameterError line if not), checked before rcl, which would log its own error first."""
+    if "--ros-args" not in args:
+        return
+    rest = args[args.index("--ros-args") + 1:]
+    for i, flag in enumerate(rest):
+        if flag not in ("-p", "--param"):
+            continue
+        rule = rest[i + 1] if i + 1 < len(rest) else ""
+        name, sep, _ = rule.partition(":=")
+        if not sep or not name.strip():
+            raise ParameterError(f"{flag} {rule!r}: a parameter override is NAME:=VALUE, "
+                                 "e.g. -p real_time_factor:=2.0")
+
+
 def init_ros(args: list[str] | None = None) -> None:
     """``rclpy.init``; an unparsable ``--ros-args`` or params file raises one ParameterError."""
     check_params_files(sys.argv if args is None else args)
+    check_parameter_rules(sys.argv if args is None else args)
     try:
         rclpy.init(args=args)
     except RCLError as exc:

@@ -65,6 +65,8 @@ def test_an_unwritable_record_path_stops_the_node_at_start(tmp_path) -> None:
     (["-p", "model.dtau:=fast"], ["model.dtau", "a number"]),
     (["-p", "model.preset:=no_such_preset"], ["no_such_preset"]),
     (["--params-file", "/nonexistent/sim.yaml"], ["/nonexistent/sim.yaml", "No such file"]),
+    (["-p", "foo"], ["'foo'", "NAME:=VALUE"]),
+    (["-p", "top_drive.mode:=fast"], ["top_drive.mode", "kinematic, speed, torque"]),
 ])
 def test_bad_start_up_input_is_one_fatal_line(args, names) -> None:
     line = _one_fatal_line(_sim(*args))

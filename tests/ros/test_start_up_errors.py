@@ -6,7 +6,12 @@ import pytest
 
 from drill_sim_ros.control.command import clamp_command
 from drill_sim_ros.model.errors import ParameterError
-from drill_sim_ros.ros.parameters import check_params_files, recording_options, yaml_defaults
+from drill_sim_ros.ros.parameters import (
+    check_parameter_rules,
+    check_params_files,
+    recording_options,
+    yaml_defaults,
+)
 
 
 def test_a_saturated_command_shows_its_value_exactly() -> None:
@@ -35,3 +40,13 @@ def test_params_files_are_checked_before_rcl(tmp_path) -> None:
     bad.write_text("a: [1,\n")
     with pytest.raises(ParameterError, match="not valid YAML"):
         check_params_files(["--ros-args", "--params-file", str(bad)])
+
+
+def test_malformed_parameter_overrides_are_one_line_before_rcl() -> None:
+    check_parameter_rules(["sim_node", "--ros-args", "-p", "lockstep:=true",
+                           "--param", "model.preset:=fig5_8a"])
+    check_parameter_rules(["sim_node", "-p", "foo"])          # not ROS arguments: rcl's own
+    for args in (["--ros-args", "-p", "foo"], ["--ros-args", "-p", ":=3"],
+                 ["--ros-args", "--param"]):
+        with pytest.raises(ParameterError, match="NAME:=VALUE"):
+            check_parameter_rules(args)
