@@ -13,7 +13,6 @@ from __future__ import annotations
 import argparse
 import os
 import random
-import signal
 import subprocess
 import sys
 import time
@@ -26,6 +25,7 @@ os.environ.setdefault("AMENT_PREFIX_PATH", sys.prefix)
 
 import numpy as np
 import rclpy
+from bench_node import stop  # the sibling script (benchmarks/ is on sys.path when run)
 from rclpy.executors import SingleThreadedExecutor
 
 from drill_sim_ros import topics
@@ -72,12 +72,7 @@ def one_run(periods: int) -> tuple[float, list[bytes]]:
         executor.remove_node(driver)
         driver.destroy_node()
         rclpy.try_shutdown(context=context)
-        sim.send_signal(signal.SIGINT)
-        try:
-            sim.wait(timeout=15)
-        except subprocess.TimeoutExpired:
-            sim.kill()
-            sim.wait()
+        stop(sim)
 
 
 def main() -> None:
