@@ -96,3 +96,17 @@ def statistics_counts(path: Path) -> collections.Counter:
     return collections.Counter(
         {topic[cid]: n for cid, n in stats.channel_message_counts.items()}
     )
+
+
+def write_float64_run(path: Path, topic: str, count: int, period_ns: int = 1_000_000) -> Path:
+    """``count`` std_msgs/Float64 messages 0, 1, ... on ``topic``, one per ``period_ns`` of log
+    time, through the archive's writer (1 kHz: one 0.5 s chunk per 500 messages)."""
+    from rclpy.serialization import serialize_message
+    from std_msgs.msg import Float64
+
+    from drill_sim_ros.archive.writer import Ros2McapWriter
+    with Ros2McapWriter(str(path)) as writer:
+        channel = writer.add_channel(topic, "std_msgs/msg/Float64")
+        for i in range(count):
+            writer.write(channel, serialize_message(Float64(data=float(i))), i * period_ns)
+    return path

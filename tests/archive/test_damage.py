@@ -10,13 +10,12 @@ import subprocess
 import pytest
 from mcap.reader import make_reader
 from mcap.writer import Writer
-from rclpy.serialization import deserialize_message, serialize_message
+from rclpy.serialization import deserialize_message
 from std_msgs.msg import Float64
 
 from drill_sim_ros.archive.reader import ArchiveReader
 from drill_sim_ros.archive.reindex import reindex
-from drill_sim_ros.archive.writer import Ros2McapWriter
-from tests.archive.helpers import BIN, counts_mcap_ros2, counts_rosbags
+from tests.archive.helpers import BIN, counts_mcap_ros2, counts_rosbags, write_float64_run
 
 MS = 1_000_000
 TOPIC = "/drill/bit/wob"
@@ -26,12 +25,7 @@ DAMAGED_CHUNK = 10
 
 @pytest.fixture
 def recording(tmp_path):
-    path = tmp_path / "run.mcap"
-    with Ros2McapWriter(str(path)) as writer:
-        channel = writer.add_channel(TOPIC, "std_msgs/msg/Float64")
-        for i in range(COUNT):
-            writer.write(channel, serialize_message(Float64(data=float(i))), i * MS)
-    return path
+    return write_float64_run(tmp_path / "run.mcap", TOPIC, COUNT, MS)
 
 
 def _chunks(path):

@@ -7,14 +7,18 @@ import random
 import subprocess
 
 import pytest
-from rclpy.serialization import serialize_message
 from std_msgs.msg import Float64
 
 from drill_sim_ros.archive.errors import ArchiveNotFoundError, NotAnArchiveError
 from drill_sim_ros.archive.reader import ArchiveReader
 from drill_sim_ros.archive.reindex import reindex
-from drill_sim_ros.archive.writer import Ros2McapWriter
-from tests.archive.helpers import BIN, counts_mcap_ros2, counts_rosbags, statistics_counts
+from tests.archive.helpers import (
+    BIN,
+    counts_mcap_ros2,
+    counts_rosbags,
+    statistics_counts,
+    write_float64_run,
+)
 
 MS = 1_000_000
 TOPIC = "/drill/bit/wob"
@@ -23,12 +27,7 @@ COUNT = 3000  # 3 s at 1 kHz: six 0.5 s chunks
 
 @pytest.fixture
 def finished(tmp_path):
-    path = tmp_path / "run.mcap"
-    with Ros2McapWriter(str(path)) as writer:
-        channel = writer.add_channel(TOPIC, "std_msgs/msg/Float64")
-        for i in range(COUNT):
-            writer.write(channel, serialize_message(Float64(data=float(i))), i * MS)
-    return path
+    return write_float64_run(tmp_path / "run.mcap", TOPIC, COUNT, MS)
 
 
 def _cut(path, size: int, name: str = "cut.mcap"):

@@ -75,3 +75,20 @@ class BridgeProcess:
 
     def output(self) -> str:
         return "".join(self.lines)
+
+
+def bridge_logs(rows, *args: str, signum: int = signal.SIGINT) -> tuple[BridgeProcess, int]:
+    """Start ``rerun_bridge *args`` on a private topic, publish ``rows`` to it at 400 Hz, wait
+    until it logged them all (bounded), stop it with ``signum``: (the bridge, its exit code)."""
+    from tests.viz.telemetry_publisher import TelemetryPublisher
+    topic = private_topic()
+    bridge = BridgeProcess(*args, *remap_telemetry(topic))
+    publisher = TelemetryPublisher(topic)
+    try:
+        assert publisher.wait_for_subscriber(30.0), bridge.output()
+        publisher.publish(rows, rate_hz=400.0)
+        assert bridge.wait_logged(len(rows), 30.0), bridge.output()
+    finally:
+        publisher.close()
+        code = bridge.stop(signum=signum)
+    return bridge, code

@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 
 from drill_sim_ros.model.presets import load_preset
-from tests.viz.bridge_process import BridgeProcess, private_topic, remap_telemetry
+from tests.viz.bridge_process import bridge_logs
 from tests.viz.rrd_read import read_recording
 from tests.viz.sim_telemetry import telemetry_rows
 from tests.viz.test_serve_loopback import free_port
@@ -55,21 +55,11 @@ def test_bad_options_are_usage_errors(args, tmp_path) -> None:
 
 @pytest.mark.parametrize("signum", [signal.SIGHUP, signal.SIGTERM])
 def test_no_viewer_beside_save_warns_and_the_signal_finishes_the_rrd(tmp_path, signum) -> None:
-    from tests.viz.telemetry_publisher import TelemetryPublisher
 
     rows = telemetry_rows(load_preset("field_8p5in_shale"), 2.0)
     rrd = tmp_path / "live.rrd"
-    topic = private_topic()
-    bridge = BridgeProcess("--save", str(rrd), "--connect", _nowhere(),
-                           *remap_telemetry(topic))
-    publisher = TelemetryPublisher(topic)
-    try:
-        assert publisher.wait_for_subscriber(30.0), bridge.output()
-        publisher.publish(rows, rate_hz=400.0)
-        assert bridge.wait_logged(len(rows), 30.0), bridge.output()
-    finally:
-        publisher.close()
-        code = bridge.stop(signum=signum)
+    bridge, code = bridge_logs(rows, "--save", str(rrd), "--connect", _nowhere(),
+                               signum=signum)
     assert code == 0, bridge.output()
     assert bridge.output().count("no viewer listening") == 1
     assert len(read_recording(rrd)["/timeseries/rop/bit"].time_ns) == len(rows)

@@ -8,7 +8,7 @@ import pytest
 from drill_sim_ros import topics
 from drill_sim_ros.model.presets import load_preset
 from tests.viz import expected as ex
-from tests.viz.bridge_process import BridgeProcess, private_topic, remap_telemetry
+from tests.viz.bridge_process import bridge_logs
 from tests.viz.rrd_read import read_recording, series_aggregation, tick_scale, view_origins
 from tests.viz.sim_telemetry import telemetry_rows
 
@@ -19,21 +19,11 @@ PRESET = "field_8p5in_shale"
 
 @pytest.fixture(scope="module")
 def live(tmp_path_factory: pytest.TempPathFactory) -> dict:
-    from tests.viz.telemetry_publisher import TelemetryPublisher
 
     preset = load_preset(PRESET)
     rows = telemetry_rows(preset, 8.0)
     rrd = tmp_path_factory.mktemp("bridge") / "live.rrd"
-    topic = private_topic()
-    bridge = BridgeProcess("--save", str(rrd), "--preset", PRESET, *remap_telemetry(topic))
-    publisher = TelemetryPublisher(topic)
-    try:
-        assert publisher.wait_for_subscriber(30.0), bridge.output()
-        publisher.publish(rows, rate_hz=400.0)
-        assert bridge.wait_logged(len(rows), 30.0), bridge.output()
-    finally:
-        publisher.close()
-        code = bridge.stop()
+    bridge, code = bridge_logs(rows, "--save", str(rrd), "--preset", PRESET)
     assert code == 0, bridge.output()
     return {"rows": rows, "preset": preset, "rrd": rrd, "data": read_recording(rrd),
             "log": bridge.output()}
