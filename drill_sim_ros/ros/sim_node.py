@@ -220,19 +220,16 @@ class SimNode(Node):
         self.get_logger().info(f"recording to {path}")
         return recorder
 
-    def _run_info(self) -> dict[str, Any]:
-        return self._session.run_info()
-
     def _run_metadata(self) -> dict[str, str]:
         """The MCAP metadata record of a recording: the run info, flat, as strings."""
-        info = self._run_info()
+        info = self._session.run_info()
         flat = {key: value for key, value in info.items() if key != "groups"}
         return {key: value if isinstance(value, str) else repr(value)
                 for key, value in flat.items()}
 
     def _publish_run_info(self) -> None:
         """/drill/run_info, latched: what this node runs, as JSON (lock held)."""
-        payload = serialize_message(String(data=json.dumps(self._run_info())))
+        payload = serialize_message(String(data=json.dumps(self._session.run_info())))
         self._sinks.emit_one(topics.RUN_INFO, payload, self._session.sim_time_ns)
 
     def _log_start(self) -> None:
