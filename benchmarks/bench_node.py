@@ -4,12 +4,15 @@
     /proc/<pid>/stat) against the reference measured in the same run: a bare rclpy process
     whose thread publishes sim_node's own payloads (the same bytes, topics and QoS) every
     10 ms through ``Publisher.publish``; and the node's tick lateness p50/p99 (its
-    /diagnostics);
+    /diagnostics). ``--pairs`` reference/node measurements alternate; the median ratio counts;
+(b0) the ceiling of a free run, measured the same way: the reference publishing the same
+    payloads as fast as it can (no simulation), as a real-time factor at 100 Hz;
 (b) free run (real_time_factor 0): achieved real-time factor (sim seconds per wall second),
-    without and with in-process recording (record.path).
+    and as a fraction of (b0); (c) the same with in-process recording (record.path).
 Targets (issue 10): (a) sim_node <= 1.5x the reference, p99 <= 2 ms; (b) >= 100x, and with
 recording >= a third of that.
-Usage: .venv/bin/python benchmarks/bench_node.py [--seconds 10] [--preset field_8p5in_shale]
+Usage: .venv/bin/python benchmarks/bench_node.py [--seconds 10] [--pairs 3]
+       [--preset field_8p5in_shale]
 """
 
 from __future__ import annotations
@@ -98,17 +101,20 @@ def start_node(preset: str, factor: float, record_path: str = "") -> subprocess.
     return subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
 
 
-def start_reference(preset: str) -> subprocess.Popen:
-    return subprocess.Popen([sys.executable, __file__, "--reference-publisher", preset],
-                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+def start_reference(preset: str, period_s: float = 0.01) -> subprocess.Popen:
+    return subprocess.Popen([sys.executable, __file__, "--reference-publisher", preset,
+                             "--reference-period", str(period_s)],
+                            stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
 
 
-def reference_publisher(preset: str) -> None:
-    """The reference: a thread publishing sim_node's payloads of one block every 10 ms."""
+def reference_publisher(preset: str, period_s: float) -> None:
+    """The reference: a thread publishing sim_node's payloads of one block every
+    ``period_s``; with 0, as fast as it can in batches of FREE_RUN_BATCH samples (the
+    ceiling of a free run), printing ``monotonic_s samples`` once a second."""
     from drill_sim_ros.model.presets import load_preset
     from drill_sim_ros.model.session import SessionConfig, SimSession
     from drill_sim_ros.ros.frame import SampleFrame
-    from drill_sim_ros.ros.sim_node import CLOCK_QOS, DATA_QOS
+    from drill_sim_ros.ros.sim_node import CLOCK_QOS, DATA_QOS, FREE_RUN_BATCH
 
     rclpy.init()
     node = Node("bench_reference")
@@ -120,14 +126,20 @@ def reference_publisher(preset: str) -> None:
     stop_event = threading.Event()
 
     def publish_every_10_ms() -> None:
-        deadline = time.monotonic()
+        deadline = next_report = time.monotonic()
         i = 0
         while not stop_event.is_set():
             for pub, payload in zip(pubs, payloads[i % len(payloads)], strict=True):
                 pub.publish(payload)
             i += 1
-            deadline += 0.01
-            time.sleep(max(0.0, deadline - time.monotonic()))
+            if period_s > 0:
+                deadline += period_s
+                time.sleep(max(0.0, deadline - time.monotonic()))
+            elif i % FREE_RUN_BATCH == 0:
+                time.sleep(0.0)                  # like sim_node's ticker: yield the GIL
+                if (now := time.monotonic()) >= next_report:
+                    print(f"{now} {i}", flush=True)
+                    next_report = now + 1.0
 
     thread = threading.Thread(target=publish_every_10_ms, daemon=True)
     thread.start()
@@ -140,6 +152,17 @@ def reference_publisher(preset: str) -> None:
         thread.join(1.0)
         node.destroy_node()
         rclpy.try_shutdown()
+
+
+def reported_rate(proc: subprocess.Popen, window: tuple[float, float]) -> float:
+    """Samples per second of a stopped ceiling publisher over ``window`` (monotonic s), from
+    its ``monotonic_s samples`` lines (the monotonic clock is one for all processes)."""
+    lines = [line.split() for line in proc.stdout.read().splitlines()]
+    points = [(float(t), int(n)) for t, n in lines if window[0] <= float(t) <= window[1]]
+    if len(points) < 2:
+        return float("nan")
+    (t0, n0), (t1, n1) = points[0], points[-1]
+    return (n1 - n0) / (t1 - t0)
 
 
 def stop(proc: subprocess.Popen) -> None:
@@ -168,7 +191,8 @@ def measure(listener: Listener, proc: subprocess.Popen, seconds: float) -> dict[
     finally:
         stop(proc)
     wall = wall1 - wall0
-    return {"cpu_percent": 100.0 * (cpu1 - cpu0) / wall, "received_per_s": (n1 - n0) / wall,
+    return {"window": (wall0, wall1), "cpu_percent": 100.0 * (cpu1 - cpu0) / wall,
+            "received_per_s": (n1 - n0) / wall,
             "p50_ms": float(diag.get("tick_lateness_p50_ms", "nan")),
             "p99_ms": float(diag.get("tick_lateness_p99_ms", "nan")),
             "overruns": float(diag.get("overruns", "nan")),
@@ -179,27 +203,43 @@ def measure(listener: Listener, proc: subprocess.Popen, seconds: float) -> dict[
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seconds", type=float, default=10.0)
+    parser.add_argument("--pairs", type=int, default=3,
+                        help="(a) reference/sim_node measurements, alternated")
     parser.add_argument("--preset", default="field_8p5in_shale")
     parser.add_argument("--reference-publisher", metavar="PRESET", help=argparse.SUPPRESS)
+    parser.add_argument("--reference-period", type=float, default=0.01, help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.reference_publisher:
-        reference_publisher(args.reference_publisher)
+        reference_publisher(args.reference_publisher, args.reference_period)
         return
     rclpy.init()
     listener = Listener()
     try:
-        ref = measure(listener, start_reference(args.preset), args.seconds)
-        rt = measure(listener, start_node(args.preset, 1.0), args.seconds)
-        print(f"(a) real time, 100 Hz, {len(PUBLISHED)} topics subscribed: sim_node CPU "
-              f"{rt['cpu_percent']:.1f} % of one core, reference publisher "
-              f"{ref['cpu_percent']:.1f} %: ratio {rt['cpu_percent'] / ref['cpu_percent']:.2f}x"
-              f"; tick lateness p50 {rt['p50_ms']:.3f} ms, p99 {rt['p99_ms']:.3f} ms; "
-              f"overruns {rt['overruns']:g}; {rt['received_per_s']:.0f} msg/s received "
-              f"(reference {ref['received_per_s']:.0f})")
+        ratios = []
+        for pair in range(1, args.pairs + 1):      # alternated: drift hits both alike
+            ref = measure(listener, start_reference(args.preset), args.seconds)
+            rt = measure(listener, start_node(args.preset, 1.0), args.seconds)
+            ratios.append(rt["cpu_percent"] / ref["cpu_percent"])
+            print(f"(a) pair {pair}: real time, 100 Hz, {len(PUBLISHED)} topics subscribed: "
+                  f"sim_node CPU {rt['cpu_percent']:.1f} % of one core, reference publisher "
+                  f"{ref['cpu_percent']:.1f} %: ratio {ratios[-1]:.2f}x; tick lateness p50 "
+                  f"{rt['p50_ms']:.3f} ms, p99 {rt['p99_ms']:.3f} ms; overruns "
+                  f"{rt['overruns']:g}; {rt['received_per_s']:.0f} msg/s received "
+                  f"(reference {ref['received_per_s']:.0f})", flush=True)
+        print(f"(a) CPU ratio, median of {len(ratios)} pairs: {float(np.median(ratios)):.2f}x "
+              f"(range {min(ratios):.2f}-{max(ratios):.2f})", flush=True)
+        ceiling_proc = start_reference(args.preset, period_s=0.0)
+        ceiling = measure(listener, ceiling_proc, args.seconds)
+        ceiling_rtf = reported_rate(ceiling_proc, ceiling["window"]) / 100.0
+        print(f"(b0) ceiling of a free run: the reference publishing as fast as it can, "
+              f"{ceiling_rtf:.1f}x real time at 100 Hz; CPU {ceiling['cpu_percent']:.0f} %; "
+              f"{ceiling['received_per_s']:.0f} msg/s received", flush=True)
         free = measure(listener, start_node(args.preset, 0.0), args.seconds)
-        print(f"(b) free run: achieved real-time factor {free['sim_rate']:.1f}x (mean of the "
-              f"node's once-a-second figures; the last {free['rtf_reported']:.1f}x); CPU "
-              f"{free['cpu_percent']:.0f} %; {free['received_per_s']:.0f} msg/s received")
+        print(f"(b) free run: achieved real-time factor {free['sim_rate']:.1f}x = "
+              f"{free['sim_rate'] / ceiling_rtf:.2f} of (b0) (mean of the node's once-a-second "
+              f"figures; the last {free['rtf_reported']:.1f}x); CPU "
+              f"{free['cpu_percent']:.0f} %; {free['received_per_s']:.0f} msg/s received",
+              flush=True)
         with tempfile.TemporaryDirectory() as tmp:
             path = str(Path(tmp) / "free.mcap")
             rec = measure(listener, start_node(args.preset, 0.0, path), args.seconds)

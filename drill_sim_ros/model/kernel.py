@@ -402,5 +402,29 @@ def advance(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarra
     return status, n_rows
 
 
+@njit(cache=True)
+def advance_and_sample(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarray,
+                       hist: np.ndarray, meta: np.ndarray, acc: np.ndarray, out: np.ndarray,
+                       n_steps: int, every: int, exact: bool) -> tuple[int, int]:
+    """:func:`advance`, then the sample of the state it ended in, in the next row of ``out``.
+
+    That sample is what the next step records at its start: it is read from one step taken
+    on copies of the state, the rock profile (or history) and the statistics, so the
+    simulation itself does not move. ``n_steps = 0`` gives the sample of the current state.
+    Returns ``(status, rows_written)`` with the end sample counted; on a failed status the
+    end sample is not taken.
+    """
+    status, rows = STATUS_OK, 0
+    if n_steps > 0:
+        status, rows = advance(st, prm, tgt, profile, hist, meta, acc, out, n_steps, every,
+                               exact)
+    if status != STATUS_OK or rows >= out.shape[0]:
+        return status, rows
+    advance(st.copy(), prm, tgt, profile if exact else profile.copy(),
+            hist.copy() if exact else hist, meta.copy(), acc.copy(), out[rows:rows + 1], 1, 1,
+            exact)
+    return status, rows + 1
+
+
 NO_HISTORY = np.zeros((2, 1))             # what the profile path takes for hist and meta
 NO_META = np.zeros(3, dtype=np.int64)

@@ -26,7 +26,7 @@ from drill_sim_ros.model.telemetry import (
     NO_COMMAND_S,
     NS_PER_S,
     field_scales,
-    si_rows,
+    stamped_si_rows,
     surface_truth,
 )
 from drill_sim_ros.model.top_drive import TopDrivePhysical
@@ -110,7 +110,7 @@ class SimSession:
         self._perfect_sensors = self.sensors.perfect
         self._factors = field_scales(self.scales)
         self._samples = np.empty((2, k.N_COLS))   # kernel rows of a run (grows as needed)
-        self.sim.advance_into(self._samples, 0, self.steps)  # load the compiled kernel now
+        self.sim.advance_into(self._samples, 0, self.steps, sample_end=True)  # compile now
         self.next_index = 0          # sample counter: stamps = index * period_ns
         # The severity window: snapshots of the kernel's running sums at the end of each of
         # its WINDOW_BUCKETS parts, the extremes restarted after each (no per-sample work).
@@ -146,18 +146,19 @@ class SimSession:
             self._samples = np.empty((periods + 1, k.N_COLS))
         first = self.next_index
         # rows 0..periods-1: the state at the start of each period; row `periods`: the end
-        count = self.sim.advance_into(self._samples, periods * self.steps, self.steps)
-        self.sim.sample_into(self._samples[count])
-        self._advanced(count)
-        return self._block(self._samples[1:count + 1], first + 1)
+        rows = self.sim.advance_into(self._samples, periods * self.steps, self.steps,
+                                     sample_end=True)
+        self._advanced(rows - 1)
+        return self._block(self._samples[1:rows], first + 1)
 
     def _block(self, samples: np.ndarray, first_index: int) -> Block:
         """SI block of kernel rows, the first stamped ``first_index * period_ns``."""
-        stamps_ns = (first_index + np.arange(samples.shape[0], dtype=np.int64)) * self.period_ns
         command_s = NO_COMMAND_S if self.command_stamp_ns is None else \
             self.command_stamp_ns / NS_PER_S
-        rows = si_rows(samples, self.sim.offsets, self._factors, stamps_ns / NS_PER_S,
-                       self.submerged_weight_n, command_s)
+        depth_offset, angle_offset = self.sim.offsets
+        rows, stamps_ns = stamped_si_rows(samples, depth_offset, angle_offset, self._factors,
+                                          first_index * self.period_ns, self.period_ns,
+                                          float(self.submerged_weight_n), command_s)
         if not self._perfect_sensors:          # si_rows gives the truth, perfect sensors
             rows[:, MEASURED] = self.sensors.measure(surface_truth(rows))
         return Block(rows, stamps_ns, self.sim.offsets)

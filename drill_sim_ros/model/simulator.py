@@ -319,15 +319,19 @@ class Simulator:
         written = self.advance_into(out, n_steps, every)
         return Samples(out[:written], self._depth_offset, self._angle_offset)
 
-    def advance_into(self, out: np.ndarray, n_steps: int, every: int) -> int:
+    def advance_into(self, out: np.ndarray, n_steps: int, every: int,
+                     sample_end: bool = False) -> int:
         """:meth:`advance` into the caller's array (rows of ``kernel.C_*`` columns, at least
-        ``n_steps // every + 1``); returns the rows written. Allocates nothing: the node's
-        10 ms tick uses it. The rows hold depth and angles less :attr:`offsets`.
+        ``n_steps // every + 1``, one more with ``sample_end``); returns the rows written.
+        With ``sample_end`` the last row is the sample of the state the run ended in (see
+        :meth:`sample_into`), in the same compiled call. Allocates nothing: the node's 10 ms
+        tick uses it. The rows hold depth and angles less :attr:`offsets`.
         """
         if n_steps < 0:
             raise ParameterError(f"n_steps = {n_steps!r} must be >= 0")
         self._open_run(n_steps)
-        status, written = k.advance(*self._kernel_arrays(), out, n_steps, every, self.exact)
+        kernel = k.advance_and_sample if sample_end else k.advance
+        status, written = kernel(*self._kernel_arrays(), out, n_steps, every, self.exact)
         self._close_run(n_steps, status)
         return written
 
@@ -337,8 +341,8 @@ class Simulator:
         read from one step of copies of the state, so the simulator itself does not move."""
         if self.fault is not None:
             raise NumericalFault(f"simulator faulted ({self.fault}); call reset()")
-        copies = [array.copy() for array in self._kernel_arrays()]
-        k.advance(*copies, out.reshape(1, k.N_COLS), 1, 1, self.exact)
+        k.advance_and_sample(*self._kernel_arrays(), out.reshape(1, k.N_COLS), 0, 0,
+                             self.exact)
 
     def _kernel_arrays(self) -> tuple[np.ndarray, ...]:
         """The arguments of ``kernel.advance`` before ``out``: state, parameters, targets,

@@ -126,6 +126,27 @@ def _fill_si(samples: np.ndarray, depth_offset: float, angle_offset: float,
         row[_MEASURED[2]] = row[_STRING]
 
 
+@njit(cache=True)
+def stamped_si_rows(samples: np.ndarray, depth_offset: float, angle_offset: float,
+                    factors: np.ndarray, first_stamp_ns: int, period_ns: int,
+                    submerged_weight_n: float,
+                    command_stamp_s: float) -> tuple[np.ndarray, np.ndarray]:
+    """(SI rows, stamps ns) of kernel samples taken every ``period_ns`` from
+    ``first_stamp_ns``: :func:`si_rows` with sim_time_s = stamp / 1e9, in one compiled call
+    (a node's tick converts one sample, and each numpy call from Python costs more than the
+    conversion)."""
+    count = samples.shape[0]
+    stamps_ns = np.empty(count, dtype=np.int64)
+    times_s = np.empty(count)
+    for i in range(count):
+        stamps_ns[i] = first_stamp_ns + i * period_ns
+        times_s[i] = stamps_ns[i] / NS_PER_S
+    out = np.empty((count, N_FIELDS))
+    _fill_si(samples, depth_offset, angle_offset, factors, times_s, submerged_weight_n,
+             command_stamp_s, out)
+    return out, stamps_ns
+
+
 def surface_truth(rows: np.ndarray) -> np.ndarray:
     """The true surface signals of SI rows, shape (rows, 3): drive speed rad/s, motor torque
     N m, string torque at the quill N m (``model.measurement.SIGNALS`` order)."""

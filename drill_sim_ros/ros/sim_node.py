@@ -175,7 +175,8 @@ class SimNode(Node):
         self._first_spin = self.create_timer(0.0, self._start_ticker, clock=self._steady)
         self._first_spin.cancel()                      # start() arms it
         self.create_timer(DIAGNOSTICS_PERIOD_S, self._publish_diagnostics, clock=self._steady)
-        self.create_timer(STATUS_PERIOD_S, self._show_status, clock=self._steady)
+        if self._status.active:        # a terminal: no executor wake-ups for nobody
+            self.create_timer(STATUS_PERIOD_S, self._show_status, clock=self._steady)
         self._stop_timer = self.create_timer(max(self._values["run_seconds"], 1e-3),
                                              self._on_run_limit, clock=self._steady)
         self._stop_timer.cancel()                      # start() arms it when run_seconds > 0

@@ -27,20 +27,24 @@ class SampleSinks:
     def __init__(self, publishers: dict[str, Publisher]) -> None:
         self._publishers = publishers
         self._frames = {with_clock: SampleFrame(with_clock) for with_clock in (False, True)}
+        # per frame: its publishers and their resolved names, in its topics order
+        self._targets = {with_clock: [publishers[topic] for topic in frame.topics]
+                         for with_clock, frame in self._frames.items()}
+        self._names = {with_clock: [publisher.topic_name for publisher in targets]
+                       for with_clock, targets in self._targets.items()}
         self.recorder: Any = None
 
     def emit(self, block: Block, with_clock: bool) -> None:
         """Publish (and record) every sample of ``block``, /clock too if ``with_clock``."""
-        frame = self._frames[with_clock]
-        publishers = [self._publishers[topic] for topic in frame.topics]
+        publishers, names = self._targets[with_clock], self._names[with_clock]
         recorder = self.recorder
-        packed = frame.pack(block.rows, block.stamps_ns)
+        packed = self._frames[with_clock].pack(block.rows, block.stamps_ns)
         for payloads, time_ns in zip(packed, block.stamps_ns.tolist(), strict=True):
             for publisher, payload in zip(publishers, payloads, strict=True):
                 publisher.publish(payload)
             if recorder is not None:
-                for publisher, payload in zip(publishers, payloads, strict=True):
-                    recorder.write_serialized(publisher.topic_name, payload, time_ns)
+                for name, payload in zip(names, payloads, strict=True):
+                    recorder.write_serialized(name, payload, time_ns)
 
     def emit_one(self, topic: str, payload: bytes, time_ns: int) -> None:
         """Publish (and record) one serialized message, e.g. /diagnostics."""
