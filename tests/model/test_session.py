@@ -44,3 +44,29 @@ def test_reset_empties_the_window():
     session.reset()
     sev, stuck = session.severity()
     assert np.isnan(sev.ssi) and np.isnan(stuck)
+
+
+def test_a_block_is_the_state_at_the_end_of_each_period_whatever_the_batching():
+    """Sample i of a block is what an every-period recording of the same run holds at the
+    start of period i + 1, converted to SI by si_rows, stamped (i + 1) periods; taking the
+    end sample never moves the simulation, so 10 runs of 1 period equal one run of 10."""
+    from drill_sim_ros.model.telemetry import NS_PER_S, field_scales, si_rows
+
+    cfg = SessionConfig(preset=load_preset("field_8p5in_shale"))
+    one_by_one = SimSession(cfg)
+    start = one_by_one.current()
+    singles = [one_by_one.run(1) for _ in range(10)]
+    batched = SimSession(cfg)
+    blocks = [batched.run(7), batched.run(3)]
+    rows = np.vstack([b.rows for b in blocks])
+    assert np.array_equal(rows, np.vstack([b.rows for b in singles]))
+    reference = SimSession(cfg)
+    # one step past the 10th period: its row is recorded at the start of that step
+    recorded = reference.sim.advance(10 * reference.steps + 1, every=reference.steps)
+    stamps_ns = np.arange(11, dtype=np.int64) * reference.period_ns
+    expected = si_rows(recorded.data, (recorded.depth_offset, recorded.angle_offset),
+                       field_scales(cfg.preset.scales), stamps_ns / NS_PER_S, 0.0)
+    assert len(recorded.data) == 11
+    assert np.array_equal(start.rows[0], expected[0]) and start.stamps_ns[0] == 0
+    assert np.array_equal(rows, expected[1:])
+    assert np.array_equal(np.concatenate([b.stamps_ns for b in blocks]), stamps_ns[1:])
