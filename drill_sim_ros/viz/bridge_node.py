@@ -13,6 +13,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import os
 import signal
 import sys
 import time
@@ -337,7 +338,14 @@ def main(argv: list[str] | None = None) -> int:
         problems = [] if outputs is None else outputs.close()
     for problem in problems:
         logger.error(problem)
-    return 1 if problems else 0
+    code = 1 if problems else 0
+    if outputs is not None and outputs.viewer is not None and outputs.viewer.closing():
+        # rerun's exit hook would wait for as long as a stuck viewer holds data unread; the
+        # .rrd and --serve are closed by now, so leave without it.
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(code)
+    return code
 
 
 if __name__ == "__main__":

@@ -1,8 +1,9 @@
-"""rerun_bridge --connect: a viewer that goes away mid-run is cut (one warning, memory
-bounded, the .rrd complete) and reconnected when one listens again at the URL.
+"""rerun_bridge --connect: a viewer that goes away (or stops reading) mid-run is cut (one
+warning, memory bounded, the .rrd complete, SIGINT still stops the bridge) and reconnected
+when one listens again at the URL.
 
 The viewer is a stand-in (tests/viz/viewer_standin.py: rerun's SDK gRPC server in its own
-process), killed with SIGKILL and restarted on the same port.
+process), killed with SIGKILL (or stopped with SIGSTOP) and restarted on the same port.
 """
 
 from __future__ import annotations
@@ -131,3 +132,38 @@ def test_a_viewer_started_after_the_bridge_is_connected(tmp_path: Path) -> None:
     assert [("no viewer listening" in line) for line in warnings(bridge)] == [True], out
     assert f"lacks up to {len(rows)} samples" in out, out
     assert received >= STATIC_BYTES, received           # the layout and static views
+
+
+def test_a_viewer_that_stops_reading_is_cut_and_the_bridge_still_stops(tmp_path: Path) -> None:
+    rows = telemetry_rows(load_preset("field_8p5in_shale"), 100.0)    # 25 s at RATE_HZ
+    rrd = tmp_path / "live.rrd"
+    viewer = ViewerStandIn(free_port())
+    viewer.start()
+    topic = private_topic()
+    bridge = BridgeProcess("--save", str(rrd), "--connect", viewer.url,
+                           *remap_telemetry(topic))
+    publisher = TelemetryPublisher(topic)
+    feeder = threading.Thread(target=publisher.publish, args=(rows, RATE_HZ), daemon=True)
+    try:
+        assert publisher.wait_for_subscriber(30.0), bridge.output()
+        feeder.start()
+        assert bridge.wait_logged(400, 30.0), bridge.output()
+        growth_with_viewer, _, streamed_bytes_s = run_on(bridge, viewer, AWAY_S)
+
+        viewer.freeze()
+        assert wait_output(bridge, "does not read", 10.0), bridge.output()
+        growth_frozen, logged_frozen, _ = run_on(bridge, None, AWAY_S)
+        feeder.join(timeout=60.0)
+        assert not feeder.is_alive()
+        assert bridge.wait_logged(len(rows), 30.0), bridge.output()
+    finally:
+        publisher.close()
+        code = bridge.stop(timeout_s=10.0, signum=signal.SIGINT)   # else SIGKILL: rc -9
+        viewer.kill()
+    out = bridge.output()
+    assert code == 0, out
+    assert logged_frozen >= 0.5 * RATE_HZ * AWAY_S, out
+    assert growth_frozen < growth_with_viewer + 0.5 * streamed_bytes_s * AWAY_S, (
+        growth_frozen, growth_with_viewer, streamed_bytes_s)
+    assert [("does not read" in line) for line in warnings(bridge)] == [True], out
+    assert len(read_recording(rrd)["/timeseries/rop/bit"].time_ns) == len(rows)

@@ -7,6 +7,8 @@ reader; the link probes a real TCP listener on loopback that the test closes and
 from __future__ import annotations
 
 import socket
+import threading
+import time
 from pathlib import Path
 
 import numpy as np
@@ -79,6 +81,14 @@ def _listener(port: int = 0) -> socket.socket:
     return sock
 
 
+def _let_go(link: ViewerLink, timeout_s: float = 5.0) -> bool:
+    """Until the stream let go is disconnected (a daemon thread does it; bounded)."""
+    deadline = time.monotonic() + timeout_s
+    while link.closing() and time.monotonic() < deadline:
+        time.sleep(0.01)
+    return not link.closing()
+
+
 def test_the_link_cuts_once_and_reconnects_with_the_gap_named() -> None:
     viewer = _listener()
     port = viewer.getsockname()[1]
@@ -94,7 +104,7 @@ def test_the_link_cuts_once_and_reconnects_with_the_gap_named() -> None:
     viewer.close()
     for i, progress in enumerate([Progress(200, 2.0), Progress(300, 3.0), Progress(400, 4.0)]):
         link.poll((2.0 + i) * CHECK_PERIOD_S, progress)
-    assert recordings.streams == [] and opened[0].disconnected
+    assert recordings.streams == [] and _let_go(link) and opened[0].disconnected
     assert [kind for kind, _ in logger.lines] == ["warning"]
     assert url in logger.lines[0][1] and "x.rrd continues" in logger.lines[0][1]
     viewer = _listener(port)
@@ -106,7 +116,8 @@ def test_the_link_cuts_once_and_reconnects_with_the_gap_named() -> None:
     kind, text = logger.lines[-1]
     assert kind == "info" and "lacks up to 400 samples" in text          # 500 - 100 seen
     assert "sim_time 1.000 s to 5.000 s" in text
-    assert link.close(1.0) is None and opened[1].disconnected and recordings.streams == []
+    assert link.close(1.0) is None and _let_go(link) and opened[1].disconnected
+    assert recordings.streams == []
 
 
 def test_no_viewer_at_start_is_one_warning_until_one_listens() -> None:
@@ -119,3 +130,42 @@ def test_no_viewer_at_start_is_one_warning_until_one_listens() -> None:
     assert link.stream is None
     assert [kind for kind, _ in logger.lines] == ["warning"]
     assert "no viewer listening" in logger.lines[0][1]
+
+
+class _StuckStream(_Stream):
+    """A stream whose viewer does not read: flush times out, disconnect waits for ``freed``."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.freed = threading.Event()
+
+    def flush(self, timeout_sec: float) -> None:
+        raise RuntimeError("Flush timed out - not all log messages were sent")
+
+    def disconnect(self) -> None:
+        self.freed.wait(timeout=30.0)
+        super().disconnect()
+
+
+def test_a_viewer_that_does_not_read_is_cut_and_no_stream_opened_while_it_holds_one() -> None:
+    viewer = _listener()
+    url = f"rerun+http://127.0.0.1:{viewer.getsockname()[1]}/proxy"
+    opened: list[_Stream] = []
+    recordings, logger = Recordings(), _Logger()
+    link = ViewerLink(url, recordings, lambda: opened.append(_StuckStream()) or opened[-1],
+                      logger, "x.rrd continues")
+    try:
+        link.poll(0.0, Progress(0, None))
+        link.poll(CHECK_PERIOD_S, Progress(100, 1.0))        # flush times out: cut
+        link.poll(2 * CHECK_PERIOD_S, Progress(200, 2.0))    # still held: no new stream
+        assert len(opened) == 1 and recordings.streams == [] and link.closing()
+        assert [kind for kind, _ in logger.lines] == ["warning"]
+        assert "does not read" in logger.lines[0][1]
+        opened[0].freed.set()
+        assert _let_go(link)
+        link.poll(3 * CHECK_PERIOD_S, Progress(300, 3.0))
+        assert len(opened) == 2 and recordings.streams == [opened[1]]
+    finally:
+        for stream in opened:
+            stream.freed.set()
+        viewer.close()

@@ -47,6 +47,10 @@ class ViewerStandIn:
             self.proc.wait(timeout=10)
         self.proc = None
 
+    def freeze(self) -> None:
+        """SIGSTOP: still accepts connections (the kernel does), reads nothing."""
+        self.proc.send_signal(signal.SIGSTOP)
+
     def bytes_received(self) -> int:
         """Bytes received so far on the server's established connections (from ``ss``)."""
         exe = shutil.which("ss")
