@@ -124,7 +124,8 @@ def run(seconds: float, src: Path | None, freeze: bool, workdir: Path) -> None:
     print(f"bridge from {src or 'this tree'}: RSS growth {alive:+.2f} MiB/min with the viewer "
           f"({rate_kib_s:.1f} KiB/s reached it), {away:+.2f} MiB/min after it was "
           f"{'frozen' if freeze else 'killed'}; "
-          f"viewer warnings {text.count('no longer streamed there')}, reconnected: {'yes' if back else 'no'} "
+          f"viewer warnings {text.count('no longer streamed there')}, "
+          f"reconnected: {'yes' if back else 'no'} "
           f"({again:.0f} KiB received again); SIGINT stop {stop_s:.2f} s, rc {code}")
 
 
