@@ -167,3 +167,31 @@ def test_a_viewer_that_stops_reading_is_cut_and_the_bridge_still_stops(tmp_path:
         growth_frozen, growth_with_viewer, streamed_bytes_s)
     assert [("does not read" in line) for line in warnings(bridge)] == [True], out
     assert len(read_recording(rrd)["/timeseries/rop/bit"].time_ns) == len(rows)
+
+
+def test_a_viewer_restarted_at_once_is_reconnected(tmp_path: Path) -> None:
+    rows = telemetry_rows(load_preset("field_8p5in_shale"), 60.0)     # 15 s at RATE_HZ
+    viewer = ViewerStandIn(free_port())
+    viewer.start()
+    topic = private_topic()
+    bridge = BridgeProcess("--save", str(tmp_path / "live.rrd"), "--connect", viewer.url,
+                           *remap_telemetry(topic))
+    publisher = TelemetryPublisher(topic)
+    feeder = threading.Thread(target=publisher.publish, args=(rows, RATE_HZ), daemon=True)
+    try:
+        assert publisher.wait_for_subscriber(30.0), bridge.output()
+        feeder.start()
+        assert bridge.wait_logged(400, 30.0), bridge.output()
+        viewer.kill()
+        viewer.start()          # back within about 2 s: a probe or the failed flush notices
+        assert wait_output(bridge, BACK, 10.0), bridge.output()
+        received = viewer.wait_receiving(STATIC_BYTES, 10.0)
+        feeder.join(timeout=60.0)
+    finally:
+        publisher.close()
+        code = bridge.stop()
+        viewer.kill()
+    out = bridge.output()
+    assert code == 0, out
+    assert len(warnings(bridge)) == 1 and out.count(BACK) == 1, out
+    assert received >= STATIC_BYTES, received
