@@ -3,7 +3,9 @@
 A ROS 2 node that subscribes to ``/drill/telemetry`` (one atomic sample per message, SI) and
 logs it on the ``sim_time`` timeline taken from the record's ``sim_time_s``. Queued samples
 are taken and sent with ``send_columns`` ``flush_hz`` times a second. ``--serve`` hosts a
-gRPC server bound to 127.0.0.1 only. Turns rerun's analytics off first.
+gRPC server bound to 127.0.0.1 only. ``--connect`` streams to a viewer through a
+:class:`~drill_sim_ros.viz.viewer_link.ViewerLink`: cut while no viewer listens there, re-made
+when one does. Turns rerun's analytics off first.
 """
 
 from __future__ import annotations
@@ -11,13 +13,17 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import os
 import signal
 import sys
 import time
+import uuid
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 import rclpy
+import rerun as rr
 from rclpy.context import Context
 from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
@@ -36,8 +42,11 @@ from drill_sim_ros.viz.dashboard import Dashboard
 from drill_sim_ros.viz.frames import Extents, view_frames
 from drill_sim_ros.viz.paper_units import PaperUnits
 from drill_sim_ros.viz.recording import (
+    DEFAULT_SERVE_MEMORY_MIB,
     DEFAULT_SERVE_PORT,
     DEFAULT_VIEWER_URL,
+    SERVE_MEMORY_MIB_RANGE,
+    Recordings,
     close_recording,
     open_recording,
     port_free,
@@ -45,6 +54,7 @@ from drill_sim_ros.viz.recording import (
 )
 from drill_sim_ros.viz.running_stats import default_window_s
 from drill_sim_ros.viz.telemetry import N_FIELDS, TelemetryBatch, field_order
+from drill_sim_ros.viz.viewer_link import Progress, ViewerLink
 
 NODE_NAME = "rerun_bridge"
 QUEUE_DEPTH = 1000          # 10 s of telemetry at the sim's default 100 Hz
@@ -89,12 +99,15 @@ RUN_INFO_WAIT_S = 3.0        # how long to wait for the sim's /drill/run_info at
 
 
 class RerunBridge(Node):
-    """Drains the telemetry queue ``flush_hz`` times a second into a :class:`Dashboard`."""
+    """Drains the telemetry queue ``flush_hz`` times a second into a :class:`Dashboard`, and
+    lets the ``viewer`` link check its viewer when a check is due."""
 
     def __init__(self, dashboard: Dashboard, flush_hz: float = 4.0,
-                 status_period_s: float = 2.0, best_effort: bool = False) -> None:
+                 status_period_s: float = 2.0, best_effort: bool = False,
+                 viewer: ViewerLink | None = None) -> None:
         super().__init__(NODE_NAME)
         self._dashboard = dashboard
+        self._viewer = viewer
         self._queue = TelemetryQueue(self.context, best_effort)
         self._order: np.ndarray | None = None
         self.dropped = 0
@@ -115,6 +128,8 @@ class RerunBridge(Node):
         rows = self._rows(self._queue.take_all())
         if rows:
             self._dashboard.log_batch(TelemetryBatch.from_rows(np.stack(rows), self._order))
+        if self._viewer is not None:
+            self._viewer.poll(time.monotonic(), progress(self._dashboard))
         self._status(force=False)
 
     def _status(self, force: bool) -> None:
@@ -145,6 +160,10 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
     parser.add_argument("--serve", action="store_true",
                         help="host a gRPC server on 127.0.0.1 for viewers to connect to")
     parser.add_argument("--serve-port", type=int, default=DEFAULT_SERVE_PORT)
+    parser.add_argument("--serve-memory-limit", metavar="MiB", type=int,
+                        default=DEFAULT_SERVE_MEMORY_MIB,
+                        help="data --serve keeps for viewers, MiB; beyond it the oldest is "
+                             f"dropped (default {DEFAULT_SERVE_MEMORY_MIB})")
     parser.add_argument("--preset", default=None,
                         help="model preset for the scales of the 2D views (default: what "
                              f"the sim publishes on {topics.RUN_INFO}, else {DEFAULT_PRESET})")
@@ -156,6 +175,10 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
     args = parser.parse_args(argv)
     if not 1 <= args.serve_port <= 65535:
         parser.error(f"--serve-port = {args.serve_port} must lie in [1, 65535]")
+    low, high = SERVE_MEMORY_MIB_RANGE
+    if not low <= args.serve_memory_limit <= high:
+        parser.error(f"--serve-memory-limit = {args.serve_memory_limit} MiB must lie in "
+                     f"[{low}, {high}]")
     if not (math.isfinite(args.flush_hz) and 0 < args.flush_hz <= 1000):
         parser.error(f"--flush-hz = {args.flush_hz!r} must lie in (0, 1000]")
     if args.window_s is not None and not (math.isfinite(args.window_s) and args.window_s > 0):
@@ -191,12 +214,13 @@ class StartError(Exception):
     """The bridge cannot start as asked (one line)."""
 
 
-def check_sinks(args: argparse.Namespace, logger: Any) -> None:
-    """Refuse an existing --save file (unless --overwrite) and a busy --serve port; drop (or
-    refuse) a --connect with no viewer listening.
+def check_sinks(args: argparse.Namespace) -> None:
+    """Refuse an existing --save file (unless --overwrite), a busy --serve port, and a
+    --connect with no viewer listening when it is the only sink.
 
     rerun buffers everything for a viewer that is not there yet (about 21 MB a minute at the
-    sim's rate), so the bridge never streams to an address where nothing listens.
+    sim's rate), so the bridge never streams to an address where nothing listens: beside
+    another sink, the ViewerLink waits for a viewer instead.
     """
     if args.save:
         try:
@@ -206,29 +230,78 @@ def check_sinks(args: argparse.Namespace, logger: Any) -> None:
     if args.serve and (busy := port_free(args.serve_port)) is not None:
         raise StartError(f"--serve-port {args.serve_port}: cannot listen on 127.0.0.1 "
                          f"({busy})")
-    if args.connect and not viewer_listening(args.connect):
-        if not (args.save or args.serve):
-            raise StartError(f"no viewer listening at {args.connect}: start one first "
-                             "(`rerun`), or use --save FILE.rrd or --serve")
-        logger.warning(f"no viewer listening at {args.connect}: not streaming there")
-        args.connect = None
+    if args.connect and not (args.save or args.serve) and not viewer_listening(args.connect):
+        raise StartError(f"no viewer listening at {args.connect}: start one first "
+                         "(`rerun`), or use --save FILE.rrd or --serve")
 
 
-def make_dashboard(args: argparse.Namespace) -> Dashboard:
-    units = run_units(args.preset)
-    window = default_window_s(units) if args.window_s is None else args.window_s
-    frames = view_frames(units, Extents.typical())     # live: the data is not known yet
-    rec = open_recording(build_blueprint(window, frames), save=args.save,
-                         connect=args.connect, serve_port=args.serve_port if args.serve else None)
-    return Dashboard(rec, units, window, frames)
+def progress(dashboard: Dashboard) -> Progress:
+    return Progress(dashboard.samples, dashboard.last_time_s)
 
 
-def _interrupt(signum: int, frame: object) -> None:
-    raise KeyboardInterrupt(f"signal {signum}")
+def kept_elsewhere(args: argparse.Namespace) -> str:
+    """What keeps the telemetry while no viewer listens (for the ViewerLink's warning)."""
+    if args.save and args.serve:
+        return f"{args.save} and --serve continue"
+    if args.save or args.serve:
+        return f"{args.save or '--serve'} continues"
+    return "nothing else records it meanwhile"
 
 
 FILE_CLOSE_TIMEOUT_S = 10.0     # a .rrd gets everything queued, and its footer
 VIEWER_CLOSE_TIMEOUT_S = 1.5    # stop within 2 s even when a viewer stopped reading
+
+
+@dataclass
+class Outputs:
+    """The dashboard, the stream of --save/--serve (if any) and the --connect viewer link."""
+
+    dashboard: Dashboard
+    stored: rr.RecordingStream | None
+    viewer: ViewerLink | None
+
+    def close(self) -> list[str]:
+        """Finish the .rrd (and --serve), then the viewer's stream (bounded); return what
+        could not be flushed, one line per sink."""
+        problems = []
+        if self.stored is not None and (
+                problem := close_recording(self.stored, FILE_CLOSE_TIMEOUT_S)) is not None:
+            problems.append(f"not everything reached --save/--serve: {problem}")
+        if self.viewer is not None and (
+                problem := self.viewer.close(VIEWER_CLOSE_TIMEOUT_S)) is not None:
+            problems.append(f"not everything reached the viewer: {problem}")
+        return problems
+
+
+def open_outputs(args: argparse.Namespace, logger: Any) -> Outputs:
+    """The dashboard logging to --save/--serve, and to --connect while a viewer listens."""
+    units = run_units(args.preset)
+    window = default_window_s(units) if args.window_s is None else args.window_s
+    frames = view_frames(units, Extents.typical())     # live: the data is not known yet
+    blueprint = build_blueprint(window, frames)
+    recording_id = str(uuid.uuid4())                    # one recording on every sink
+    stored = None
+    if args.save or args.serve:
+        stored = open_recording(blueprint, save=args.save,
+                                serve_port=args.serve_port if args.serve else None,
+                                serve_memory_mib=args.serve_memory_limit,
+                                recording_id=recording_id)
+    recordings = Recordings(*([stored] if stored is not None else []))
+    dashboard = Dashboard(recordings, units, window, frames)
+    viewer = None
+    if args.connect:
+        def open_stream() -> rr.RecordingStream:
+            stream = open_recording(blueprint, connect=args.connect, recording_id=recording_id)
+            dashboard.log_static(stream)
+            return stream
+
+        viewer = ViewerLink(args.connect, recordings, open_stream, logger, kept_elsewhere(args))
+        viewer.poll(time.monotonic(), progress(dashboard))
+    return Outputs(dashboard, stored, viewer)
+
+
+def _interrupt(signum: int, frame: object) -> None:
+    raise KeyboardInterrupt(f"signal {signum}")
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -237,7 +310,7 @@ def main(argv: list[str] | None = None) -> int:
     args = parse_args(remove_ros_args(argv)[1:])
     logger = rclpy.logging.get_logger(NODE_NAME)
     try:
-        check_sinks(args, logger)
+        check_sinks(args)
     except StartError as exc:
         logger.fatal(str(exc))
         return 2
@@ -246,13 +319,14 @@ def main(argv: list[str] | None = None) -> int:
     rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
     signal.signal(signal.SIGTERM, _interrupt)
     signal.signal(signal.SIGHUP, _interrupt)
-    dashboard: Dashboard | None = None
+    outputs: Outputs | None = None
     node: RerunBridge | None = None
     try:
-        dashboard = make_dashboard(args)
-        node = RerunBridge(dashboard, args.flush_hz, best_effort=args.best_effort)
+        outputs = open_outputs(args, logger)
+        node = RerunBridge(outputs.dashboard, args.flush_hz, best_effort=args.best_effort,
+                           viewer=outputs.viewer)
         node.get_logger().info(f"ready: {topics.TELEMETRY} -> rerun "
-                               f"(scales of {dashboard.units.preset or 'the run info'})")
+                               f"(scales of {outputs.dashboard.units.preset or 'the run info'})")
         rclpy.spin(node)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
@@ -261,12 +335,17 @@ def main(argv: list[str] | None = None) -> int:
             node.finish()
             node.destroy_node()
         rclpy.try_shutdown()
-        timeout_s = VIEWER_CLOSE_TIMEOUT_S if args.connect else FILE_CLOSE_TIMEOUT_S
-        problem = None if dashboard is None else close_recording(dashboard.rec, timeout_s)
-    if problem is not None:
-        logger.error(f"not everything reached the viewer: {problem}")
-        return 1
-    return 0
+        problems = [] if outputs is None else outputs.close()
+    for problem in problems:
+        logger.error(problem)
+    code = 1 if problems else 0
+    if outputs is not None and outputs.viewer is not None and outputs.viewer.closing():
+        # rerun's exit hook would wait for as long as a stuck viewer holds data unread; the
+        # .rrd and --serve are closed by now, so leave without it.
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(code)
+    return code
 
 
 if __name__ == "__main__":

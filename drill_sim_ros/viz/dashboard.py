@@ -10,6 +10,7 @@ from drill_sim_ros.viz import log_views as lv
 from drill_sim_ros.viz.frames import Extents, ViewFrames, view_frames
 from drill_sim_ros.viz.paper_units import PaperUnits
 from drill_sim_ros.viz.plot_values import pattern_point, pattern_radius, phase_point
+from drill_sim_ros.viz.recording import Recordings
 from drill_sim_ros.viz.running_stats import default_window_s, new_window, running_stats
 from drill_sim_ros.viz.static_views import log_static
 from drill_sim_ros.viz.telemetry import TelemetryBatch
@@ -19,9 +20,10 @@ MAX_ROWS = 20_000   # bounds the sliding-window work arrays for large offline ba
 
 
 class Dashboard:
-    """Logs telemetry batches to one recording stream; keeps the sliding window."""
+    """Logs telemetry batches to a recording stream (or to the
+    :class:`~drill_sim_ros.viz.recording.Recordings` attached now); keeps the sliding window."""
 
-    def __init__(self, rec: rr.RecordingStream, units: PaperUnits,
+    def __init__(self, rec: rr.RecordingStream | Recordings, units: PaperUnits,
                  window_s: float | None = None, frames: ViewFrames | None = None) -> None:
         self.rec = rec
         self.units = units
@@ -33,7 +35,11 @@ class Dashboard:
         self._last_turn: list = []
         self.samples = 0
         self.last_time_s: float | None = None
-        log_static(rec, units, self.window_s, self.frames)
+        self.log_static(rec)
+
+    def log_static(self, rec: rr.RecordingStream | Recordings) -> None:
+        """The static parts (series styles, reference geometry, run notes) on ``rec``."""
+        log_static(rec, self.units, self.window_s, self.frames)
 
     def log_batch(self, batch: TelemetryBatch) -> None:
         """Log every sample of ``batch``; a backwards jump in sim time restarts the window."""

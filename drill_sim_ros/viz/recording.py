@@ -1,13 +1,15 @@
 """Open a rerun RecordingStream on the requested sinks, with the dashboard blueprint.
 
 ``serve`` hosts a gRPC server bound to 127.0.0.1 only (rerun's ``GrpcServerSink`` takes a
-``bind_ip``; ``rr.serve_grpc`` would bind 0.0.0.0).
+``bind_ip``; ``rr.serve_grpc`` would bind 0.0.0.0), holding at most ``serve_memory_mib`` of
+data for viewers (beyond it the server drops the oldest).
 """
 
 from __future__ import annotations
 
 import socket
 from pathlib import Path
+from typing import Any
 from urllib.parse import urlsplit
 
 import rerun as rr
@@ -18,11 +20,16 @@ from drill_sim_ros.viz.entities import APP_ID
 LOOPBACK = "127.0.0.1"
 DEFAULT_SERVE_PORT = 9876
 DEFAULT_VIEWER_URL = f"rerun+http://{LOOPBACK}:{DEFAULT_SERVE_PORT}/proxy"
+# What --serve keeps for viewers that connect later (rerun's default is 1 GiB); the bridge
+# with --serve and no viewer grew 6.6 MiB a minute at the sim's default 100 Hz telemetry.
+DEFAULT_SERVE_MEMORY_MIB = 256
+SERVE_MEMORY_MIB_RANGE = (16, 65536)
 
 
 def sinks_for(save: str | Path | None = None, connect: str | None = None,
-              serve_port: int | None = None) -> list[rr.FileSink | rr.GrpcSink |
-                                                       rr.GrpcServerSink]:
+              serve_port: int | None = None,
+              serve_memory_mib: int = DEFAULT_SERVE_MEMORY_MIB,
+              ) -> list[rr.FileSink | rr.GrpcSink | rr.GrpcServerSink]:
     """FileSink for ``save``, GrpcSink for ``connect``, loopback server for ``serve_port``."""
     sinks: list[rr.FileSink | rr.GrpcSink | rr.GrpcServerSink] = []
     if save is not None:
@@ -31,20 +38,62 @@ def sinks_for(save: str | Path | None = None, connect: str | None = None,
     if connect is not None:
         sinks.append(rr.GrpcSink(connect))
     if serve_port is not None:
-        sinks.append(rr.GrpcServerSink(bind_ip=LOOPBACK, port=serve_port))
+        sinks.append(rr.GrpcServerSink(bind_ip=LOOPBACK, port=serve_port,
+                                       server_memory_limit=f"{serve_memory_mib}MiB"))
     return sinks
 
 
 def open_recording(blueprint: rrb.Blueprint, *, save: str | Path | None = None,
-                   connect: str | None = None,
-                   serve_port: int | None = None) -> rr.RecordingStream:
-    """A new recording of application ``drill_sim_ros`` streaming to the given sinks."""
-    sinks = sinks_for(save, connect, serve_port)
+                   connect: str | None = None, serve_port: int | None = None,
+                   serve_memory_mib: int = DEFAULT_SERVE_MEMORY_MIB,
+                   recording_id: str | None = None) -> rr.RecordingStream:
+    """A new recording of application ``drill_sim_ros`` streaming to the given sinks.
+
+    Streams opened with the same ``recording_id`` are parts of one recording.
+    """
+    sinks = sinks_for(save, connect, serve_port, serve_memory_mib)
     if not sinks:
         raise ValueError("no rerun sink: give save, connect or serve_port")
-    rec = rr.RecordingStream(APP_ID)
+    rec = rr.RecordingStream(APP_ID, recording_id=recording_id)
     rec.set_sinks(*sinks, default_blueprint=blueprint)
     return rec
+
+
+class Recordings:
+    """The recording streams the dashboard logs to at the moment.
+
+    It has the two methods the ``log_*`` functions call (``send_columns`` and ``log``) and
+    hands each call to every attached stream, so one stream (a viewer's) can be attached
+    and detached without touching the others (a FileSink cannot be re-attached: it would
+    truncate its file).
+    """
+
+    def __init__(self, *streams: rr.RecordingStream) -> None:
+        self.streams = list(streams)
+
+    def attach(self, stream: rr.RecordingStream) -> None:
+        self.streams.append(stream)
+
+    def detach(self, stream: rr.RecordingStream) -> None:
+        self.streams.remove(stream)
+
+    def send_columns(self, *args: Any, **kwargs: Any) -> None:
+        for stream in self.streams:
+            stream.send_columns(*args, **kwargs)
+
+    def log(self, *args: Any, **kwargs: Any) -> None:
+        for stream in self.streams:
+            stream.log(*args, **kwargs)
+
+
+def flush_recording(rec: rr.RecordingStream, timeout_s: float) -> str | None:
+    """Wait up to ``timeout_s`` until every sink has taken what was logged; None, or one line
+    on why not (a viewer gone away, or not reading)."""
+    try:
+        rec.flush(timeout_sec=timeout_s)
+    except RuntimeError as exc:             # rerun reports a sink it cannot flush this way
+        return str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+    return None
 
 
 def close_recording(rec: rr.RecordingStream, timeout_s: float = 10.0) -> str | None:
@@ -52,11 +101,7 @@ def close_recording(rec: rr.RecordingStream, timeout_s: float = 10.0) -> str | N
 
     Returns None, or one line on why a sink could not be flushed (a viewer gone away).
     """
-    problem = None
-    try:
-        rec.flush(timeout_sec=timeout_s)
-    except RuntimeError as exc:             # rerun reports a sink it cannot flush this way
-        problem = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+    problem = flush_recording(rec, timeout_s)
     rec.disconnect()
     return problem
 

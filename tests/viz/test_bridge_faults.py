@@ -1,4 +1,5 @@
-"""rerun_bridge faults: no viewer listening, a busy or invalid --serve port, SIGHUP."""
+"""rerun_bridge faults: no viewer listening, a busy or invalid --serve port or memory limit,
+SIGHUP (a viewer lost mid-run: test_bridge_viewer_watchdog.py)."""
 
 from __future__ import annotations
 
@@ -45,6 +46,8 @@ def test_a_busy_serve_port_fails_at_start() -> None:
 
 
 @pytest.mark.parametrize("args", [["--serve", "--serve-port", "99999"],
+                                  ["--serve", "--serve-memory-limit", "0"],
+                                  ["--serve", "--serve-memory-limit", "1GiB"],
                                   ["--save", "x.rrd", "--flush-hz", "0"],
                                   ["--save", "x.rrd", "--window-s", "nan"]])
 def test_bad_options_are_usage_errors(args, tmp_path) -> None:

@@ -1,0 +1,197 @@
+"""rerun_bridge --connect: a viewer that goes away (or stops reading) mid-run is cut (one
+warning, memory bounded, the .rrd complete, SIGINT still stops the bridge) and reconnected
+when one listens again at the URL.
+
+The viewer is a stand-in (tests/viz/viewer_standin.py: rerun's SDK gRPC server in its own
+process), killed with SIGKILL (or stopped with SIGSTOP) and restarted on the same port.
+"""
+
+from __future__ import annotations
+
+import signal
+import threading
+import time
+from pathlib import Path
+
+import pytest
+
+from drill_sim_ros.model.presets import load_preset
+from tests.viz.bridge_process import BridgeProcess, private_topic, remap_telemetry
+from tests.viz.rrd_read import read_recording
+from tests.viz.sim_telemetry import telemetry_rows
+from tests.viz.telemetry_publisher import TelemetryPublisher
+from tests.viz.test_serve_loopback import free_port
+from tests.viz.viewer_standin import ViewerStandIn
+
+pytestmark = pytest.mark.ros
+
+RATE_HZ = 400.0          # 4x the sim's default telemetry rate: more to buffer, sooner
+AWAY_S = 8.0             # how long the bridge runs on without a viewer (4 checks)
+STATIC_BYTES = 10_000     # far more than a gRPC handshake; the layout and static views
+GONE = "stopped listening"
+BACK = ": streaming from sim_time"
+
+
+def rss_bytes(pid: int) -> int:
+    for line in Path(f"/proc/{pid}/status").read_text().splitlines():
+        if line.startswith("VmRSS:"):
+            return int(line.split()[1]) * 1024
+    raise RuntimeError(f"no VmRSS for {pid}")
+
+
+def wait_output(bridge: BridgeProcess, text: str, timeout_s: float) -> bool:
+    deadline = time.monotonic() + timeout_s
+    while text not in bridge.output() and time.monotonic() < deadline:
+        time.sleep(0.05)
+    return text in bridge.output()
+
+
+def run_on(bridge: BridgeProcess, viewer: ViewerStandIn | None, seconds: float,
+           ) -> tuple[int, int, float]:
+    """Over ``seconds``: (the bridge's RSS growth, bytes; samples it logged; bytes a second
+    the viewer received, 0 without one)."""
+    pid = bridge.proc.pid
+    rss, logged, start = rss_bytes(pid), bridge.logged(), time.monotonic()
+    received = viewer.bytes_received() if viewer else 0
+    time.sleep(seconds)
+    rate = (viewer.bytes_received() - received) / (time.monotonic() - start) if viewer else 0.0
+    return rss_bytes(pid) - rss, bridge.logged() - logged, rate
+
+
+def warnings(bridge: BridgeProcess) -> list[str]:
+    return [line for line in bridge.lines if "[WARN]" in line and "[rerun_bridge]" in line]
+
+
+def test_a_viewer_gone_mid_run_is_cut_then_reconnected(tmp_path: Path) -> None:
+    rows = telemetry_rows(load_preset("field_8p5in_shale"), 120.0)    # 30 s at RATE_HZ
+    rrd = tmp_path / "live.rrd"
+    viewer = ViewerStandIn(free_port())
+    viewer.start()
+    topic = private_topic()
+    bridge = BridgeProcess("--save", str(rrd), "--connect", viewer.url,
+                           *remap_telemetry(topic))
+    publisher = TelemetryPublisher(topic)
+    feeder = threading.Thread(target=publisher.publish, args=(rows, RATE_HZ), daemon=True)
+    try:
+        assert publisher.wait_for_subscriber(30.0), bridge.output()
+        feeder.start()
+        assert bridge.wait_logged(400, 30.0), bridge.output()
+        growth_with_viewer, _, streamed_bytes_s = run_on(bridge, viewer, AWAY_S)
+
+        viewer.kill()
+        assert wait_output(bridge, GONE, 10.0), bridge.output()
+        growth_away, logged_away, _ = run_on(bridge, None, AWAY_S)
+
+        viewer.start()
+        assert wait_output(bridge, BACK, 10.0), bridge.output()
+        received = viewer.wait_receiving(int(streamed_bytes_s), 10.0)
+        feeder.join(timeout=60.0)
+        assert not feeder.is_alive()
+        assert bridge.wait_logged(len(rows), 30.0), bridge.output()
+    finally:
+        publisher.close()
+        code = bridge.stop(signum=signal.SIGINT)
+        viewer.kill()
+    out = bridge.output()
+    assert code == 0, out
+    assert "Traceback" not in out
+    # Telemetry kept flowing while no viewer listened, and memory did not follow it: a client
+    # buffering for the lost viewer would hold at least what the viewer used to receive.
+    assert logged_away >= 0.5 * RATE_HZ * AWAY_S, out
+    buffered_bytes = streamed_bytes_s * AWAY_S
+    assert buffered_bytes > 1e6, streamed_bytes_s                   # the bound is meaningful
+    assert growth_away < growth_with_viewer + 0.5 * buffered_bytes, (
+        growth_away, growth_with_viewer, buffered_bytes)
+    assert [GONE in line for line in warnings(bridge)] == [True], out
+    assert viewer.url in warnings(bridge)[0] and "live.rrd continues" in warnings(bridge)[0]
+    assert out.count(BACK) == 1 and "lacks up to" in out, out
+    assert received >= streamed_bytes_s, received              # data reaches the new viewer
+    assert len(read_recording(rrd)["/timeseries/rop/bit"].time_ns) == len(rows)
+
+
+def test_a_viewer_started_after_the_bridge_is_connected(tmp_path: Path) -> None:
+    rows = telemetry_rows(load_preset("field_8p5in_shale"), 12.0)
+    viewer = ViewerStandIn(free_port())
+    topic = private_topic()
+    bridge = BridgeProcess("--save", str(tmp_path / "live.rrd"), "--connect", viewer.url,
+                           *remap_telemetry(topic))
+    publisher = TelemetryPublisher(topic)
+    try:
+        assert publisher.wait_for_subscriber(30.0), bridge.output()
+        publisher.publish(rows, rate_hz=RATE_HZ)
+        assert bridge.wait_logged(len(rows), 30.0), bridge.output()
+        viewer.start()
+        assert wait_output(bridge, BACK, 10.0), bridge.output()
+        received = viewer.wait_receiving(STATIC_BYTES, 10.0)
+    finally:
+        publisher.close()
+        code = bridge.stop()
+        viewer.kill()
+    out = bridge.output()
+    assert code == 0, out
+    assert [("no viewer listening" in line) for line in warnings(bridge)] == [True], out
+    assert f"lacks up to {len(rows)} samples" in out, out
+    assert received >= STATIC_BYTES, received           # the layout and static views
+
+
+def test_a_viewer_that_stops_reading_is_cut_and_the_bridge_still_stops(tmp_path: Path) -> None:
+    rows = telemetry_rows(load_preset("field_8p5in_shale"), 100.0)    # 25 s at RATE_HZ
+    rrd = tmp_path / "live.rrd"
+    viewer = ViewerStandIn(free_port())
+    viewer.start()
+    topic = private_topic()
+    bridge = BridgeProcess("--save", str(rrd), "--connect", viewer.url,
+                           *remap_telemetry(topic))
+    publisher = TelemetryPublisher(topic)
+    feeder = threading.Thread(target=publisher.publish, args=(rows, RATE_HZ), daemon=True)
+    try:
+        assert publisher.wait_for_subscriber(30.0), bridge.output()
+        feeder.start()
+        assert bridge.wait_logged(400, 30.0), bridge.output()
+        growth_with_viewer, _, streamed_bytes_s = run_on(bridge, viewer, AWAY_S)
+
+        viewer.freeze()
+        assert wait_output(bridge, "does not read", 10.0), bridge.output()
+        growth_frozen, logged_frozen, _ = run_on(bridge, None, AWAY_S)
+        feeder.join(timeout=60.0)
+        assert not feeder.is_alive()
+        assert bridge.wait_logged(len(rows), 30.0), bridge.output()
+    finally:
+        publisher.close()
+        code = bridge.stop(timeout_s=10.0, signum=signal.SIGINT)   # else SIGKILL: rc -9
+        viewer.kill()
+    out = bridge.output()
+    assert code == 0, out
+    assert logged_frozen >= 0.5 * RATE_HZ * AWAY_S, out
+    assert growth_frozen < growth_with_viewer + 0.5 * streamed_bytes_s * AWAY_S, (
+        growth_frozen, growth_with_viewer, streamed_bytes_s)
+    assert [("does not read" in line) for line in warnings(bridge)] == [True], out
+    assert len(read_recording(rrd)["/timeseries/rop/bit"].time_ns) == len(rows)
+
+
+def test_a_viewer_restarted_at_once_is_reconnected(tmp_path: Path) -> None:
+    rows = telemetry_rows(load_preset("field_8p5in_shale"), 60.0)     # 15 s at RATE_HZ
+    viewer = ViewerStandIn(free_port())
+    viewer.start()
+    topic = private_topic()
+    bridge = BridgeProcess("--save", str(tmp_path / "live.rrd"), "--connect", viewer.url,
+                           *remap_telemetry(topic))
+    publisher = TelemetryPublisher(topic)
+    feeder = threading.Thread(target=publisher.publish, args=(rows, RATE_HZ), daemon=True)
+    try:
+        assert publisher.wait_for_subscriber(30.0), bridge.output()
+        feeder.start()
+        assert bridge.wait_logged(400, 30.0), bridge.output()
+        viewer.kill()
+        viewer.start()          # back within about 2 s: a probe or the failed flush notices
+        assert wait_output(bridge, BACK, 10.0), bridge.output()
+        received = viewer.wait_receiving(STATIC_BYTES, 10.0)
+        feeder.join(timeout=60.0)
+    finally:
+        publisher.close()
+        code = bridge.stop()
+        viewer.kill()
+    out = bridge.output()
+    assert code == 0, out
+    assert len(warnings(bridge)) == 1 and out.count(BACK) == 1, out
+    assert received >= STATIC_BYTES, received
