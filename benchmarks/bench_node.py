@@ -205,6 +205,7 @@ def main() -> None:
     parser.add_argument("--seconds", type=float, default=10.0)
     parser.add_argument("--pairs", type=int, default=3,
                         help="(a) reference/sim_node measurements, alternated")
+    parser.add_argument("--real-time-only", action="store_true", help="(a) only")
     parser.add_argument("--preset", default="field_8p5in_shale")
     parser.add_argument("--reference-publisher", metavar="PRESET", help=argparse.SUPPRESS)
     parser.add_argument("--reference-period", type=float, default=0.01, help=argparse.SUPPRESS)
@@ -228,6 +229,8 @@ def main() -> None:
                   f"(reference {ref['received_per_s']:.0f})", flush=True)
         print(f"(a) CPU ratio, median of {len(ratios)} pairs: {float(np.median(ratios)):.2f}x "
               f"(range {min(ratios):.2f}-{max(ratios):.2f})", flush=True)
+        if args.real_time_only:
+            return
         ceiling_proc = start_reference(args.preset, period_s=0.0)
         ceiling = measure(listener, ceiling_proc, args.seconds)
         ceiling_rtf = reported_rate(ceiling_proc, ceiling["window"]) / 100.0
