@@ -420,9 +420,10 @@ def advance_and_sample(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile
                                exact)
     if status != STATUS_OK or rows >= out.shape[0]:
         return status, rows
+    one = np.int64(1)               # not the literal 1: that would compile advance twice
     advance(st.copy(), prm, tgt, profile if exact else profile.copy(),
-            hist.copy() if exact else hist, meta.copy(), acc.copy(), out[rows:rows + 1], 1, 1,
-            exact)
+            hist.copy() if exact else hist, meta.copy(), acc.copy(), out[rows:rows + 1], one,
+            one, exact)
     return status, rows + 1
 
 

@@ -34,6 +34,11 @@ class SampleSinks:
                        for with_clock, targets in self._targets.items()}
         self.recorder: Any = None
 
+    def warm_up(self, block: Block) -> None:
+        """Compile the packing (of ``block``) now rather than on the first tick."""
+        for frame in self._frames.values():
+            frame.pack(block.rows, block.stamps_ns)
+
     def emit(self, block: Block, with_clock: bool) -> None:
         """Publish (and record) every sample of ``block``, /clock too if ``with_clock``."""
         publishers, names = self._targets[with_clock], self._names[with_clock]
