@@ -111,8 +111,10 @@ class SimSession:
         self._perfect_sensors = self.sensors.perfect
         self._factors = field_scales(self.scales)
         self._samples = np.empty((2, k.N_COLS))   # kernel rows of a run (grows as needed)
-        self.sim.advance_into(self._samples, 0, self.steps, sample_end=True)  # compile now
-        self._block(self._samples[:1], 0)                                      # and this
+        # compile now, not on the first tick (no _block: it would move the sensors' noise)
+        self.sim.advance_into(self._samples, 0, self.steps, sample_end=True)
+        stamped_si_rows(self._samples[:1], 0.0, 0.0, self._factors, 0, self.period_ns, 0.0,
+                        NO_COMMAND_S)
         self.next_index = 0          # sample counter: stamps = index * period_ns
         # The severity window: snapshots of the kernel's running sums at the end of each of
         # its WINDOW_BUCKETS parts, the extremes restarted after each (no per-sample work).

@@ -190,7 +190,7 @@ class SimNode(Node):
         with self._lock.urgent():
             session = SimSession(session_config(self._values, self._preset))
             self._session = session
-            self._sinks.warm_up(session.current())
+            self._sinks.warm_up()
             self._pacer = Pacer(self._wall_period_ns(self._rtf))
             self._sinks.recorder = self._open_recorder(self._values["record.path"])
             self._publish_run_info()

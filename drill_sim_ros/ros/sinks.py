@@ -10,9 +10,11 @@ from __future__ import annotations
 
 from typing import Any
 
+import numpy as np
 from rclpy.publisher import Publisher
 
 from drill_sim_ros.model.session import Block
+from drill_sim_ros.model.telemetry import N_FIELDS
 from drill_sim_ros.ros.frame import SampleFrame
 
 # In free run the ticker waits while the recorder has this many messages queued (about 2 s
@@ -34,10 +36,10 @@ class SampleSinks:
                        for with_clock, targets in self._targets.items()}
         self.recorder: Any = None
 
-    def warm_up(self, block: Block) -> None:
-        """Compile the packing (of ``block``) now rather than on the first tick."""
+    def warm_up(self) -> None:
+        """Compile the packing now rather than on the first tick (packs a row of zeros)."""
         for frame in self._frames.values():
-            frame.pack(block.rows, block.stamps_ns)
+            frame.pack(np.zeros((1, N_FIELDS)), np.zeros(1, dtype=np.int64))
 
     def emit(self, block: Block, with_clock: bool) -> None:
         """Publish (and record) every sample of ``block``, /clock too if ``with_clock``."""
