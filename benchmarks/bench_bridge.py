@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import argparse
 import os
-import random
 import re
 import signal
 import subprocess
@@ -18,18 +17,10 @@ import tempfile
 import time
 from pathlib import Path
 
+from drill_sim_ros.ros.closed_loop import ros_environment
+
 BIN = Path(sys.prefix) / "bin"
 TICKS = os.sysconf("SC_CLK_TCK")
-
-
-def ros_environment() -> dict[str, str]:
-    """Loopback DDS, a domain of our own, the wheels' ament prefix (as tests/conftest.py)."""
-    env = dict(os.environ)
-    env["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
-    env.pop("ROS_LOCALHOST_ONLY", None)
-    env.setdefault("ROS_DOMAIN_ID", str(random.randint(1, 101)))
-    env.setdefault("AMENT_PREFIX_PATH", sys.prefix)
-    return env
 
 
 def cpu_seconds(pid: int) -> float:

@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import argparse
 import os
-import random
 import signal
 import socket
 import subprocess
@@ -27,21 +26,12 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
+from drill_sim_ros.ros.closed_loop import ros_environment  # noqa: E402
 from tests.viz.viewer_standin import ViewerStandIn  # noqa: E402
 
 BIN = Path(sys.prefix) / "bin"
 MIB = 1024 * 1024
 STOP_WAIT_S = 30.0
-
-
-def ros_environment() -> dict[str, str]:
-    """Loopback DDS, a domain of our own, the wheels' ament prefix (as tests/conftest.py)."""
-    env = dict(os.environ)
-    env["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
-    env.pop("ROS_LOCALHOST_ONLY", None)
-    env.setdefault("ROS_DOMAIN_ID", str(random.randint(1, 101)))
-    env.setdefault("AMENT_PREFIX_PATH", sys.prefix)
-    return env
 
 
 def free_port() -> int:
