@@ -8,7 +8,10 @@
 (b0) the ceiling of a free run, measured the same way: the reference publishing the same
     payloads as fast as it can (no simulation), as a real-time factor at 100 Hz;
 (b) free run (real_time_factor 0): achieved real-time factor (sim seconds per wall second),
-    and as a fraction of (b0); (c) the same with in-process recording (record.path).
+    and as a fraction of (b0); (c) the same with in-process recording (record.path);
+(d) (b0) and (b) again, first with the subscriber process idle (its subscriptions matched,
+    so Fast DDS still delivers to it, but it takes nothing and leaves the second core to the
+    publisher), then with no subscriber: what the subscriber costs on this 2-core machine.
 Targets (issue 10): (a) sim_node <= 1.5x the reference, p99 <= 2 ms; (b) >= 100x, and with
 recording >= a third of that.
 Usage: .venv/bin/python benchmarks/bench_node.py [--seconds 10] [--pairs 3]
@@ -20,6 +23,7 @@ from __future__ import annotations
 import argparse
 import os
 import random
+import select
 import signal
 import subprocess
 import sys
@@ -54,16 +58,17 @@ def cpu_seconds(pid: int) -> float:
 
 
 class Listener(Node):
-    """One subscription per published topic; keeps the last /diagnostics values."""
+    """One subscription per published topic (none with ``telemetry=False``: /diagnostics
+    only); keeps the last /diagnostics values."""
 
-    def __init__(self) -> None:
-        super().__init__("bench_listener")
+    def __init__(self, telemetry: bool = True) -> None:
+        super().__init__("bench_listener" if telemetry else "bench_watcher")
         self.count = 0
         self.diagnostics: dict[str, str] = {}
         # (wall s at receipt, the node's real_time_factor_achieved over its last second)
         self.rates: list[tuple[float, float]] = []
         qos = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE)
-        for topic in PUBLISHED:
+        for topic in PUBLISHED if telemetry else ():
             self.create_subscription(type_of(topic), topic, self._on_message, qos)
         self.create_subscription(type_of(topics.DIAGNOSTICS), topics.DIAGNOSTICS,
                                  self._on_diagnostics, qos)
@@ -165,6 +170,11 @@ def reported_rate(proc: subprocess.Popen, window: tuple[float, float]) -> float:
     return (n1 - n0) / (t1 - t0)
 
 
+def printed(proc: subprocess.Popen) -> bool:
+    """A ceiling publisher has printed its first figure (it is publishing)."""
+    return proc.stdout is not None and bool(select.select([proc.stdout], [], [], 0)[0])
+
+
 def stop(proc: subprocess.Popen) -> None:
     proc.send_signal(signal.SIGINT)
     try:
@@ -174,20 +184,26 @@ def stop(proc: subprocess.Popen) -> None:
         proc.wait()
 
 
-def measure(listener: Listener, proc: subprocess.Popen, seconds: float) -> dict[str, float]:
-    """CPU %, message rate and diagnostics of one running process over a steady window."""
+def measure(listener: Listener, proc: subprocess.Popen, seconds: float,
+            watcher: Listener | None = None) -> dict[str, float]:
+    """CPU %, message rate and diagnostics of one running process over a steady window. With
+    a ``watcher``, only it is spun during the window: the listener's subscriptions stay
+    matched (Fast DDS still delivers to them) but nothing takes their messages."""
+    spun = listener if watcher is None else watcher
     try:
         # start-up (numba compiles on a cold cache: tens of seconds), discovery, then 3 s
-        first = listener.count
+        first, reports = listener.count, len(spun.rates)
         end = time.monotonic() + 120.0
-        while listener.count == first and time.monotonic() < end:
-            rclpy.spin_once(listener, timeout_sec=0.05)
-        spin_for(listener, 3.0)
+        while not (listener.count > first or len(spun.rates) > reports
+                   or printed(proc)) and time.monotonic() < end:
+            rclpy.spin_once(listener, timeout_sec=0.025)
+            rclpy.spin_once(spun, timeout_sec=0.025)
+        spin_for(spun, 3.0)
         cpu0, wall0, n0 = cpu_seconds(proc.pid), time.monotonic(), listener.count
-        spin_for(listener, seconds)
+        spin_for(spun, seconds)
         cpu1, wall1, n1 = cpu_seconds(proc.pid), time.monotonic(), listener.count
-        spin_for(listener, 1.1)                       # the next /diagnostics
-        diag = dict(listener.diagnostics)
+        spin_for(spun, 1.1)                           # the next /diagnostics
+        diag = dict(spun.diagnostics)
     finally:
         stop(proc)
     wall = wall1 - wall0
@@ -196,7 +212,7 @@ def measure(listener: Listener, proc: subprocess.Popen, seconds: float) -> dict[
             "p50_ms": float(diag.get("tick_lateness_p50_ms", "nan")),
             "p99_ms": float(diag.get("tick_lateness_p99_ms", "nan")),
             "overruns": float(diag.get("overruns", "nan")),
-            "sim_rate": sim_rate(listener.rates, wall0, wall1),
+            "sim_rate": sim_rate(spun.rates, wall0, wall1),
             "rtf_reported": float(diag.get("real_time_factor_achieved", "nan"))}
 
 
@@ -249,6 +265,19 @@ def main() -> None:
         print(f"(c) free run, recording in process: achieved real-time factor "
               f"{rec['sim_rate']:.1f}x = {rec['sim_rate'] / free['sim_rate']:.2f} of (b); "
               f"CPU {rec['cpu_percent']:.0f} %")
+        watcher = Listener(telemetry=False)
+        for case, spun in (("the subscriber process idle (its subscriptions matched, "
+                            "nothing taken)", watcher), ("no subscriber", None)):
+            if spun is None:                      # no telemetry subscription at all
+                listener.destroy_node()
+                listener = spun = watcher
+            top_proc = start_reference(args.preset, period_s=0.0)
+            top = measure(listener, top_proc, args.seconds, watcher=spun)
+            top_rtf = reported_rate(top_proc, top["window"]) / 100.0
+            run = measure(listener, start_node(args.preset, 0.0), args.seconds, watcher=spun)
+            print(f"(d) with {case}: ceiling {top_rtf:.1f}x, free run {run['sim_rate']:.1f}x "
+                  f"= {run['sim_rate'] / top_rtf:.2f} of it; CPU reference "
+                  f"{top['cpu_percent']:.0f} %, sim_node {run['cpu_percent']:.0f} %", flush=True)
     finally:
         listener.destroy_node()
         rclpy.try_shutdown()
