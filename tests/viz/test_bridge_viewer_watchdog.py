@@ -11,8 +11,13 @@ from __future__ import annotations
 import signal
 import threading
 import time
+from collections.abc import Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
+import numpy as np
 import pytest
 
 from drill_sim_ros.model.presets import load_preset
@@ -62,20 +67,48 @@ def warnings(bridge: BridgeProcess) -> list[str]:
     return [line for line in bridge.lines if "[WARN]" in line and "[rerun_bridge]" in line]
 
 
-def test_a_viewer_gone_mid_run_is_cut_then_reconnected(tmp_path: Path) -> None:
-    rows = telemetry_rows(load_preset("field_8p5in_shale"), 120.0)    # 30 s at RATE_HZ
-    rrd = tmp_path / "live.rrd"
+@dataclass
+class LiveRun:
+    """A viewer stand-in listening, a bridge saving ``rrd`` and streaming to it, and a feeder
+    publishing ``rows`` at RATE_HZ, the bridge already logging; ``code``: the bridge's exit
+    status once the ``with`` block has ended."""
+
+    rows: np.ndarray
+    rrd: Path
+    viewer: ViewerStandIn
+    bridge: BridgeProcess
+    feeder: threading.Thread
+    code: int | None = None
+
+
+@contextmanager
+def live_run(tmp_path: Path, sim_seconds: float, **stop: Any) -> Iterator[LiveRun]:
+    """Start a :class:`LiveRun` of ``sim_seconds`` of the field preset's telemetry; at the
+    end close the publisher, stop the bridge (``stop``: BridgeProcess.stop's arguments) and
+    kill the viewer."""
+    rows = telemetry_rows(load_preset("field_8p5in_shale"), sim_seconds)
     viewer = ViewerStandIn(free_port())
     viewer.start()
     topic = private_topic()
-    bridge = BridgeProcess("--save", str(rrd), "--connect", viewer.url,
-                           *remap_telemetry(topic))
+    rrd = tmp_path / "live.rrd"
+    bridge = BridgeProcess("--save", str(rrd), "--connect", viewer.url, *remap_telemetry(topic))
     publisher = TelemetryPublisher(topic)
     feeder = threading.Thread(target=publisher.publish, args=(rows, RATE_HZ), daemon=True)
+    run = LiveRun(rows, rrd, viewer, bridge, feeder)
     try:
         assert publisher.wait_for_subscriber(30.0), bridge.output()
         feeder.start()
         assert bridge.wait_logged(400, 30.0), bridge.output()
+        yield run
+    finally:
+        publisher.close()
+        run.code = bridge.stop(**stop)
+        viewer.kill()
+
+
+def test_a_viewer_gone_mid_run_is_cut_then_reconnected(tmp_path: Path) -> None:
+    with live_run(tmp_path, 120.0, signum=signal.SIGINT) as run:    # 30 s at RATE_HZ
+        bridge, viewer, rows = run.bridge, run.viewer, run.rows
         growth_with_viewer, _, streamed_bytes_s = run_on(bridge, viewer, AWAY_S)
 
         viewer.kill()
@@ -85,13 +118,10 @@ def test_a_viewer_gone_mid_run_is_cut_then_reconnected(tmp_path: Path) -> None:
         viewer.start()
         assert wait_output(bridge, BACK, 10.0), bridge.output()
         received = viewer.wait_receiving(int(streamed_bytes_s), 10.0)
-        feeder.join(timeout=60.0)
-        assert not feeder.is_alive()
+        run.feeder.join(timeout=60.0)
+        assert not run.feeder.is_alive()
         assert bridge.wait_logged(len(rows), 30.0), bridge.output()
-    finally:
-        publisher.close()
-        code = bridge.stop(signum=signal.SIGINT)
-        viewer.kill()
+    code, rrd = run.code, run.rrd
     out = bridge.output()
     assert code == 0, out
     assert "Traceback" not in out
@@ -135,31 +165,18 @@ def test_a_viewer_started_after_the_bridge_is_connected(tmp_path: Path) -> None:
 
 
 def test_a_viewer_that_stops_reading_is_cut_and_the_bridge_still_stops(tmp_path: Path) -> None:
-    rows = telemetry_rows(load_preset("field_8p5in_shale"), 100.0)    # 25 s at RATE_HZ
-    rrd = tmp_path / "live.rrd"
-    viewer = ViewerStandIn(free_port())
-    viewer.start()
-    topic = private_topic()
-    bridge = BridgeProcess("--save", str(rrd), "--connect", viewer.url,
-                           *remap_telemetry(topic))
-    publisher = TelemetryPublisher(topic)
-    feeder = threading.Thread(target=publisher.publish, args=(rows, RATE_HZ), daemon=True)
-    try:
-        assert publisher.wait_for_subscriber(30.0), bridge.output()
-        feeder.start()
-        assert bridge.wait_logged(400, 30.0), bridge.output()
-        growth_with_viewer, _, streamed_bytes_s = run_on(bridge, viewer, AWAY_S)
+    # 25 s at RATE_HZ; SIGINT must stop the bridge within 10 s, else SIGKILL: rc -9
+    with live_run(tmp_path, 100.0, timeout_s=10.0, signum=signal.SIGINT) as run:
+        bridge, rows = run.bridge, run.rows
+        growth_with_viewer, _, streamed_bytes_s = run_on(bridge, run.viewer, AWAY_S)
 
-        viewer.freeze()
+        run.viewer.freeze()
         assert wait_output(bridge, "does not read", 10.0), bridge.output()
         growth_frozen, logged_frozen, _ = run_on(bridge, None, AWAY_S)
-        feeder.join(timeout=60.0)
-        assert not feeder.is_alive()
+        run.feeder.join(timeout=60.0)
+        assert not run.feeder.is_alive()
         assert bridge.wait_logged(len(rows), 30.0), bridge.output()
-    finally:
-        publisher.close()
-        code = bridge.stop(timeout_s=10.0, signum=signal.SIGINT)   # else SIGKILL: rc -9
-        viewer.kill()
+    code, rrd = run.code, run.rrd
     out = bridge.output()
     assert code == 0, out
     assert logged_frozen >= 0.5 * RATE_HZ * AWAY_S, out
@@ -170,27 +187,14 @@ def test_a_viewer_that_stops_reading_is_cut_and_the_bridge_still_stops(tmp_path:
 
 
 def test_a_viewer_restarted_at_once_is_reconnected(tmp_path: Path) -> None:
-    rows = telemetry_rows(load_preset("field_8p5in_shale"), 60.0)     # 15 s at RATE_HZ
-    viewer = ViewerStandIn(free_port())
-    viewer.start()
-    topic = private_topic()
-    bridge = BridgeProcess("--save", str(tmp_path / "live.rrd"), "--connect", viewer.url,
-                           *remap_telemetry(topic))
-    publisher = TelemetryPublisher(topic)
-    feeder = threading.Thread(target=publisher.publish, args=(rows, RATE_HZ), daemon=True)
-    try:
-        assert publisher.wait_for_subscriber(30.0), bridge.output()
-        feeder.start()
-        assert bridge.wait_logged(400, 30.0), bridge.output()
+    with live_run(tmp_path, 60.0) as run:                             # 15 s at RATE_HZ
+        bridge, viewer = run.bridge, run.viewer
         viewer.kill()
         viewer.start()          # back within about 2 s: a probe or the failed flush notices
         assert wait_output(bridge, BACK, 10.0), bridge.output()
         received = viewer.wait_receiving(STATIC_BYTES, 10.0)
-        feeder.join(timeout=60.0)
-    finally:
-        publisher.close()
-        code = bridge.stop()
-        viewer.kill()
+        run.feeder.join(timeout=60.0)
+    code = run.code
     out = bridge.output()
     assert code == 0, out
     assert len(warnings(bridge)) == 1 and out.count(BACK) == 1, out
