@@ -17,16 +17,11 @@ import tempfile
 import time
 from pathlib import Path
 
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))   # for tests.process_probes
 from drill_sim_ros.ros.closed_loop import ros_environment
+from tests.process_probes import cpu_seconds
 
 BIN = Path(sys.prefix) / "bin"
-TICKS = os.sysconf("SC_CLK_TCK")
-
-
-def cpu_seconds(pid: int) -> float:
-    """utime + stime of a process, in seconds."""
-    fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
-    return (int(fields[11]) + int(fields[12])) / TICKS
 
 
 def logged(text: str) -> int:

@@ -46,15 +46,11 @@ from rclpy.qos import QoSProfile, ReliabilityPolicy
 from drill_sim_ros import topics
 from drill_sim_ros.ros.messages import type_of
 
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))   # for tests.process_probes
+from tests.process_probes import cpu_seconds
+
 BIN = Path(sys.prefix) / "bin"
-TICKS = os.sysconf("SC_CLK_TCK")
 PUBLISHED = [t for t in topics.MSG_TYPES if t not in topics.COMMANDS]
-
-
-def cpu_seconds(pid: int) -> float:
-    """utime + stime of a process, in seconds."""
-    fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
-    return (int(fields[11]) + int(fields[12])) / TICKS
 
 
 class Listener(Node):

@@ -17,7 +17,6 @@ from __future__ import annotations
 import argparse
 import os
 import signal
-import socket
 import subprocess
 import sys
 import tempfile
@@ -27,24 +26,12 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 from drill_sim_ros.ros.closed_loop import ros_environment  # noqa: E402
+from tests.process_probes import free_port, rss_bytes  # noqa: E402
 from tests.viz.viewer_standin import ViewerStandIn  # noqa: E402
 
 BIN = Path(sys.prefix) / "bin"
 MIB = 1024 * 1024
 STOP_WAIT_S = 30.0
-
-
-def free_port() -> int:
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        return sock.getsockname()[1]
-
-
-def rss_bytes(pid: int) -> int:
-    for line in Path(f"/proc/{pid}/status").read_text().splitlines():
-        if line.startswith("VmRSS:"):
-            return int(line.split()[1]) * 1024
-    return 0
 
 
 def bridge_command(src: Path | None) -> list[str]:

@@ -159,13 +159,13 @@ class SimSession:
         """SI block of kernel rows, the first stamped ``first_index * period_ns``."""
         command_s = NO_COMMAND_S if self.command_stamp_ns is None else \
             self.command_stamp_ns / NS_PER_S
-        depth_offset, angle_offset = self.sim.offsets
-        rows, stamps_ns = stamped_si_rows(samples, depth_offset, angle_offset, self._factors,
+        offsets = self.sim.offsets
+        rows, stamps_ns = stamped_si_rows(samples, offsets[0], offsets[1], self._factors,
                                           first_index * self.period_ns, self.period_ns,
                                           float(self.submerged_weight_n), command_s)
         if not self._perfect_sensors:          # si_rows gives the truth, perfect sensors
             rows[:, MEASURED] = self.sensors.measure(surface_truth(rows))
-        return Block(rows, stamps_ns, self.sim.offsets)
+        return Block(rows, stamps_ns, offsets)
 
     def _advanced(self, count: int) -> None:
         """Count ``count`` samples advanced and take the severity window's snapshot when it

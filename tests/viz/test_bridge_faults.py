@@ -12,10 +12,10 @@ from pathlib import Path
 import pytest
 
 from drill_sim_ros.model.presets import load_preset
+from tests.process_probes import free_port
 from tests.viz.bridge_process import bridge_logs
 from tests.viz.rrd_read import read_recording
 from tests.viz.sim_telemetry import telemetry_rows
-from tests.viz.test_serve_loopback import free_port
 
 pytestmark = pytest.mark.ros
 

@@ -21,11 +21,11 @@ import numpy as np
 import pytest
 
 from drill_sim_ros.model.presets import load_preset
+from tests.process_probes import free_port, rss_bytes
 from tests.viz.bridge_process import BridgeProcess, private_topic, remap_telemetry
 from tests.viz.rrd_read import read_recording
 from tests.viz.sim_telemetry import telemetry_rows
 from tests.viz.telemetry_publisher import TelemetryPublisher
-from tests.viz.test_serve_loopback import free_port
 from tests.viz.viewer_standin import ViewerStandIn
 
 pytestmark = pytest.mark.ros
@@ -35,13 +35,6 @@ AWAY_S = 8.0             # how long the bridge runs on without a viewer (4 check
 STATIC_BYTES = 10_000     # far more than a gRPC handshake; the layout and static views
 GONE = "stopped listening"
 BACK = ": streaming from sim_time"
-
-
-def rss_bytes(pid: int) -> int:
-    for line in Path(f"/proc/{pid}/status").read_text().splitlines():
-        if line.startswith("VmRSS:"):
-            return int(line.split()[1]) * 1024
-    raise RuntimeError(f"no VmRSS for {pid}")
 
 
 def wait_output(bridge: BridgeProcess, text: str, timeout_s: float) -> bool:
@@ -79,6 +72,12 @@ class LiveRun:
     bridge: BridgeProcess
     feeder: threading.Thread
     code: int | None = None
+
+    def feed_to_the_end(self) -> None:
+        """Wait for the feeder to publish every row and the bridge to log them all."""
+        self.feeder.join(timeout=60.0)
+        assert not self.feeder.is_alive()
+        assert self.bridge.wait_logged(len(self.rows), 30.0), self.bridge.output()
 
 
 @contextmanager
@@ -118,9 +117,7 @@ def test_a_viewer_gone_mid_run_is_cut_then_reconnected(tmp_path: Path) -> None:
         viewer.start()
         assert wait_output(bridge, BACK, 10.0), bridge.output()
         received = viewer.wait_receiving(int(streamed_bytes_s), 10.0)
-        run.feeder.join(timeout=60.0)
-        assert not run.feeder.is_alive()
-        assert bridge.wait_logged(len(rows), 30.0), bridge.output()
+        run.feed_to_the_end()
     code, rrd = run.code, run.rrd
     out = bridge.output()
     assert code == 0, out
@@ -173,9 +170,7 @@ def test_a_viewer_that_stops_reading_is_cut_and_the_bridge_still_stops(tmp_path:
         run.viewer.freeze()
         assert wait_output(bridge, "does not read", 10.0), bridge.output()
         growth_frozen, logged_frozen, _ = run_on(bridge, None, AWAY_S)
-        run.feeder.join(timeout=60.0)
-        assert not run.feeder.is_alive()
-        assert bridge.wait_logged(len(rows), 30.0), bridge.output()
+        run.feed_to_the_end()
     code, rrd = run.code, run.rrd
     out = bridge.output()
     assert code == 0, out

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import socket
-import time
 from pathlib import Path
 
 import pytest
@@ -12,36 +10,8 @@ from drill_sim_ros.viz.blueprint import build_blueprint
 from drill_sim_ros.viz.frames import Extents, view_frames
 from drill_sim_ros.viz.paper_units import PaperUnits
 from drill_sim_ros.viz.recording import close_recording, open_recording
+from tests.process_probes import free_port, wait_listening
 from tests.viz.bridge_process import BridgeProcess
-
-LISTEN = "0A"
-
-
-def free_port() -> int:
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        return sock.getsockname()[1]
-
-
-def listening_addresses(port: int) -> set[str]:
-    """Hex local addresses (as in /proc/net/tcp*) listening on ``port``."""
-    found = set()
-    for table in ("/proc/net/tcp", "/proc/net/tcp6"):
-        for line in Path(table).read_text().splitlines()[1:]:
-            fields = line.split()
-            address, port_hex = fields[1].rsplit(":", 1)
-            if int(port_hex, 16) == port and fields[3] == LISTEN:
-                found.add(address)
-    return found
-
-
-def wait_listening(port: int, timeout_s: float) -> set[str]:
-    deadline = time.monotonic() + timeout_s
-    while time.monotonic() < deadline:
-        if found := listening_addresses(port):
-            return found
-        time.sleep(0.05)
-    return set()
 
 
 def test_open_recording_serves_on_loopback_only() -> None:

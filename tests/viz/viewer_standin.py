@@ -18,7 +18,7 @@ import sys
 import time
 from pathlib import Path
 
-from tests.viz.test_serve_loopback import wait_listening
+from tests.process_probes import wait_listening
 
 READY = "listening"
 ROOT = Path(__file__).resolve().parents[2]
