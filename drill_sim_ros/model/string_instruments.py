@@ -82,10 +82,11 @@ def send_pulse_from_bit(sim: Simulator, axial: bool, amplitude: float,
     n, off, pos = (int(wave_i[sg.W_LEN, j]), int(wave_i[sg.W_OFF, j]),
                    int(wave_i[sg.W_POS, j]))
     cells = np.arange(min(n, int(8 * width_steps) + 1))
-    shape = amplitude * np.exp(-0.5 * (cells / width_steps) ** 2)
-    image = amplitude * np.exp(-0.5 * ((cells + 1) / width_steps) ** 2)
-    wave[off + n + (pos - 1 - cells) % n] += shape      # b, k cells above the bit
-    wave[off + (pos + cells) % n] -= image              # a, k cells above the bit
+    # b in the cell k above the bit left it k + 1 steps ago; a in the cell k above it
+    # reaches it in k steps and leaves again as b = -a: the centre is at the bit now
+    wave[off + n + (pos - 1 - cells) % n] += amplitude * np.exp(
+        -0.5 * ((cells + 1) / width_steps) ** 2)
+    wave[off + (pos + cells) % n] -= amplitude * np.exp(-0.5 * (cells / width_steps) ** 2)
 
 
 def _peaks_hz(signal: np.ndarray, sample_hz: float, count: int, f_min_hz: float) -> list[float]:
