@@ -19,6 +19,7 @@ from dataclasses import dataclass, fields
 from pathlib import Path
 from typing import Any, TextIO
 
+from drill_sim_ros import string_cli
 from drill_sim_ros.control import closed_loop_cli
 from drill_sim_ros.model import analysis, telemetry
 from drill_sim_ros.model import kernel as k
@@ -118,6 +119,7 @@ def build_parser() -> argparse.ArgumentParser:
     info = sub.add_parser("info", help="groups, scales and stability of a preset")
     info.add_argument("preset", nargs="?", default="field_8p5in_shale")
     study_cli.add_parsers(sub, _add_model_args)
+    string_cli.add_parsers(sub)
     return parser
 
 
@@ -403,7 +405,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         return {"run": _cmd_run, "sweep": _cmd_sweep, "info": _cmd_info,
                 "closed-loop": closed_loop_cli.cmd_closed_loop,
                 "map-plot": study_cli.cmd_map_plot,
-                "figures": study_cli.cmd_figures}[args.command](args)
+                "figures": study_cli.cmd_figures, "modes": string_cli.cmd_modes,
+                "reflection": string_cli.cmd_reflection}[args.command](args)
     except DrillSimError as exc:
         print(f"drill_sim: error: {exc}", file=sys.stderr)
         return 2
