@@ -420,10 +420,13 @@ def advance_and_sample(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile
         advance(st.copy(), prm, tgt, profile if exact else profile.copy(),
                 hist.copy() if exact else hist, meta.copy(), acc.copy(), out[rows:rows + 1],
                 wave, wave_i, wave_f, one, one, exact)
-    else:
+    else:                           # one step undone: the slots it writes, the positions
+        slots = sg.step_slots(wave_i)
+        saved = wave[slots]
         advance(st.copy(), prm, tgt, profile if exact else profile.copy(),
                 hist.copy() if exact else hist, meta.copy(), acc.copy(), out[rows:rows + 1],
-                wave.copy(), wave_i.copy(), wave_f, one, one, exact)
+                wave, wave_i.copy(), wave_f, one, one, exact)
+        wave[slots] = saved
     return status, rows + 1
 
 

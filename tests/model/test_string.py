@@ -245,3 +245,22 @@ def test_damping_rate_sets_the_mode_damping_ratio() -> None:
     rate = -np.polyfit(peaks_t, np.log(peaks_a), 1)[0]
     assert rate == pytest.approx(gamma / 2, rel=0.1)          # zeta omega1 = gamma / 2
     assert omega1 > 0
+
+
+def test_the_end_sample_leaves_the_distributed_string_untouched() -> None:
+    """advance_into with sample_end takes one step on the side and undoes it: the run goes
+    on exactly as one that never sampled."""
+    preset = load_preset("field_8p5in_shale")
+    sims = [Simulator(preset.params, SimConfig(dtau=1e-4), perturb_v=1e-3,
+                      top_drive=preset.top_drive, scales=preset.scales,
+                      string=preset.kernel_string) for _ in range(2)]
+    out = np.empty((400, k.N_COLS))
+    for _ in range(20):
+        sims[0].advance_into(out, 136, 136, sample_end=True)
+        sims[1].advance(136)
+    assert np.array_equal(sims[0].state, sims[1].state)
+    assert np.array_equal(sims[0].string_arrays()[0], sims[1].string_arrays()[0])
+    assert np.array_equal(sims[0].string_arrays()[1], sims[1].string_arrays()[1])
+    end = out[1]                                  # the end sample of the last run
+    step = sims[1].advance(1, every=1).data[0]    # what the next step records at its start
+    assert np.array_equal(end, step)
