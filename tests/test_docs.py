@@ -6,8 +6,9 @@
   and an anchor (``page.md#heading``) to a heading of that page (GitHub's slugs).
 - Every ``docs/...`` or ``config/...`` path named in a comment of config/ or in the source,
   tests and benchmarks exists (with its anchor).
-- Every ``path.py::name`` the docs name (the equation table of docs/model.md) is a function,
-  class or constant of that file.
+- Every file the docs name in code (``model/session.py``, ``fig8b.yaml``) exists, and every
+  ``path.py::name`` (the equation table of docs/model.md) is a function, class or constant
+  of that file.
 """
 
 from __future__ import annotations
@@ -38,6 +39,7 @@ HEADING = re.compile(r"^#{1,6}\s+(.*?)\s*#*\s*$", re.MULTILINE)
 REPO_PATH = re.compile(r"\b((?:docs|config|drill_sim_ros|tests|benchmarks)/[\w./-]*\w)"
                        r"(#[\w-]+)?")
 CODE_REF = re.compile(r"`([\w/]+\.py)::([\w.]+)`")
+FILE_NAME = re.compile(r"`([\w./-]+\.(?:py|yaml|md|xml|mjs))(?:::[\w.]+)?`")
 SOURCE_DIRS = ("drill_sim_ros", "tests", "benchmarks")
 
 
@@ -143,6 +145,15 @@ def _name_of(node: ast.stmt) -> set[str]:
     return set()
 
 
+def missing_files(page: Path, root: Path = ROOT) -> list[str]:
+    """Each file named in a code span of ``page`` that is nowhere it could mean: the
+    repository root, the package or one of its folders, the page's folder, the presets."""
+    folders = [root, root / "drill_sim_ros", page.parent, root / "config" / "presets",
+               *sorted(p for p in (root / "drill_sim_ros").glob("*") if p.is_dir())]
+    return [name for name in FILE_NAME.findall(page.read_text(encoding="utf-8"))
+            if not any((folder / name).exists() for folder in folders)]
+
+
 def broken_code_refs(text: str, root: Path = ROOT) -> list[str]:
     problems = []
     for path_part, name in CODE_REF.findall(text):
@@ -183,6 +194,11 @@ def test_every_link_resolves(page: Path) -> None:
 @pytest.mark.parametrize("page", PAGES, ids=lambda p: p.relative_to(ROOT).as_posix())
 def test_every_named_function_exists(page: Path) -> None:
     assert broken_code_refs(page.read_text(encoding="utf-8")) == []
+
+
+@pytest.mark.parametrize("page", PAGES, ids=lambda p: p.relative_to(ROOT).as_posix())
+def test_every_named_file_exists(page: Path) -> None:
+    assert missing_files(page) == []
 
 
 def test_config_comments_point_to_what_exists() -> None:
@@ -244,3 +260,8 @@ def test_checks_find_missing_code_and_paths(tmp_path: Path) -> None:
     (tmp_path / "docs").mkdir()
     assert broken_repo_paths("see docs/none.md and docs", tmp_path) == [
         "docs/none.md: no such file"]
+    (tmp_path / "drill_sim_ros" / "model").mkdir(parents=True)
+    (tmp_path / "drill_sim_ros" / "model" / "kernel.py").write_text("")
+    page = tmp_path / "docs" / "p.md"
+    page.write_text("`kernel.py` `model/kernel.py` `m.py::f` `model/gone.py` `run.mcap`\n")
+    assert missing_files(page, tmp_path) == ["model/gone.py"]
