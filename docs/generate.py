@@ -38,8 +38,8 @@ def _number(value: float) -> str:
         return "true" if value else "false"
     if isinstance(value, int):
         return str(value)
-    if math.isinf(value):
-        return "inf"
+    if not math.isfinite(value):
+        return str(value)              # inf, -inf, nan
     if value == int(value) and abs(value) < 1e7:
         return str(int(value))
     return f"{value:.6g}"
@@ -48,7 +48,11 @@ def _number(value: float) -> str:
 def _value(value: Any) -> str:
     if isinstance(value, str):
         return f'"{value}"' if value == "" else value
-    return _number(value)
+    if isinstance(value, (bool, int, float)):
+        return _number(value)
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(_value(v) for v in value) + "]"
+    return str(value)
 
 
 def unit_of(name: str, description: str) -> str:
