@@ -55,9 +55,13 @@ def _value(value: Any) -> str:
     return str(value)
 
 
-def unit_of(name: str, description: str) -> str:
-    """The unit the description names in square brackets, else the one the name ends in
-    (``publish_rate_hz``: Hz), else "–" (dimensionless, or not a number)."""
+def unit_of(spec: Any) -> str:
+    """The spec's own unit if it has one, else the unit its description names in square
+    brackets, else the one its name ends in (``publish_rate_hz``: Hz), else "–"."""
+    own = getattr(spec, "unit", None)
+    if own is not None:
+        return own
+    name, description = spec.name, spec.description
     found = UNIT_IN_TEXT.search(description)
     if found:
         return found.group(1)
@@ -90,7 +94,7 @@ def parameter_table() -> str:
     rows = ["| name | type | unit | range | default | runtime | meaning |",
             "| --- | --- | --- | --- | --- | --- | --- |"]
     for spec in SPECS:
-        cells = (f"`{spec.name}`", spec.kind, unit_of(spec.name, spec.description), _range(spec),
+        cells = (f"`{spec.name}`", spec.kind, unit_of(spec), _range(spec),
                  _default(spec, preset), "no" if spec.read_only else "yes",
                  spec.description)
         rows.append("| " + " | ".join(_cell(c) for c in cells) + " |")
