@@ -7,8 +7,8 @@ exits 1 when a page differs from what the script would write (tests/test_docs.py
 same).
 
 Sources: ``SPECS`` of ``drill_sim_ros/ros/parameters.py`` (the parameter table) and
-``MSG_TYPES`` / ``DESCRIPTIONS`` of ``drill_sim_ros/topics.py`` with the QoS sim_node uses
-(the topic table).
+``MSG_TYPES``, ``DESCRIPTIONS``, ``JOINTS`` and ``JOINT_FIELDS`` of ``drill_sim_ros/topics.py``
+with the QoS sim_node uses (the topic table).
 """
 
 from __future__ import annotations
@@ -107,6 +107,21 @@ def _qos_text(profile: Any) -> str:
             f"keep-last {profile.depth}")
 
 
+def _content(topic: str) -> str:
+    """The topic's description, then what each joint's position, velocity, effort mean."""
+    from drill_sim_ros import topics
+
+    text = topics.DESCRIPTIONS[topic]
+    if topic not in topics.JOINTS:
+        return text
+    fields = topics.JOINT_FIELDS.get(topic, {})
+    joints = topics.JOINTS[topic]
+    if tuple(fields) != joints:
+        raise ValueError(f"topics.JOINT_FIELDS[{topic}] describes {tuple(fields)}, "
+                         f"the topic carries {joints}")
+    return text + ": " + "; ".join(f"`{j}` [{', '.join(fields[j])}]" for j in joints)
+
+
 def topic_table() -> str:
     """One row per topic of ``topics.MSG_TYPES``: direction, type, QoS, content."""
     from drill_sim_ros import topics
@@ -121,7 +136,7 @@ def topic_table() -> str:
         subscribed = topic in topics.COMMANDS
         qos = COMMAND_QOS if subscribed else SimNode._qos(topic)
         cells = (f"`{topic}`", "subscribes" if subscribed else "publishes",
-                 msg_type.replace("/msg/", "/"), _qos_text(qos), topics.DESCRIPTIONS[topic])
+                 msg_type.replace("/msg/", "/"), _qos_text(qos), _content(topic))
         rows.append("| " + " | ".join(_cell(c) for c in cells) + " |")
     return "\n".join(rows)
 

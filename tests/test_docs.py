@@ -265,3 +265,17 @@ def test_checks_find_missing_code_and_paths(tmp_path: Path) -> None:
     page = tmp_path / "docs" / "p.md"
     page.write_text("`kernel.py` `model/kernel.py` `m.py::f` `model/gone.py` `run.mcap`\n")
     assert missing_files(page, tmp_path) == ["model/gone.py"]
+
+
+def test_generator_refuses_an_undescribed_topic_or_joint(monkeypatch: pytest.MonkeyPatch) -> None:
+    from drill_sim_ros import topics
+
+    generator = _load_generator()
+    monkeypatch.setitem(topics.JOINTS, topics.SURFACE_MEASURED,
+                        (*topics.MEASURED_JOINTS, "hook"))
+    with pytest.raises(ValueError, match="JOINT_FIELDS"):
+        generator.topic_table()
+    monkeypatch.undo()
+    monkeypatch.delitem(topics.DESCRIPTIONS, topics.CLOCK)
+    with pytest.raises(ValueError, match="DESCRIPTIONS has no entry for /clock"):
+        generator.topic_table()
