@@ -9,6 +9,7 @@
 - Every file the docs name in code (``model/session.py``, ``fig8b.yaml``) exists, and every
   ``path.py::name`` (the equation table of docs/model.md) is a function, class or constant
   of that file.
+- config/sim.yaml sets only parameters that sim_node has, each to a value it accepts.
 """
 
 from __future__ import annotations
@@ -279,3 +280,26 @@ def test_generator_refuses_an_undescribed_topic_or_joint(monkeypatch: pytest.Mon
     monkeypatch.delitem(topics.DESCRIPTIONS, topics.CLOCK)
     with pytest.raises(ValueError, match="DESCRIPTIONS has no entry for /clock"):
         generator.topic_table()
+
+
+def _flatten(tree: dict, prefix: str = "") -> dict[str, object]:
+    flat: dict[str, object] = {}
+    for key, value in tree.items():
+        name = f"{prefix}{key}"
+        flat.update(_flatten(value, name + ".") if isinstance(value, dict) else {name: value})
+    return flat
+
+
+def test_sim_yaml_sets_only_parameters_that_exist_with_valid_values() -> None:
+    import yaml
+
+    from drill_sim_ros.ros.parameters import SPEC_BY_NAME, validate
+
+    tree = yaml.safe_load((ROOT / "config" / "sim.yaml").read_text(encoding="utf-8"))
+    (node_key,) = tree                       # one node: drill_sim (in any namespace)
+    values = _flatten(tree[node_key]["ros__parameters"])
+    assert values, "config/sim.yaml sets no parameter"
+    unknown = sorted(set(values) - set(SPEC_BY_NAME))
+    assert unknown == [], f"config/sim.yaml sets parameters sim_node does not have: {unknown}"
+    reasons = [validate(SPEC_BY_NAME[name], value) for name, value in values.items()]
+    assert [r for r in reasons if r is not None] == []
