@@ -32,7 +32,7 @@ PAGES_IN_PROGRESS = {"docs/control-loop.md", "docs/ros.md", "docs/when-things-go
                      "docs/league.md", "docs/string.md"}
 README_MAX_LINES = 200
 
-FENCE = re.compile(r"^(```|~~~).*?^\1", re.MULTILINE | re.DOTALL)
+FENCE = re.compile(r"^[ \t]*(```|~~~).*?^[ \t]*\1", re.MULTILINE | re.DOTALL)
 CODE_SPAN = re.compile(r"`[^`\n]*`")
 LINK = re.compile(r"!?\[(?:[^\[\]]|\[[^\]]*\])*\]\(\s*<?([^)\s>]+)>?(?:\s+\"[^\"]*\")?\s*\)")
 HTML_SRC = re.compile(r"<(?:img|a)\s[^>]*?(?:src|href)=\"([^\"]+)\"")
@@ -237,7 +237,8 @@ def test_checks_find_dead_links_and_anchors(tmp_path: Path) -> None:
     page.write_text("[ok](docs/a.md#the-top-drive-eq-12) ![img](docs/none.png) "
                     "[gone](docs/b.md) [bad](docs/a.md#nowhere) [self](#title-x) "
                     "[web](https://example.org/x) `[code](docs/c.md)`\n"
-                    "```\n[fenced](docs/d.md)\n```\n[wip](docs/wip.md)\n")
+                    "```\n[fenced](docs/d.md)\n```\n  ```\n  [indented](docs/e.md)\n  ```\n"
+                    "[wip](docs/wip.md)\n")
     assert broken_links(page, tmp_path, in_progress={"docs/wip.md"}) == [
         "docs/none.png: no such file", "docs/b.md: no such file",
         "docs/a.md#nowhere: docs/a.md has no heading #nowhere",
