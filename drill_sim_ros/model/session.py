@@ -92,7 +92,8 @@ def build_simulator(cfg: SessionConfig, period_tau: float, steps: int) -> Simula
     config = SimConfig(dtau=period_tau / steps, n_nodes=cfg.n_nodes, omega_rate=omega_rate,
                        w_rate=w_rate)
     drive = cfg.preset.top_drive if cfg.top_drive is None else cfg.top_drive.scaled(sc)
-    return Simulator(params, config, perturb_v=cfg.perturb_v, top_drive=drive, scales=sc)
+    return Simulator(params, config, perturb_v=cfg.perturb_v, top_drive=drive, scales=sc,
+                     string=cfg.preset.kernel_string)
 
 
 class SimSession:

@@ -96,6 +96,36 @@ def drive_acceleration(motor: float, t_string: float, inertia: float) -> float:
     return (motor - t_string) / inertia
 
 
+@njit(cache=True, inline="always")
+def motor_lag(previous: float, command: float, alpha: float) -> float:
+    """First-order motor torque lag (the drive's torque bandwidth): the torque moves by
+    ``alpha = 1 - exp(-dtau / lag)`` of the way to the command each step (1: no lag)."""
+    if alpha >= 1.0:
+        return command
+    return previous + alpha * (command - previous)
+
+
+@njit(cache=True, inline="always")
+def drive_step(mode: int, omega_s: float, omega_ref: float, integral: float, motor: float,
+               t_string: float, tgt_omega: float, tgt_torque: float, omega_rate: float,
+               inertia: float, kp: float, ki: float, max_torque: float, lag_alpha: float,
+               dt: float) -> tuple[float, float, float, float]:
+    """One step of the drive in its mode, against the string torque ``t_string`` at the
+    quill: ``(omega_s at the end of the step, omega_ref, integral, motor torque)``."""
+    if mode == TD_KINEMATIC:                  # the paper's imposed speed
+        omega_next = ramp(omega_s, tgt_omega, omega_rate, dt)
+        return omega_next, omega_next, integral, kinematic_torque(omega_s, omega_next,
+                                                                  t_string, inertia, dt)
+    omega_ref = ramp(omega_ref, tgt_omega, omega_rate, dt)   # an inertia turned by a motor
+    if mode == TD_SPEED:
+        command, integral = speed_loop(omega_ref, omega_s, integral, kp, ki, max_torque, dt)
+    else:
+        command = torque_command(tgt_torque, max_torque)
+    motor = motor_lag(motor, command, lag_alpha)
+    return (omega_s + drive_acceleration(motor, t_string, inertia) * dt, omega_ref, integral,
+            motor)
+
+
 # ---- parameters -------------------------------------------------------------------------
 @dataclass(frozen=True)
 class TopDrive:

@@ -19,7 +19,7 @@ from drill_sim_ros.model.presets import load_preset
 from drill_sim_ros.model.telemetry import N_FIELDS, TELEMETRY_INDEX
 
 F = TELEMETRY_INDEX
-PRESET = load_preset("field_8p5in_shale")
+PRESET = load_preset("field_8p5in_shale_lumped")
 RIG = rig_physics(PRESET)
 PERIOD_S = 0.01
 

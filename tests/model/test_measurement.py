@@ -63,7 +63,7 @@ def test_blocks_give_the_same_measurements_as_one_call() -> None:
 
 
 def test_surface_truth_of_the_field_preset_in_si() -> None:
-    preset = load_preset("field_8p5in_shale")
+    preset = load_preset("field_8p5in_shale_lumped")
     sim = Simulator(preset.params, SimConfig(dtau=preset.dtau), top_drive=preset.top_drive,
                     scales=preset.scales)
     rows = sim.advance(1000, every=100).data

@@ -65,7 +65,7 @@ def telemetry_rows(preset: Preset, seconds: float, rate_hz: float = 100.0) -> np
     return np.column_stack([fields[name] for name in topics.TELEMETRY_FIELDS])
 
 
-def default_rows(seconds: float = 30.0, preset: str = "field_8p5in_shale") -> np.ndarray:
+def default_rows(seconds: float = 30.0, preset: str = "field_8p5in_shale_lumped") -> np.ndarray:
     return telemetry_rows(load_preset(preset), seconds)
 
 
