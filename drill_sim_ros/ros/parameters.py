@@ -127,9 +127,9 @@ SPECS: tuple[ParamSpec, ...] = (
               "Default: steel mass x g x (1 - 1200 kg/m3 mud / steel density); 0 for "
               "dimensionless presets.", 0.0, 1e10),
     ParamSpec("limits.max_surface_rpm", DOUBLE, 300.0,
-              "Surface-rpm commands above this [rev/min] are rejected.", 0.0, 1e4),
+              "Surface-rpm commands above this [rev/min] are clamped to it.", 0.0, 1e4),
     ParamSpec("limits.max_wob_n", DOUBLE, _max_wob_n,
-              "WOB commands above this [N] are rejected (default: 10 x the preset's WOB).",
+              "WOB commands above this [N] are clamped to it (default: 10 x the preset's WOB).",
               0.0, 1e9),
     ParamSpec("limits.top_drive_accel_rpm_s", DOUBLE, 0.0,
               "Top-drive acceleration limit [rev/min per s]; 0 = step changes.", 0.0, 1e6,
@@ -142,7 +142,7 @@ SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("real_time_factor", DOUBLE, 1.0,
               "Simulated seconds per wall second; 0 = as fast as possible.", 0.0, 1000.0),
     ParamSpec("lockstep", BOOL, False,
-              "Advance only on ~/step (one publish period per call); deterministic."),
+              "Advance one publish period per trigger (lockstep_trigger) only; deterministic."),
     ParamSpec("lockstep_trigger", STRING, "service",
               "What advances one period in lockstep: 'service' (a ~/step call) or 'command' "
               "(each message on drill/cmd/top_drive, applied first).",
