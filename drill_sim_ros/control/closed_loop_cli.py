@@ -23,7 +23,8 @@ LABELS = {"ssi_before_mean": "SSI before switch-on (mean)", "ssi_mean": "SSI aft
           "rop_m_h": "mean ROP [m/h]", "mse_mpa": "MSE at the bit [MPa]",
           "quill_torque_peak_nm": "quill torque peak [N m]",
           "quill_torque_rms_nm": "quill torque RMS [N m]",
-          "motor_energy_mj": "motor energy [MJ]", "saturation_count": "saturated samples"}
+          "motor_energy_mj": "motor energy [MJ]", "saturation_count": "saturated samples",
+          "status": "status", "stall_time_s": "stalled at [s]"}
 
 
 def add_parser(sub: Any) -> None:
@@ -86,7 +87,7 @@ def _table(columns: dict[str, dict[str, Any]]) -> str:
     def cell(value: Any) -> str:
         if value is None:
             return "-"
-        if isinstance(value, int):
+        if isinstance(value, (int, str)):
             return str(value)
         return f"{value:.4g}" if math.isfinite(value) else "-"
     names = list(columns)
