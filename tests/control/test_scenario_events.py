@@ -22,9 +22,9 @@ import pytest
 
 from drill_sim_ros.control.bench import Bench, run_in_process
 from drill_sim_ros.control.command import Command, SurfaceMeasurement
+from drill_sim_ros.control.rig import rig_physics
 from drill_sim_ros.control.scenario import Scenario, scenario_from_dict
 from drill_sim_ros.control.scorecard import score
-from drill_sim_ros.control.rig import rig_physics
 from drill_sim_ros.model import analysis
 from drill_sim_ros.model.errors import ParameterError
 from drill_sim_ros.model.presets import load_preset
