@@ -43,7 +43,8 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
                    help="a controller parameter, e.g. --set damping_ratio=0.3 (repeatable)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
-    p.add_argument("--plot", type=Path, help="PNG of bit rpm and quill torque against time, "
+    p.add_argument("--plot", type=Path, help="PNG of speeds with the setpoint, quill and "
+                   "motor torque with its limit, WOB; stuck and saturated spans shaded; "
                    "beside the uncontrolled run")
     p.add_argument("--no-baseline", action="store_true", help="skip the uncontrolled run "
                    "(by default it runs too, for the comparison)")
@@ -98,6 +99,13 @@ def _table(columns: dict[str, dict[str, Any]]) -> str:
     return "\n".join(lines)
 
 
+def status_text(card: dict[str, Any]) -> str:
+    """``ok``, ``stick-slip``, ``stalled at 42.1 s`` or ``fault``."""
+    if card.get("status") == "stalled":
+        return f"stalled at {card['stall_time_s']:.1f} s"
+    return str(card.get("status", ""))
+
+
 def cmd_closed_loop(args: argparse.Namespace) -> int:
     scenario = _scenario(args)
     preset = scenario.load_preset()
@@ -116,10 +124,15 @@ def cmd_closed_loop(args: argparse.Namespace) -> int:
                            scenario.period_s)
     rate = scenario.periods / controlled.wall_s if controlled.wall_s > 0 else math.nan
     if args.plot:
-        from drill_sim_ros.control.plot import plot_runs
-        plot_runs(args.plot, controlled.rows, None if baseline is None else baseline.rows,
-                  scenario.enable_at_s, f"{preset.name}: {label}, switched on at "
-                  f"{scenario.enable_at_s:g} s")
+        from drill_sim_ros.control.plot import PlotContext, PlotRun, plot_runs, schedule_events
+        runs = [PlotRun(name, rows, speed_mode, status_text(columns[name]))
+                for name, rows, speed_mode in (
+                    ("no control", None if baseline is None else baseline.rows, True),
+                    (label, controlled.rows, scenario.mode == "speed")) if rows is not None]
+        plot_runs(args.plot, runs, PlotContext(
+            f"{preset.name}: {label}, switched on at {scenario.enable_at_s:g} s", schedule,
+            scenario.enable_at_s, rig.max_torque_nm, rig.max_surface_rpm,
+            schedule_events(schedule)))
     if args.json:
         print(json.dumps({"scenario": scenario.to_dict(), "path": "ros" if args.ros else
                           "in-process", "periods": scenario.periods,
