@@ -12,7 +12,7 @@ from drill_sim_ros.control.bench import ClosedLoopRun, run_in_process
 from drill_sim_ros.control.controllers import CONTROL_MODES
 from drill_sim_ros.control.rig import rig_physics
 from drill_sim_ros.control.scenario import Scenario, load_scenario
-from drill_sim_ros.control.scorecard import SCORE_FIELDS, score
+from drill_sim_ros.control.scorecard import SCORE_FIELDS, score, status_text
 from drill_sim_ros.model.errors import DrillSimError
 from drill_sim_ros.terminal import StatusLine
 
@@ -97,13 +97,6 @@ def _table(columns: dict[str, dict[str, Any]]) -> str:
         lines.append(f"{LABELS[key]:30s}" + "".join(f"{cell(columns[n][key]):>22s}"
                                                     for n in names))
     return "\n".join(lines)
-
-
-def status_text(card: dict[str, Any]) -> str:
-    """``ok``, ``stick-slip``, ``stalled at 42.1 s`` or ``fault``."""
-    if card.get("status") == "stalled":
-        return f"stalled at {card['stall_time_s']:.1f} s"
-    return str(card.get("status", ""))
 
 
 def cmd_closed_loop(args: argparse.Namespace) -> int:

@@ -130,3 +130,13 @@ def _time_to_suppress(t: np.ndarray, stuck: np.ndarray, enable_at_s: float,
         return 0.0
     last_s = float(t[stuck][-1])
     return None if last_s > end_s - WINDOW_S else last_s - enable_at_s
+
+
+def status_text(card: dict[str, Any]) -> str:
+    """``ok``, ``stick-slip``, ``stalled at 42.1 s``, ``fault at 3.20 s`` or as given."""
+    status = str(card.get("status", ""))
+    if status == "stalled":
+        return f"stalled at {card['stall_time_s']:.1f} s"
+    if status == "fault":
+        return f"fault at {card['fault_time_s']:.2f} s"
+    return status
