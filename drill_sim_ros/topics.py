@@ -73,9 +73,12 @@ SURFACE_JOINTS = ("top_drive", "hook")
 # top_drive: angle rad, speed rad/s, surface (pipe) torque N m
 # hook:      bit depth m, rate of penetration m/s, hook load N
 # What the rig's surface sensors give (the only signals a controller should read):
-MEASURED_JOINTS = ("top_drive", "quill")
-# top_drive: angle rad, measured speed rad/s (encoder), measured motor torque N m
-# quill:     angle rad, measured speed rad/s, measured string torque N m (torque sub)
+MEASURED_JOINTS = ("top_drive", "quill", "hook", "wob_estimate")
+# top_drive:    angle rad, measured speed rad/s (encoder), measured motor torque N m
+# quill:        angle rad, measured speed rad/s, measured string torque N m (torque sub)
+# hook:         bit depth m, rate of penetration m/s, measured hook load N (load cell)
+# wob_estimate: bit depth m, rate of penetration m/s, applied WOB estimate N
+#               (submerged string weight - measured hook load)
 
 # /drill/telemetry carries one row of the model's telemetry record per sample, and its
 # layout.dim[0].label lists TELEMETRY_FIELDS (drill_sim_ros.model.telemetry).

@@ -87,7 +87,7 @@ def _sensor_specs() -> tuple[ParamSpec, ...]:
     """sensors.<signal>.noise_std / quantum / delay_periods for each surface signal."""
     out = []
     for signal in SIGNALS:
-        unit = "rad/s" if signal.endswith("rad_s") else "N m"
+        unit = {"drive_speed_rad_s": "rad/s", "hook_load_n": "N"}.get(signal, "N m")
         out += [
             ParamSpec(f"sensors.{signal}.noise_std", DOUBLE, 0.0,
                       f"Gaussian noise (standard deviation) of the measured {signal} [{unit}];"
@@ -136,6 +136,11 @@ SPECS: tuple[ParamSpec, ...] = (
               read_only=True),
     ParamSpec("limits.wob_rate_n_s", DOUBLE, 0.0,
               "Applied-WOB rate limit [N/s]; 0 = step changes.", 0.0, 1e9, read_only=True),
+    ParamSpec("commands.delay_s", DOUBLE, 0.0,
+              "Transport delay of every setpoint command (drill/cmd/*) [s]: a command "
+              "received at sim time t takes effect at t + delay, at the integrator step "
+              "nearest it, also within a publish period; 0 = from the next step.", 0.0, 60.0,
+              read_only=True),
     ParamSpec("publish_rate_hz", DOUBLE, 100.0,
               "Samples published per second of SIMULATED time.", 1.0, 1000.0, read_only=True),
     ParamSpec("publish_clock", BOOL, True, "Publish /clock (rosgraph_msgs/Clock) in sim time."),
