@@ -45,13 +45,13 @@ from drill_sim_ros.model.measurement import SIGNALS, RigSensors, SignalSpec
 from drill_sim_ros.model.params import RPM_PER_RAD_S
 from drill_sim_ros.model.presets import load_preset
 from drill_sim_ros.model.session import Block, SessionConfig, SimSession
-from drill_sim_ros.model.telemetry import MODE_NAMES, TELEMETRY_INDEX
+from drill_sim_ros.model.telemetry import MODE_NAMES, NS_PER_S, TELEMETRY_INDEX
 from drill_sim_ros.model.top_drive import TopDrivePhysical
 from drill_sim_ros.realtime.pacing import Pacer, RateMeter
 from drill_sim_ros.realtime.ticker import HandoffLock, Ticker
 from drill_sim_ros.ros import messages
 from drill_sim_ros.ros.command_types import ForeignCommandTypes
-from drill_sim_ros.ros.diagnostics import Figures, diagnostics
+from drill_sim_ros.ros.diagnostics import Diagnostics, Figures, source_of
 from drill_sim_ros.ros.frame import SAMPLE_TOPICS
 from drill_sim_ros.ros.messages import RUN_INFO_QOS, stamp_ns
 from drill_sim_ros.ros.parameters import (
@@ -121,6 +121,18 @@ COMMAND_INTERFACES = {("top_drive", "velocity"): "speed_rad_s",
                       ("top_drive", "effort"): "motor_torque_nm", ("hook", "effort"): "wob_n"}
 
 
+def malformed_joint_state(msg: JointState) -> str | None:
+    """Why a drill/cmd/top_drive message cannot be read joint by joint (None: it can): each
+    of position, velocity and effort must be empty or as long as ``name``."""
+    lengths = {"position": len(msg.position), "velocity": len(msg.velocity),
+               "effort": len(msg.effort)}
+    wrong = [f"{array} has {n}" for array, n in lengths.items() if n not in (0, len(msg.name))]
+    if not wrong:
+        return None
+    return (f"{len(msg.name)} names but {', '.join(wrong)} values (each array is empty or "
+            "one value per name)")
+
+
 def joint_commands(msg: JointState) -> dict[tuple[str, str], float]:
     """``{(joint, 'velocity' | 'effort'): value}`` of a drill/cmd/top_drive message; NaN and
     missing entries are no command."""
@@ -153,6 +165,9 @@ class SimNode(Node):
         self.recording_failed = False
         self.rejected_commands = 0
         self.saturated_commands = 0
+        self._last_command_ns: int | None = None     # sim time of the last top_drive command
+        self._diagnostics = Diagnostics(source_of(self.get_fully_qualified_name(),
+                                                  self.get_namespace()))
         self._last_row: np.ndarray | None = None     # SI, TELEMETRY_FIELDS; lock held
         self._pubs = {t: self.create_publisher(messages.type_of(t), topics.node_relative(t),
                                                self._qos(t), event_callbacks=QUIET_PUBLISHER)
@@ -191,6 +206,7 @@ class SimNode(Node):
             session = SimSession(session_config(self._values, self._preset))
             self._session = session
             self._sinks.warm_up()
+            self._sinks.clock_period_ns = round(NS_PER_S / self._values["clock_rate_hz"])
             self._pacer = Pacer(self._wall_period_ns(self._rtf))
             self._sinks.recorder = self._open_recorder(self._values["record.path"])
             self._publish_run_info()
@@ -370,6 +386,10 @@ class SimNode(Node):
         advance exactly one period under it."""
         msg = deserialize_message(raw, JointState)
         topic = topics.CMD_TOP_DRIVE
+        if (problem := malformed_joint_state(msg)) is not None:
+            with self._lock.urgent():
+                self._reject(topic, problem)
+            return
         values = joint_commands(msg)
         for joint, interface in set(values) - set(COMMAND_INTERFACES):
             self._reject(topic, f"joint {joint!r} takes no {interface} command "
@@ -378,6 +398,7 @@ class SimNode(Node):
                              if key in values})
         with self._lock.urgent():
             self._apply(topic, command)
+            self._last_command_ns = self._session.sim_time_ns     # the controller is alive
             self._session.command_stamp_ns = stamp_ns(msg.header.stamp)
             self._record_command(topic, raw)
             if self._command_steps():
@@ -469,7 +490,7 @@ class SimNode(Node):
         with self._lock.urgent():
             time_ns = self._session.sim_time_ns
             figures = self._figures(time_ns)
-        payload = serialize_message(diagnostics(figures, time_ns))
+        payload = serialize_message(self._diagnostics.message(figures, time_ns))
         self._sinks.emit_one(topics.DIAGNOSTICS, payload, time_ns)
 
     def _figures(self, time_ns: int) -> Figures:
@@ -487,7 +508,10 @@ class SimNode(Node):
             written=self._recorder_count("written"), severity=sev,
             stick_fraction=stick_fraction,
             mode="none" if row is None else MODE_NAMES[int(row[TELEMETRY_INDEX["mode"]])],
-            window_s=self._values["diagnostics.window_s"])
+            window_s=self._values["diagnostics.window_s"],
+            command_silence_s=None if self._last_command_ns is None else
+            (time_ns - self._last_command_ns) * 1e-9,
+            command_timeout_s=self._values["diagnostics.command_timeout_s"])
 
     def _recorder_count(self, name: str) -> int:
         recorder = self._sinks.recorder
