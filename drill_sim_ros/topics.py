@@ -37,6 +37,16 @@ CMD_TOP_DRIVE = "/drill/cmd/top_drive"        # sensor_msgs/JointState (COMMAND_
 COMMAND_JOINTS = ("top_drive", "hook")
 COMMANDS = (CMD_SURFACE_RPM, CMD_WOB, CMD_TOP_DRIVE)
 
+# ---- typed twins (drill_sim_msgs, when installed; drill_sim_ros.ros.typed) --------------
+TYPED_TELEMETRY = "/drill/typed/telemetry"    # drill_sim_msgs/Telemetry, one per sample
+TYPED_RUN_INFO = "/drill/typed/run_info"      # drill_sim_msgs/RunInfo; latched
+TYPED_CMD_TOP_DRIVE = "/drill/typed/cmd/top_drive"  # drill_sim_msgs/TopDriveCommand (subscribed)
+TYPED_MSG_TYPES: dict[str, str] = {
+    TYPED_TELEMETRY: "drill_sim_msgs/msg/Telemetry",
+    TYPED_RUN_INFO: "drill_sim_msgs/msg/RunInfo",
+    TYPED_CMD_TOP_DRIVE: "drill_sim_msgs/msg/TopDriveCommand",
+}
+
 # sim_node names its topics relative to its namespace (`-r __ns:=/rig1` moves them all),
 # except these two, which ROS conventions keep absolute. The names above are those of the
 # root namespace, as a recording of a sim without a namespace holds them.

@@ -49,7 +49,7 @@ from drill_sim_ros.model.telemetry import MODE_NAMES, NS_PER_S, TELEMETRY_INDEX
 from drill_sim_ros.model.top_drive import TopDrivePhysical
 from drill_sim_ros.realtime.pacing import Pacer, RateMeter
 from drill_sim_ros.realtime.ticker import HandoffLock, Ticker
-from drill_sim_ros.ros import messages
+from drill_sim_ros.ros import messages, typed
 from drill_sim_ros.ros.command_types import ForeignCommandTypes
 from drill_sim_ros.ros.diagnostics import Diagnostics, Figures, source_of
 from drill_sim_ros.ros.frame import SAMPLE_TOPICS
@@ -62,7 +62,7 @@ from drill_sim_ros.ros.parameters import (
     recording_options,
     validate,
 )
-from drill_sim_ros.ros.sinks import SampleSinks
+from drill_sim_ros.ros.sinks import SampleSinks, TypedTelemetry
 from drill_sim_ros.terminal import StatusLine, format_status
 
 RCLError = rclpy_implementation.RCLError
@@ -183,6 +183,7 @@ class SimNode(Node):
             self._command_names[topic] = sub.topic_name
         self._foreign_commands = ForeignCommandTypes(
             {name: topics.MSG_TYPES[topic] for topic, name in self._command_names.items()})
+        self._typed_pubs = self._add_typed_topics()
         self.create_service(Trigger, "~/reset", self._on_reset)
         self.create_service(SetBool, "~/pause", self._on_pause)
         self.create_service(Trigger, "~/step", self._on_step)
@@ -197,6 +198,25 @@ class SimNode(Node):
         self._stop_timer.cancel()                      # start() arms it when run_seconds > 0
         self.add_on_set_parameters_callback(self._validate_parameters)
         self.add_post_set_parameters_callback(self._apply_parameters)
+
+    def _add_typed_topics(self) -> dict[str, Any]:
+        """The drill_sim_msgs twins of the telemetry, run info and command, when that package
+        is installed; returns the typed publishers by topic."""
+        if not typed.AVAILABLE:
+            return {}
+        pubs = {topic: self.create_publisher(msg_type, topics.node_relative(topic), qos,
+                                             event_callbacks=QUIET_PUBLISHER)
+                for topic, msg_type, qos in (
+                    (topics.TYPED_TELEMETRY, typed.Telemetry, DATA_QOS),
+                    (topics.TYPED_RUN_INFO, typed.RunInfo, RUN_INFO_QOS))}
+        rig = self._diagnostics.source.hardware_id
+        self._sinks.typed = TypedTelemetry(pubs[topics.TYPED_TELEMETRY],
+                                           typed.TelemetryPacker(rig))
+        sub = self.create_subscription(typed.TopDriveCommand,
+                                       topics.node_relative(topics.TYPED_CMD_TOP_DRIVE),
+                                       self._on_typed_top_drive, COMMAND_QOS, raw=True)
+        self._command_names[topics.TYPED_CMD_TOP_DRIVE] = sub.topic_name
+        return pubs
 
     # ---- start -------------------------------------------------------------------------
     def start(self) -> None:
@@ -218,7 +238,7 @@ class SimNode(Node):
 
     @staticmethod
     def _qos(topic: str) -> QoSProfile:
-        if topic == topics.RUN_INFO:
+        if topic in (topics.RUN_INFO, topics.TYPED_RUN_INFO):
             return RUN_INFO_QOS
         return CLOCK_QOS if topic in (topics.CLOCK, topics.DIAGNOSTICS) else DATA_QOS
 
@@ -231,10 +251,11 @@ class SimNode(Node):
         recorder = InProcessRecorder(path, node_name=topics.NODE_NAME,
                                      metadata=self._run_metadata(),
                                      **recording_options(self._values))
-        for topic, publisher in self._pubs.items():
-            recorder.add_topic(publisher.topic_name, topics.MSG_TYPES[topic], self._qos(topic))
+        types = {**topics.MSG_TYPES, **topics.TYPED_MSG_TYPES}
+        for topic, publisher in {**self._pubs, **self._typed_pubs}.items():
+            recorder.add_topic(publisher.topic_name, types[topic], self._qos(topic))
         for topic, name in self._command_names.items():
-            recorder.add_topic(name, topics.MSG_TYPES[topic], COMMAND_QOS)
+            recorder.add_topic(name, types[topic], COMMAND_QOS)
         self.get_logger().info(f"recording to {path}")
         return recorder
 
@@ -249,6 +270,12 @@ class SimNode(Node):
         """/drill/run_info, latched: what this node runs, as JSON (lock held)."""
         payload = serialize_message(String(data=json.dumps(self._session.run_info())))
         self._sinks.emit_one(topics.RUN_INFO, payload, self._session.sim_time_ns)
+        if topics.TYPED_RUN_INFO in self._typed_pubs:
+            msg = typed.run_info_message(self._session.run_info(), self._values,
+                                         self._session.sim_time_ns,
+                                         self._diagnostics.source.hardware_id)
+            self._sinks.emit_one(topics.TYPED_RUN_INFO, serialize_message(msg),
+                                 self._session.sim_time_ns, self._typed_pubs)
 
     def _log_start(self) -> None:
         s = self._session
@@ -396,10 +423,21 @@ class SimNode(Node):
                                 "(top_drive: velocity, effort; hook: effort)")
         command = Command(**{name: values[key] for key, name in COMMAND_INTERFACES.items()
                              if key in values})
+        self._take_top_drive(topic, command, stamp_ns(msg.header.stamp), raw)
+
+    def _on_typed_top_drive(self, raw: bytes) -> None:
+        """drill/typed/cmd/top_drive: the same command as drill/cmd/top_drive, typed."""
+        msg = deserialize_message(raw, typed.TopDriveCommand)
+        self._take_top_drive(topics.TYPED_CMD_TOP_DRIVE, typed.command_of(msg),
+                             stamp_ns(msg.header.stamp), raw)
+
+    def _take_top_drive(self, topic: str, command: Command, reacts_to_ns: int,
+                        raw: bytes) -> None:
+        """Apply a top-drive command and, in command-triggered lockstep, advance one period."""
         with self._lock.urgent():
             self._apply(topic, command)
             self._last_command_ns = self._session.sim_time_ns     # the controller is alive
-            self._session.command_stamp_ns = stamp_ns(msg.header.stamp)
+            self._session.command_stamp_ns = reacts_to_ns
             self._record_command(topic, raw)
             if self._command_steps():
                 self._advance(1)
