@@ -32,9 +32,20 @@ CMD_SURFACE_RPM = "/drill/cmd/surface_rpm"    # std_msgs/Float64, rev/min
 CMD_WOB = "/drill/cmd/wob"                    # std_msgs/Float64, N
 CMD_TOP_DRIVE = "/drill/cmd/top_drive"        # sensor_msgs/JointState (COMMAND_JOINTS)
 # top_drive: velocity = speed setpoint rad/s, effort = motor torque N m (torque mode);
-# hook: effort = applied WOB N. header.stamp: the stamp of the sample the command reacts to.
+# hook: effort = applied WOB N, as in the state. header.stamp: the stamp of the sample the
+# command reacts to. Each array is empty or as long as name; other messages are rejected.
 COMMAND_JOINTS = ("top_drive", "hook")
 COMMANDS = (CMD_SURFACE_RPM, CMD_WOB, CMD_TOP_DRIVE)
+
+# ---- typed twins (drill_sim_msgs, when installed; drill_sim_ros.ros.typed) --------------
+TYPED_TELEMETRY = "/drill/typed/telemetry"    # drill_sim_msgs/Telemetry, one per sample
+TYPED_RUN_INFO = "/drill/typed/run_info"      # drill_sim_msgs/RunInfo; latched
+TYPED_CMD_TOP_DRIVE = "/drill/typed/cmd/top_drive"  # drill_sim_msgs/TopDriveCommand (subscribed)
+TYPED_MSG_TYPES: dict[str, str] = {
+    TYPED_TELEMETRY: "drill_sim_msgs/msg/Telemetry",
+    TYPED_RUN_INFO: "drill_sim_msgs/msg/RunInfo",
+    TYPED_CMD_TOP_DRIVE: "drill_sim_msgs/msg/TopDriveCommand",
+}
 
 # sim_node names its topics relative to its namespace (`-r __ns:=/rig1` moves them all),
 # except these two, which ROS conventions keep absolute. The names above are those of the
@@ -71,7 +82,8 @@ BIT_JOINTS = ("bit_rotation", "bit_axial")
 # bit_axial:    depth m (down positive), rate of penetration m/s, weight on bit N
 SURFACE_JOINTS = ("top_drive", "hook")
 # top_drive: angle rad, speed rad/s, surface (pipe) torque N m
-# hook:      bit depth m, rate of penetration m/s, hook load N
+# hook:      bit depth m, rate of penetration m/s, applied WOB N (the weight the hook sets
+#            down: submerged string weight - hook load; the hook load is in the telemetry)
 # What the rig's surface sensors give (the only signals a controller should read):
 MEASURED_JOINTS = ("top_drive", "quill", "hook", "wob_estimate")
 # top_drive:    angle rad, measured speed rad/s (encoder), measured motor torque N m

@@ -21,6 +21,7 @@ from collections.abc import Callable
 from typing import Any
 
 import numpy as np
+from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
 from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.serialization import deserialize_message
@@ -96,7 +97,10 @@ class LockstepDriver(Node):
         msg_type = JointState if sample_topic == topics.SURFACE_MEASURED else Float64MultiArray
         self._sub = self.create_subscription(msg_type, topics.node_relative(sample_topic),
                                              self._on_sample, LOCKSTEP_QOS, raw=True)
-        self._start = self.create_timer(0.05, self._start_when_matched)
+        # steady: with use_sim_time the ROS clock stands still until the sim publishes,
+        # and the sim publishes only after this first command (command lockstep)
+        self._start = self.create_timer(0.05, self._start_when_matched,
+                                        clock=Clock(clock_type=ClockType.STEADY_TIME))
 
     @property
     def done(self) -> bool:

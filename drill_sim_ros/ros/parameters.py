@@ -144,6 +144,10 @@ SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("publish_rate_hz", DOUBLE, 100.0,
               "Samples published per second of SIMULATED time.", 1.0, 1000.0, read_only=True),
     ParamSpec("publish_clock", BOOL, True, "Publish /clock (rosgraph_msgs/Clock) in sim time."),
+    ParamSpec("clock_rate_hz", DOUBLE, 100.0,
+              "/clock messages per second of SIMULATED time, on the samples' stamps: at most "
+              "one per sample (at or above publish_rate_hz, every sample).", 1.0, 1000.0,
+              read_only=True),
     ParamSpec("real_time_factor", DOUBLE, 1.0,
               "Simulated seconds per wall second; 0 = as fast as possible.", 0.0, 1000.0),
     ParamSpec("lockstep", BOOL, False,
@@ -187,6 +191,9 @@ SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("diagnostics.window_s", DOUBLE, 20.0,
               "Simulated seconds of bit speed behind the stick-slip severity on /diagnostics.",
               0.1, 3600.0, read_only=True),
+    ParamSpec("diagnostics.command_timeout_s", DOUBLE, 1.0,
+              "Once a drill/cmd/top_drive command came, /diagnostics warns (controller "
+              "silent) when none follows for this many SIMULATED seconds; 0 = never.", 0.0, 1e6),
     ParamSpec("status_line", BOOL, True,
               "Show one live status line when stderr is a terminal."),
 )

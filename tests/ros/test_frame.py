@@ -60,7 +60,7 @@ def expected_messages(v: np.ndarray, time_ns: int) -> dict[str, object]:
         topics.SURFACE_JOINT_STATES: joint_state(topics.SURFACE_JOINTS, sec, nanosec, [
             v[F["surface_angle_rad"]], v[F["bit_depth_m"]],
             v[F["surface_rpm"]] / RPM_PER_RAD_S, v[F["rop_m_s"]], v[F["surface_torque_nm"]],
-            v[F["hook_load_n"]]]),
+            v[F["applied_wob_n"]]]),
         topics.SURFACE_MEASURED: joint_state(topics.MEASURED_JOINTS, sec, nanosec, [
             v[F["surface_angle_rad"]], v[F["surface_angle_rad"]], v[F["bit_depth_m"]],
             v[F["bit_depth_m"]], v[F["drive_speed_measured_rad_s"]],
