@@ -135,11 +135,13 @@ JOINT_FIELDS: dict[str, dict[str, tuple[str, str, str]]] = {
     },
     SURFACE_JOINT_STATES: {
         "top_drive": ("angle rad", "speed rad/s", "surface (pipe) torque N m"),
-        "hook": ("bit depth m", "ROP m/s", "hook load N"),
+        "hook": ("bit depth m", "ROP m/s", "applied WOB N"),
     },
     SURFACE_MEASURED: {
         "top_drive": ("angle rad", "encoder speed rad/s", "motor torque N m"),
         "quill": ("angle rad", "speed rad/s", "string torque N m (torque sub)"),
+        "hook": ("-", "-", "measured hook load N"),
+        "wob_estimate": ("-", "-", "applied WOB estimate N (submerged weight - hook load)"),
     },
     CMD_TOP_DRIVE: {
         "top_drive": ("-", "speed setpoint rad/s (kinematic, speed modes)",
