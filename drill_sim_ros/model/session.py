@@ -19,6 +19,7 @@ import numpy as np
 from drill_sim_ros.model import kernel as k
 from drill_sim_ros.model.analysis import Severity, severity_of
 from drill_sim_ros.model.errors import ParameterError
+from drill_sim_ros.model.formation import layers_from_dicts
 from drill_sim_ros.model.measurement import RigSensors
 from drill_sim_ros.model.params import GROUPS
 from drill_sim_ros.model.presets import Preset
@@ -271,6 +272,12 @@ class SimSession:
         """New drive gains, limit and mode (SI) from the next period, without a bump; the
         inertia is fixed for a session."""
         self.sim.set_top_drive(drive.scaled(self.scales))
+
+    def set_formation(self, layers: list[dict]) -> None:
+        """Rock layers by depth below the start (SI keys of model.formation.LAYER_KEYS), from
+        the next period; ``[]``: the preset's rock throughout."""
+        self.sim.set_formation(layers_from_dicts(layers, self.cfg.preset.rock) if layers
+                               else ())
 
     def reset(self) -> None:
         """Model back to its initial state and setpoints; the simulated clock runs on."""
