@@ -123,10 +123,10 @@ class Bench:
     sample at the end of the last period is ``rows[period]``. One implementation behind
     :func:`run_in_process` and the Gymnasium environment."""
 
-    def __init__(self, scenario: Scenario) -> None:
+    def __init__(self, scenario: Scenario, preset: Preset | None = None) -> None:
         scenario.check_supported()
         self.scenario = scenario
-        self.preset = scenario.load_preset()
+        self.preset = scenario.load_preset() if preset is None else preset
         self.rig = rig_physics(self.preset)
         self.schedule = scenario.setpoints(self.preset)
         self.limits = command_limits(self.preset, self.rig)

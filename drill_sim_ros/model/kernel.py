@@ -69,7 +69,8 @@ P_PARTS_T = 17      # distributed: parts of the torsional line (the axial ones f
 P_BIT_INERTIA = 18  # distributed: lumped inertia at the bit / I
 P_HOOK_KP = 19      # distributed: hook speed per unit force error (WOB loop, P)
 P_HOOK_KI = 20      # distributed: hook speed per unit force error x tau (WOB loop, I)
-P_OFF_BOTTOM = 21   # 1: the bit hangs free off bottom (T = W = 0) and the hook is fixed
+P_OFF_BOTTOM = 21   # 1: the bit hangs free off bottom (T = W = 0), the hook fixed; 2: and
+                    # the torsional line ends without reflection (an anechoic bottom)
 P_BHA_PART = 22     # distributed: the part at whose top the BHA speed is read
 N_PARAMS = 23
 
@@ -223,8 +224,9 @@ def _distributed_move(prm: np.ndarray, wave: np.ndarray, wave_i: np.ndarray,
     z = wave_f[sg.W_Z]
     b_top_t, a_bot_t = sg.arriving(wave, wave_i, 0, parts_t)
     b_top_a, a_bot_a = sg.arriving(wave, wave_i, parts_t, parts)
+    anechoic = prm[P_OFF_BOTTOM] == 2.0       # nothing comes back from below
     sg.scatter(wave, wave_i, wave_f, 0, parts_t, b_top_t + 2.0 * z[0] * omega_s_next,
-               a_bot_t - 2.0 * z[parts_t - 1] * omega_new)
+               0.0 if anechoic else a_bot_t - 2.0 * z[parts_t - 1] * omega_new)
     sg.scatter(wave, wave_i, wave_f, parts_t, parts, b_top_a + 2.0 * z[parts_t] * v_hook,
                a_bot_a - 2.0 * z[parts - 1] * v_new)
     return v_hook, hook_int

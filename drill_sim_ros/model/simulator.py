@@ -560,11 +560,12 @@ class Simulator:
                 + sg.line_energy(self._wave, self._wave_i, self._wave_f, parts_t,
                                  self._wave_i.shape[1], dtau))
 
-    def hang_off_bottom(self) -> None:
+    def hang_off_bottom(self, anechoic: bool = False) -> None:
         """The bit hangs free off bottom (no bit-rock forces), the hook is fixed, and the
         string is at rest: no twist, no torque, no axial motion, turning at the drive's
-        speed, as the string instruments start (``drill_sim modes``, ``reflection``)."""
-        self._prm[k.P_OFF_BOTTOM] = 1.0
+        speed, as the string instruments start (``drill_sim modes``, ``reflection``).
+        ``anechoic``: the torsional line's bottom sends nothing back up (a matched end)."""
+        self._prm[k.P_OFF_BOTTOM] = 2.0 if anechoic else 1.0
         st = self._state
         if self.distributed:
             parts_t = self._parts[0]
