@@ -82,6 +82,19 @@ class EntryResult:
         return out
 
 
+def code_fingerprint() -> str:
+    """The model and control code a result depends on (``store.model_fingerprint``), with
+    the sensors and this module."""
+    import hashlib
+
+    from drill_sim_ros.study.store import model_fingerprint
+    root = Path(__file__).resolve().parents[1]
+    digest = hashlib.sha256(model_fingerprint(controlled=True).encode())
+    for name in ("model/measurement.py", "study/suite.py"):
+        digest.update((root / name).read_bytes())
+    return digest.hexdigest()[:16]
+
+
 def scenario_files(names: Sequence[str] = ()) -> list[Path]:
     """The named scenarios (names of config/scenarios or paths), default all, sorted."""
     if not names:
