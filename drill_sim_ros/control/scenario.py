@@ -51,6 +51,7 @@ from drill_sim_ros.model.measurement import SIGNALS, RigSensors, SignalSpec
 from drill_sim_ros.model.presets import (
     DEFAULT_PRESET,
     Preset,
+    config_dirs,
     load_preset,
     preset_from_dict,
     preset_path,
@@ -239,6 +240,28 @@ def load_scenario(path: str | Path) -> Scenario:
         return scenario_from_dict(data)
     except ParameterError as exc:
         raise ParameterError(f"{path}: {exc}") from exc
+
+
+def scenario_dir() -> Path:
+    """config/scenarios of the first config directory that has it."""
+    for base in config_dirs():
+        if (base / "scenarios").is_dir():
+            return base / "scenarios"
+    raise ParameterError("no config/scenarios directory found (set DRILL_SIM_CONFIG_DIR)")
+
+
+def scenario_path(name_or_path: str | Path) -> Path:
+    """A scenario by name (config/scenarios/<name>.yaml) or a YAML path; ParameterError
+    naming the known scenarios otherwise."""
+    path = Path(name_or_path)
+    if path.suffix in (".yaml", ".yml") and path.exists():
+        return path
+    path = scenario_dir() / f"{name_or_path}.yaml"
+    if not path.exists():
+        known = ", ".join(p.stem for p in sorted(scenario_dir().glob("*.yaml")))
+        raise ParameterError(f"scenario {str(name_or_path)!r}: no such file or scenario "
+                             f"(known: {known})")
+    return path
 
 
 def save_scenario(scenario: Scenario, path: str | Path) -> None:
