@@ -63,11 +63,12 @@ class ClosedLoopRun:
     snapshot: np.ndarray | None = None
 
 
-def drive_of(preset: Preset, mode: str) -> TopDrivePhysical:
-    """The preset's drive in SI, in ``mode``."""
+def drive_of(preset: Preset, mode: str, motor_lag_s: float | None = None) -> TopDrivePhysical:
+    """The preset's drive in SI, in ``mode`` (and with ``motor_lag_s`` when given)."""
     d = preset.top_drive.physical(preset.scales)
     return TopDrivePhysical(mode=mode, inertia_kg_m2=d.inertia_kg_m2, kp_nm_s=d.kp_nm_s,
-                            ki_nm=d.ki_nm, max_torque_nm=d.max_torque_nm)
+                            ki_nm=d.ki_nm, max_torque_nm=d.max_torque_nm,
+                            motor_lag_s=d.motor_lag_s if motor_lag_s is None else motor_lag_s)
 
 
 def session_config(scenario: Scenario, preset: Preset) -> SessionConfig:
@@ -78,7 +79,8 @@ def session_config(scenario: Scenario, preset: Preset) -> SessionConfig:
         n_nodes=preset.n_nodes or 2048, perturb_v=PERTURB_V,
         applied_wob_n=schedule.wob_at(0.0), surface_rpm=schedule.rpm_at(0.0),
         window_s=WINDOW_S, submerged_weight_n=submerged_string_weight_n(preset),
-        top_drive=drive_of(preset, scenario.mode), sensors=scenario.rig_sensors(),
+        top_drive=drive_of(preset, scenario.mode, scenario.drive.get("motor_lag_s")),
+        sensors=scenario.rig_sensors(), formation=tuple(scenario.formation),
         top_drive_accel_rpm_s=float(scenario.drive.get("accel_rpm_s", 0.0)),
         wob_rate_n_s=float(scenario.drive.get("wob_rate_n_s", 0.0)),
         command_delay_s=float(scenario.drive.get("command_delay_s", 0.0)))
