@@ -1,9 +1,10 @@
 """sim_node's /diagnostics: the two statuses built from a copy of the node's figures.
 
 ``simulation``: state, sim time, target and achieved real-time factor, overruns, tick
-lateness, rejected commands, recorder counts (ERROR on a numerical fault, WARN on overruns
-or recorder drops). ``bit dynamics``: mode, stick-slip severity, under-torque ratio and
-stick fraction of the last window (WARN in stick-slip).
+lateness, rejected, stale and lost commands, matched command publishers, lockstep's wait,
+recorder counts (ERROR on a numerical fault, WARN while lockstep waits past
+``lockstep.warn_after_s``, on overruns or recorder drops). ``bit dynamics``: mode, stick-slip
+severity, under-torque ratio and stick fraction of the last window (WARN in stick-slip).
 """
 
 from __future__ import annotations
@@ -41,6 +42,12 @@ class Figures:
     stick_fraction: float
     mode: str
     window_s: float
+    # command-triggered lockstep's handshake (drill_sim_ros.ros.handshake)
+    stale: int = 0                 # commands that did not answer the latest sample
+    lost_commands: int = 0         # commands DDS reports lost on their way
+    command_publishers: int = 0    # publishers matched on drill/cmd/top_drive
+    waiting: str | None = None     # what lockstep waits for, past lockstep.warn_after_s
+    waits: int = 0                 # waits that went past lockstep.warn_after_s
 
 
 def diagnostics(figures: Figures, time_ns: int) -> DiagnosticArray:
@@ -62,6 +69,11 @@ def node_status(f: Figures) -> DiagnosticStatus:
         "tick_lateness_p99_ms": f"{p99:.4g}",
         "rejected_commands": str(f.rejected),
         "saturated_commands": str(f.saturated),
+        "stale_commands": str(f.stale),
+        "lost_commands": str(f.lost_commands),
+        "command_publishers": str(f.command_publishers),
+        "lockstep_waits": str(f.waits),
+        "waiting": f.waiting or "",
         "recorder_dropped": str(f.dropped),
         "recorder_written": str(f.written),
         "fault": f.fault or "",
@@ -71,6 +83,8 @@ def node_status(f: Figures) -> DiagnosticStatus:
         level, message = DiagnosticStatus.ERROR, f"numerical fault: {f.fault}"
     elif f.record_error is not None:
         level, message = DiagnosticStatus.ERROR, f"recording stopped: {f.record_error}"
+    elif f.waiting is not None:
+        level, message = DiagnosticStatus.WARN, f.waiting
     elif f.overruns or f.dropped:
         level, message = DiagnosticStatus.WARN, "overruns or recorder drops"
     else:

@@ -14,6 +14,7 @@ ROS-free; sim_node holds one :class:`CommandGate` and one :class:`WaitWatch` und
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 from drill_sim_ros.model.telemetry import NS_PER_S
 
@@ -94,3 +95,73 @@ class WaitWatch:
         self.warned = True
         self.waits += 1
         return True
+
+
+COMMAND_MODE, SERVICE_MODE = "command", "service"     # lockstep_trigger values
+LOG_THROTTLE_S = 5.0        # at most one stale or lost-command warning per this many seconds
+
+
+class Handshake:
+    """sim_node's side of lockstep: the gate, the wait watch, the commands lost in DDS, and
+    their log lines (``logger``: the node's; it takes ``throttle_duration_sec``)."""
+
+    def __init__(self, logger: Any, command_topic: str, step_service: str,
+                 now_s: float) -> None:
+        self.gate = CommandGate()
+        self.watch = WaitWatch(now_s)
+        self.lost_commands = 0
+        self._logger = logger
+        self._waiting_for = {COMMAND_MODE: (f"a command on {command_topic}", "answering"),
+                             SERVICE_MODE: (f"a call of {step_service}", "at")}
+
+    def restart(self, now_s: float) -> None:
+        """Lockstep (re)starts now: a wait counts from here."""
+        self.watch.since_s, self.watch.warned = now_s, False
+
+    def published(self, stamp_ns: int, now_s: float) -> None:
+        """A sample stamped ``stamp_ns`` went out: the latest; one info line if the sim had
+        been reported waiting."""
+        self.gate.published(stamp_ns)
+        waited_s = self.watch.advanced(now_s)
+        if waited_s is not None:
+            self._logger.info(f"lockstep runs again: {seconds_text(stamp_ns)} published "
+                              f"after {waited_s:.1f} s of waiting")
+
+    def admit(self, topic: str, stamp_ns: int) -> bool:
+        """Whether a command stamped ``stamp_ns`` answers the latest sample; a stale one is
+        counted and warned about (throttled), with both stamps."""
+        why = self.gate.admit(stamp_ns)
+        if why is None:
+            return True
+        self._logger.warning(
+            f"stale command on {topic}: {why}; not applied, the sim does not advance "
+            f"(stamp a command with the stamp of the sample it answers; "
+            f"{self.gate.stale} stale so far)", throttle_duration_sec=LOG_THROTTLE_S)
+        return False
+
+    def lost(self, topic: str, count: int) -> None:
+        """``count`` commands on ``topic`` that DDS reports lost (a publisher's history
+        overwrote them before they were delivered)."""
+        self.lost_commands += count
+        self._logger.warning(
+            f"{count} command(s) on {topic} lost in DDS before they reached the sim (a "
+            f"publisher sends faster than its history keeps; {self.lost_commands} lost so "
+            "far)", throttle_duration_sec=LOG_THROTTLE_S)
+
+    def waiting(self, mode: str | None, now_s: float) -> Waiting | None:
+        """What lockstep in ``mode`` (None: not in lockstep) waits for, once reported."""
+        if mode is None or not self.watch.warned:
+            return None
+        what, relation = self._waiting_for[mode]
+        return Waiting(what, self.gate.latest_ns or 0, self.watch.waited_s(now_s), relation)
+
+    def check(self, mode: str | None, now_s: float, warn_after_s: float,
+              publishers: int) -> None:
+        """One warning line when the wait passes ``warn_after_s``."""
+        if mode is None or not self.watch.overdue(now_s, warn_after_s):
+            return
+        waiting = self.waiting(mode, now_s)
+        hint = f"{publishers} command publisher(s) matched; a controller answers every sample " \
+               "it receives (docs/control-loop.md)" if mode == COMMAND_MODE else \
+               "each call advances one period"
+        self._logger.warning(f"{waiting.text}; {hint}")

@@ -16,6 +16,11 @@ HARDWARE_ID = "drill_sim_ros"
 RUN_INFO_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1,
                           reliability=ReliabilityPolicy.RELIABLE,
                           durability=DurabilityPolicy.TRANSIENT_LOCAL)
+# What a controller reads (drill/surface/measured, drill/telemetry) is latched the same way:
+# a subscriber asking for transient local gets the latest sample when it connects, whether it
+# started before sim_node, after it, or again mid-run; volatile subscribers still match.
+LATEST_SAMPLE_QOS = RUN_INFO_QOS
+LATCHED_SAMPLE_TOPICS = (topics.SURFACE_MEASURED, topics.TELEMETRY)
 
 
 def type_of(topic: str) -> type:

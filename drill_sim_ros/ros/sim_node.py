@@ -26,7 +26,7 @@ import numpy as np
 import rclpy
 from rcl_interfaces.msg import SetParametersResult
 from rclpy.clock import Clock, ClockType
-from rclpy.event_handler import PublisherEventCallbacks
+from rclpy.event_handler import PublisherEventCallbacks, SubscriptionEventCallbacks
 from rclpy.executors import ExternalShutdownException
 from rclpy.impl.implementation_singleton import rclpy_implementation
 from rclpy.node import Node
@@ -53,7 +53,13 @@ from drill_sim_ros.ros import messages
 from drill_sim_ros.ros.command_types import ForeignCommandTypes
 from drill_sim_ros.ros.diagnostics import Figures, diagnostics
 from drill_sim_ros.ros.frame import SAMPLE_TOPICS
-from drill_sim_ros.ros.messages import RUN_INFO_QOS, stamp_ns
+from drill_sim_ros.ros.handshake import COMMAND_MODE, SERVICE_MODE, Handshake
+from drill_sim_ros.ros.messages import (
+    LATCHED_SAMPLE_TOPICS,
+    LATEST_SAMPLE_QOS,
+    RUN_INFO_QOS,
+    stamp_ns,
+)
 from drill_sim_ros.ros.parameters import (
     SPEC_BY_NAME,
     coerce,
@@ -70,9 +76,10 @@ DATA_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=100,
                       reliability=ReliabilityPolicy.RELIABLE)
 CLOCK_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=10,
                        reliability=ReliabilityPolicy.RELIABLE)
-# Deep enough that a controller driving command-triggered lockstep never loses a command.
-COMMAND_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1000,
-                         reliability=ReliabilityPolicy.RELIABLE)
+# The node's queue never drops a command (a flood is held back by DDS flow control, and what
+# a publisher's own history overwrites is reported lost): in command-triggered lockstep a
+# controller's answer is never lost behind other commands.
+COMMAND_QOS = QoSProfile(history=HistoryPolicy.KEEP_ALL, reliability=ReliabilityPolicy.RELIABLE)
 # Reliable volatile publishers match every subscriber but transient-local ones; without the
 # default QoS-event handlers the executor's wait set is 2 entities per publisher smaller.
 QUIET_PUBLISHER = PublisherEventCallbacks(use_default_callbacks=False)
@@ -83,6 +90,7 @@ DIAGNOSTICS_PERIOD_S = 1.0
 STATUS_PERIOD_S = 0.25
 WARN_THROTTLE_S = 1.0
 GIL_SWITCH_INTERVAL_S = 0.0005
+WAIT_CHECK_PERIOD_S = 0.1    # how often lockstep's wait is compared with lockstep.warn_after_s
 
 
 def session_config(values: dict[str, Any], preset: Any) -> SessionConfig:
@@ -160,17 +168,24 @@ class SimNode(Node):
                                 topics.RUN_INFO)}
         self._sinks = SampleSinks(self._pubs)
         self._command_names: dict[str, str] = {}      # command topic -> its resolved name
+        self._command_subs = {}
         for topic, callback in ((topics.CMD_SURFACE_RPM, self._on_surface_rpm),
                                 (topics.CMD_WOB, self._on_wob),
                                 (topics.CMD_TOP_DRIVE, self._on_top_drive)):
-            sub = self.create_subscription(messages.type_of(topic), topics.node_relative(topic),
-                                           callback, COMMAND_QOS, raw=True)
+            sub = self.create_subscription(
+                messages.type_of(topic), topics.node_relative(topic), callback, COMMAND_QOS,
+                raw=True, event_callbacks=SubscriptionEventCallbacks(
+                    message_lost=self._on_commands_lost(topic)))
             self._command_names[topic] = sub.topic_name
+            self._command_subs[topic] = sub
         self._foreign_commands = ForeignCommandTypes(
             {name: topics.MSG_TYPES[topic] for topic, name in self._command_names.items()})
         self.create_service(Trigger, "~/reset", self._on_reset)
         self.create_service(SetBool, "~/pause", self._on_pause)
-        self.create_service(Trigger, "~/step", self._on_step)
+        step = self.create_service(Trigger, "~/step", self._on_step)
+        self._handshake = Handshake(self.get_logger(), self._command_names[topics.CMD_TOP_DRIVE],
+                                    step.srv_name, time.monotonic())
+        self.create_timer(WAIT_CHECK_PERIOD_S, self._check_waiting, clock=self._steady)
         self._ticker = Ticker(self._tick, self._on_tick_error, name="drill_sim_ticker")
         self._first_spin = self.create_timer(0.0, self._start_ticker, clock=self._steady)
         self._first_spin.cancel()                      # start() arms it
@@ -204,6 +219,8 @@ class SimNode(Node):
     def _qos(topic: str) -> QoSProfile:
         if topic == topics.RUN_INFO:
             return RUN_INFO_QOS
+        if topic in LATCHED_SAMPLE_TOPICS:
+            return LATEST_SAMPLE_QOS
         return CLOCK_QOS if topic in (topics.CLOCK, topics.DIAGNOSTICS) else DATA_QOS
 
     def _open_recorder(self, path: str) -> Any:
@@ -270,7 +287,7 @@ class SimNode(Node):
             if names & {"top_drive.kp_nm_s", "top_drive.ki_nm", "top_drive.max_torque_nm",
                         "top_drive.mode"}:
                 self._session.set_top_drive(top_drive(self._values))   # between runs: no bump
-            if names & {"real_time_factor", "lockstep"}:
+            if names & {"real_time_factor", "lockstep", "lockstep_trigger"}:
                 self._restart_ticks()
 
     # ---- pacing and the one tick path --------------------------------------------------
@@ -285,9 +302,14 @@ class SimNode(Node):
         self._ticker.start()
 
     def _restart_ticks(self) -> None:
-        """New schedule for the current factor, anchored now (call with the lock held)."""
+        """New schedule for the current factor, anchored now; in command-triggered lockstep
+        the latest sample (at start: t = 0) is out for a controller to answer (call with the
+        lock held)."""
         self._pacer = Pacer(self._wall_period_ns(self._rtf))
         self._anchor()
+        self._handshake.restart(time.monotonic())
+        if self._command_steps():
+            self._emit_initial()
 
     def _anchor(self) -> None:
         """The next tick is due now; wake the ticker (call with the lock held)."""
@@ -338,6 +360,7 @@ class SimNode(Node):
         self._sinks.emit(block, self._values["publish_clock"])
         if len(block):
             self._last_row = block.rows[-1]
+            self._handshake.published(int(block.stamps_ns[-1]), time.monotonic())
 
     def _on_tick_error(self, exc: Exception) -> bool:
         """An unexpected error on the ticker: quiet at shutdown, else a fault until reset."""
@@ -367,21 +390,34 @@ class SimNode(Node):
 
     def _on_top_drive(self, raw: bytes) -> None:
         """drill/cmd/top_drive: apply what it commands and, in command-triggered lockstep,
-        advance exactly one period under it."""
+        advance exactly one period under it if it answers the latest sample (else it is
+        stale: not applied, counted)."""
         msg = deserialize_message(raw, JointState)
         topic = topics.CMD_TOP_DRIVE
+        command_stamp_ns = stamp_ns(msg.header.stamp)
+        with self._lock.urgent():
+            self._record_command(topic, raw)
+            steps = self._command_steps()
+            if steps and not self._handshake.admit(topic, command_stamp_ns):
+                return
+            self._apply(topic, self._top_drive_command(msg))
+            self._session.command_stamp_ns = command_stamp_ns
+            if steps:
+                self._advance(1)
+
+    def _top_drive_command(self, msg: JointState) -> Command:
+        """The Command of a drill/cmd/top_drive message; a joint/interface it does not know
+        is rejected (counted)."""
         values = joint_commands(msg)
         for joint, interface in set(values) - set(COMMAND_INTERFACES):
-            self._reject(topic, f"joint {joint!r} takes no {interface} command "
-                                "(top_drive: velocity, effort; hook: effort)")
-        command = Command(**{name: values[key] for key, name in COMMAND_INTERFACES.items()
-                             if key in values})
-        with self._lock.urgent():
-            self._apply(topic, command)
-            self._session.command_stamp_ns = stamp_ns(msg.header.stamp)
-            self._record_command(topic, raw)
-            if self._command_steps():
-                self._advance(1)
+            self._reject(topics.CMD_TOP_DRIVE, f"joint {joint!r} takes no {interface} command "
+                                               "(top_drive: velocity, effort; hook: effort)")
+        return Command(**{name: values[key] for key, name in COMMAND_INTERFACES.items()
+                          if key in values})
+
+    def _on_commands_lost(self, topic: str) -> Any:
+        """The message_lost event handler of the ``topic`` subscription."""
+        return lambda info: self._handshake.lost(topic, info.total_count_change)
 
     def _command_steps(self) -> bool:
         """Each drill/cmd/top_drive message advances one period (lock held)."""
@@ -425,6 +461,9 @@ class SimNode(Node):
             if self._fault is not None:
                 self._fault = None
                 self._anchor()       # no catching up on the time spent in the fault
+            if self._command_steps():        # the reset state is the sample to answer now
+                self._initial_pending = False
+                self._emit(self._session.current())
             time_s = self._session.sim_time_ns * 1e-9
         response.success = True
         response.message = (f"model reset to its initial state at t = {time_s:.3f} s "
@@ -459,6 +498,22 @@ class SimNode(Node):
         return response
 
     # ---- diagnostics, status, shutdown -------------------------------------------------
+    def _lockstep_mode(self) -> str | None:
+        """What advances the sim now: COMMAND_MODE, SERVICE_MODE, or None (it runs by itself,
+        or cannot run: a fault, closing) (lock held)."""
+        if not self._lockstep or self._fault is not None or self._closing:
+            return None
+        return COMMAND_MODE if self._values["lockstep_trigger"] == "command" else SERVICE_MODE
+
+    def _check_waiting(self) -> None:
+        """One warning when lockstep has waited longer than lockstep.warn_after_s."""
+        if self._session is None:
+            return
+        publishers = self._command_subs[topics.CMD_TOP_DRIVE].get_publisher_count()
+        with self._lock.urgent():
+            self._handshake.check(self._lockstep_mode(), time.monotonic(),
+                                  self._values["lockstep.warn_after_s"], publishers)
+
     def _publish_diagnostics(self) -> None:
         """/diagnostics: the figures are copied under the lock, the message is built and
         serialized outside it, so the ticker waits for a copy, not for the formatting."""
@@ -487,7 +542,17 @@ class SimNode(Node):
             written=self._recorder_count("written"), severity=sev,
             stick_fraction=stick_fraction,
             mode="none" if row is None else MODE_NAMES[int(row[TELEMETRY_INDEX["mode"]])],
-            window_s=self._values["diagnostics.window_s"])
+            window_s=self._values["diagnostics.window_s"], **self._handshake_figures())
+
+    def _handshake_figures(self) -> dict[str, Any]:
+        """The lockstep handshake's part of the figures (lock held)."""
+        waiting = self._handshake.waiting(self._lockstep_mode(), time.monotonic())
+        return {"stale": self._handshake.gate.stale,
+                "lost_commands": self._handshake.lost_commands,
+                "command_publishers":
+                    self._command_subs[topics.CMD_TOP_DRIVE].get_publisher_count(),
+                "waiting": None if waiting is None else waiting.text,
+                "waits": self._handshake.watch.waits}
 
     def _recorder_count(self, name: str) -> int:
         recorder = self._sinks.recorder
