@@ -210,6 +210,7 @@ class SimNode(Node):
             self._sinks.recorder = self._open_recorder(self._values["record.path"])
             self._publish_run_info()
             self._initial_pending = True       # t = 0 goes out before the first period
+        self._handshake.restart(time.monotonic())     # a wait counts from here
         self._first_spin.reset()
         if self._values["run_seconds"] > 0:
             self._stop_timer.reset()
