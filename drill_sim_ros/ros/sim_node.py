@@ -54,12 +54,7 @@ from drill_sim_ros.ros.command_types import ForeignCommandTypes
 from drill_sim_ros.ros.diagnostics import Figures, diagnostics
 from drill_sim_ros.ros.frame import SAMPLE_TOPICS
 from drill_sim_ros.ros.handshake import COMMAND_MODE, SERVICE_MODE, Handshake
-from drill_sim_ros.ros.messages import (
-    LATCHED_SAMPLE_TOPICS,
-    LATEST_SAMPLE_QOS,
-    RUN_INFO_QOS,
-    stamp_ns,
-)
+from drill_sim_ros.ros.messages import LATEST_SAMPLE_QOS, RUN_INFO_QOS, TELEMETRY_QOS, stamp_ns
 from drill_sim_ros.ros.parameters import (
     SPEC_BY_NAME,
     coerce,
@@ -220,8 +215,10 @@ class SimNode(Node):
     def _qos(topic: str) -> QoSProfile:
         if topic == topics.RUN_INFO:
             return RUN_INFO_QOS
-        if topic in LATCHED_SAMPLE_TOPICS:
+        if topic == topics.SURFACE_MEASURED:
             return LATEST_SAMPLE_QOS
+        if topic == topics.TELEMETRY:
+            return TELEMETRY_QOS
         return CLOCK_QOS if topic in (topics.CLOCK, topics.DIAGNOSTICS) else DATA_QOS
 
     def _open_recorder(self, path: str) -> Any:
