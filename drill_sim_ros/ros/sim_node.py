@@ -179,7 +179,8 @@ class SimNode(Node):
         self.create_service(SetBool, "~/pause", self._on_pause)
         step = self.create_service(Trigger, "~/step", self._on_step)
         self._handshake = Handshake(self.get_logger(), self._command_names[topics.CMD_TOP_DRIVE],
-                                    step.srv_name, time.monotonic())
+                                    self.resolve_service_name(step.srv_name),
+                                    time.monotonic())
         self.create_timer(WAIT_CHECK_PERIOD_S, self._check_waiting, clock=self._steady)
         self._ticker = Ticker(self._tick, self._on_tick_error, name="drill_sim_ticker")
         self._first_spin = self.create_timer(0.0, self._start_ticker, clock=self._steady)
