@@ -7,7 +7,8 @@ lockstep_trigger:=command``), so both give the same telemetry bit for bit:
 1. the session is built from the same settings sim_node takes from its parameters
    (:func:`session_config`, :func:`sim_node_parameters`), and its t = 0 sample is taken
    (sim_node publishes it at start; the sensors' noise and delay lines see it);
-2. the controller's first command reacts to no measurement (the initial state, stamp 0);
+2. the controller's first command answers the t = 0 sample (stamp 0), which sim_node
+   publishes, latched, before it waits for its first command;
 3. each command is applied with sim_node's limits (``control.command.apply_command``: speed and WOB
    within [0, limit], motor torque within +-the drive's limit) and stamped with the sample it
    reacts to; then exactly one period runs under it (zero-order hold), and the sample at the
@@ -178,7 +179,7 @@ def run_in_process(scenario: Scenario,
     controller = build_controller(scenario, bench.preset)
     sim = bench.session.sim
     start = time.perf_counter()
-    command = controller.update(None)
+    command = controller.update(bench.measurement())   # the answer to t = 0
     snapshot = sim.accumulators if snapshot_after == 0 else None
     for i in range(bench.periods):
         bench.step(command)
