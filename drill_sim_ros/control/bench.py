@@ -33,6 +33,7 @@ from drill_sim_ros.control.command import (
 from drill_sim_ros.control.registry import make_controller
 from drill_sim_ros.control.rig import RigPhysics, rig_physics
 from drill_sim_ros.control.scenario import Scenario
+from drill_sim_ros.model import defaults
 from drill_sim_ros.model.errors import ParameterError
 from drill_sim_ros.model.measurement import SIGNALS
 from drill_sim_ros.model.presets import Preset, submerged_string_weight_n
@@ -40,14 +41,11 @@ from drill_sim_ros.model.session import SessionConfig, SimSession
 from drill_sim_ros.model.telemetry import N_FIELDS
 from drill_sim_ros.model.top_drive import TopDrivePhysical
 
-PERTURB_V = 1e-3        # sim_node's model.perturb_v default
-WINDOW_S = 20.0         # sim_node's diagnostics.window_s default
-
 
 def command_limits(preset: Preset, rig: RigPhysics) -> CommandLimits:
     """sim_node's command limits at their defaults (limits.*, top_drive.max_torque_nm)."""
     wob_n = preset.scales.wob_n(preset.params.w0)
-    return CommandLimits(rig.max_surface_rpm, max(10.0 * wob_n, 1.0), rig.max_torque_nm)
+    return CommandLimits(rig.max_surface_rpm, defaults.max_wob_n(wob_n), rig.max_torque_nm)
 
 
 @dataclass
@@ -77,9 +75,9 @@ def session_config(scenario: Scenario, preset: Preset) -> SessionConfig:
     schedule = scenario.setpoints(preset)
     return SessionConfig(
         preset=preset, publish_rate_hz=scenario.control_rate_hz, dtau_max=preset.dtau,
-        n_nodes=preset.n_nodes or 2048, perturb_v=PERTURB_V,
+        n_nodes=defaults.n_nodes(preset), perturb_v=defaults.PERTURB_V,
         applied_wob_n=schedule.wob_at(0.0), surface_rpm=schedule.rpm_at(0.0),
-        window_s=WINDOW_S, submerged_weight_n=submerged_string_weight_n(preset),
+        window_s=defaults.WINDOW_S, submerged_weight_n=submerged_string_weight_n(preset),
         top_drive=drive_of(preset, scenario.mode, scenario.drive.get("motor_lag_s")),
         sensors=scenario.rig_sensors(), formation=tuple(scenario.formation),
         top_drive_accel_rpm_s=float(scenario.drive.get("accel_rpm_s", 0.0)),

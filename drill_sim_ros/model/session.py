@@ -16,6 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from drill_sim_ros.model import defaults
 from drill_sim_ros.model import kernel as k
 from drill_sim_ros.model.analysis import Severity, severity_of
 from drill_sim_ros.model.errors import ParameterError
@@ -43,14 +44,14 @@ class SessionConfig:
 
     preset: Preset
     publish_rate_hz: float = 100.0
-    dtau_max: float = 1e-4
-    n_nodes: int = 2048
+    dtau_max: float = defaults.DTAU
+    n_nodes: int = defaults.N_NODES
     perturb_v: float = 0.0
     applied_wob_n: float | None = None
     surface_rpm: float | None = None
     top_drive_accel_rpm_s: float = 0.0   # 0: no limit
     wob_rate_n_s: float = 0.0            # 0: no limit
-    window_s: float = 20.0
+    window_s: float = defaults.WINDOW_S
     submerged_weight_n: float = 0.0      # for the hook load
     top_drive: TopDrivePhysical | None = None   # None: the preset's drive
     sensors: RigSensors | None = None           # None: perfect surface sensors

@@ -23,6 +23,7 @@ from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescri
 from rclpy.exceptions import InvalidParameterTypeException, InvalidParameterValueException
 from rclpy.impl.implementation_singleton import rclpy_implementation
 
+from drill_sim_ros.model import defaults
 from drill_sim_ros.model.errors import ParameterError
 from drill_sim_ros.model.measurement import MAX_DELAY_PERIODS, SIGNALS
 from drill_sim_ros.model.params import UNIT_SCALES
@@ -60,15 +61,11 @@ def _preset_rpm(preset: Preset | None) -> float:
 
 
 def _preset_dtau(preset: Preset | None) -> float:
-    return 1e-4 if preset is None else preset.dtau
-
-
-def _preset_nodes(preset: Preset | None) -> int:
-    return 2048 if preset is None or preset.n_nodes is None else preset.n_nodes
+    return defaults.DTAU if preset is None else preset.dtau
 
 
 def _max_wob_n(preset: Preset | None) -> float:
-    return max(10.0 * _preset_wob_n(preset), 1.0)
+    return defaults.max_wob_n(_preset_wob_n(preset))
 
 
 def _drive(preset: Preset | None) -> TopDrivePhysical:
@@ -119,16 +116,16 @@ SPECS: tuple[ParamSpec, ...] = (
               "Largest dimensionless integrator step (RGD07 units of t*); refined so that a "
               "whole number of steps fills one publish period.", 1e-7, 0.05, read_only=True,
               unit="1"),
-    ParamSpec("model.n_nodes", INTEGER, _preset_nodes,
+    ParamSpec("model.n_nodes", INTEGER, defaults.n_nodes,
               "Bottom-hole profile nodes per blade sector.", 16, 1 << 22, read_only=True),
-    ParamSpec("model.perturb_v", DOUBLE, 1e-3,
+    ParamSpec("model.perturb_v", DOUBLE, defaults.PERTURB_V,
               "Dimensionless axial-velocity perturbation added at t = 0 (seeds the "
               "instability).", -1e3, 1e3, read_only=True, unit="1"),
     ParamSpec("model.submerged_string_weight_n", DOUBLE, submerged_string_weight_n,
               "Buoyed weight of drill pipe + BHA [N]; hook load = this - applied WOB. "
               "Default: steel mass x g x (1 - 1200 kg/m3 mud / steel density); 0 for "
               "dimensionless presets.", 0.0, 1e10),
-    ParamSpec("limits.max_surface_rpm", DOUBLE, 300.0,
+    ParamSpec("limits.max_surface_rpm", DOUBLE, defaults.MAX_SURFACE_RPM,
               "Surface-rpm commands above this [rev/min] are clamped to it.", 0.0, 1e4),
     ParamSpec("limits.max_wob_n", DOUBLE, _max_wob_n,
               "WOB commands above this [N] are clamped to it (default: 10 x the preset's WOB).",
@@ -195,7 +192,7 @@ SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("record.split_duration_s", DOUBLE, 0.0,
               "Start a new numbered file after this many simulated seconds; 0 = one file.",
               0.0, 1e9, read_only=True, unit="s"),
-    ParamSpec("diagnostics.window_s", DOUBLE, 20.0,
+    ParamSpec("diagnostics.window_s", DOUBLE, defaults.WINDOW_S,
               "Simulated seconds of bit speed behind the stick-slip severity on /diagnostics.",
               0.1, 3600.0, read_only=True, unit="s"),
     ParamSpec("diagnostics.command_timeout_s", DOUBLE, 1.0,
