@@ -277,7 +277,8 @@ def advance(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarra
     stops after the step that reaches ``prm[P_LAYER_U]``. Returns (status, rows)."""
     u, v, phi, omega, phi_s, omega_s, w_app, stuck, node, frac, h_old, step, omega_ref, \
         integral, motor, v_hook, hook_int = _unpack(st)
-    dt, tau_avg, beta, lam, n_blades, psi, off_bottom, layer_u, cut_factor = _law_params(prm)
+    dt, tau_avg, beta, lam, n_blades, psi, off_bottom, layer_u, cut_factor, sector, tgt_w, \
+        w_rate = _law_params(prm, tgt)
     head, count, cursor = meta[0], meta[1], meta[2]
     td_mode, tgt_omega, tgt_torque, omega_rate, td_j, td_kp, td_ki, td_max, td_lag, _ = \
         _drive_params(prm, tgt)
@@ -285,7 +286,7 @@ def advance(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarra
         STATUS_OK, 0.0                       # (a NaN probe survives the contact logic)
     for _ in range(n_steps):
         surface, cursor = _surface(exact, hist, profile, head, count, cursor, node, frac,
-                                   h_old, phi - 2.0 * math.pi / n_blades)
+                                   h_old, phi - sector)
         doc = n_blades * (u - surface)          # delta = n (U - U(tau - tau_n)), eq. 8
         if wave is None:                      # the lumped string (compiled apart)
             v0, kick_v, f_ext, omega0, kick_w, t_ext, t_top, f_top = _lumped_ends(
@@ -318,9 +319,9 @@ def advance(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarra
         u_new, phi_new = u + v_new * dt, phi + omega_new * dt     # symplectic Euler, eq. C.1
         head, count, cursor, node, frac, h_old, ok = _remember(
             exact, hist, profile, head, count, cursor, node, frac, h_old, u, u_new, phi,
-            phi_new, n_blades)
+            phi_new, profile.shape[0] / sector)
         u, v, phi, omega = u_new, v_new, phi_new, omega_new
-        w_app = ramp(w_app, tgt[I_W_APP], prm[P_W_RATE], dt)
+        w_app = ramp(w_app, tgt_w, w_rate, dt)
         step += 1
         if not ok or u >= layer_u:
             status = STATUS_LAYER if ok else (STATUS_HISTORY_FULL if exact else STATUS_RUNAWAY)
@@ -331,11 +332,13 @@ def advance(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarra
 
 
 @njit(cache=True, inline="always")
-def _law_params(prm: np.ndarray) -> tuple:
+def _law_params(prm: np.ndarray, tgt: np.ndarray) -> tuple:
     """dtau, the statistics window start, beta, lambda, n, psi, off bottom, the next layer's
-    top and the cutting factor, for a run."""
+    top, the cutting factor, the blade sector 2 pi / n, the applied weight's target and its
+    ramp rate, read once for a run."""
     return (prm[P_DT], prm[P_TAU_AVG], prm[P_BETA], prm[P_LAM], prm[P_N], prm[P_PSI],
-            prm[P_OFF_BOTTOM] != 0.0, prm[P_LAYER_U], prm[P_CUT])
+            prm[P_OFF_BOTTOM] != 0.0, prm[P_LAYER_U], prm[P_CUT], 2.0 * math.pi / prm[P_N],
+            tgt[I_W_APP], prm[P_W_RATE])
 
 
 @njit(cache=True, inline="always")
@@ -359,14 +362,13 @@ def _surface(exact: bool, hist: np.ndarray, profile: np.ndarray, head: int, coun
 @njit(cache=True, inline="always")
 def _remember(exact: bool, hist: np.ndarray, profile: np.ndarray, head: int, count: int,
               cursor: int, node: int, frac: float, h_old: float, u: float, u_new: float,
-              phi: float, phi_new: float, n_blades: float) -> tuple:
+              phi: float, phi_new: float, inv_spacing: float) -> tuple:
     """The delay's memory after the bit moved: the history stores (PHI, U), or the profile
     nodes passed are re-cut. Returns (head, count, cursor, node, frac, h_old, ok)."""
     if exact:
         head, count, cursor, ok = br.history_store(hist, head, count, cursor, phi, phi_new,
                                                    u_new)
         return head, count, cursor, node, frac, h_old, ok
-    inv_spacing = profile.shape[0] / (2.0 * math.pi / n_blades)
     node, frac, h_old, ok = br.profile_recut(profile, node, frac, h_old, u, u_new,
                                              (phi_new - phi) * inv_spacing)
     return head, count, cursor, node, frac, h_old, ok
