@@ -106,6 +106,14 @@ def test_two_rigs_in_two_namespaces_each_recorded_and_bridged(tmp_path) -> None:
             for rig in rigs:
                 assert bridges[rig].wait_logged(STEPS + 1, 30), bridges[rig].output()
             ros.spin_for(1.5)                   # /diagnostics of both, at 1 Hz
+
+            def services() -> list[str]:
+                return [name for name, _ in node.get_service_names_and_types()]
+
+            # the bridge node offers its parameter services; its inner queue node none
+            assert ros.spin_until(lambda: all(
+                f"/{rig}/rerun_bridge/list_parameters" in services() for rig in rigs), 10)
+            assert not [name for name in services() if "rerun_bridge_" in name]
     finally:
         codes = {f"{kind} {rig}": stop(process) for kind, group in
                  (("bridge", {r: b.proc for r, b in bridges.items()}), ("recorder", recorders),
