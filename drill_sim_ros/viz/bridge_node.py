@@ -221,7 +221,7 @@ def run_units(preset: str | None, timeout_s: float = RUN_INFO_WAIT_S) -> PaperUn
         node.destroy_node()
     if received:
         return PaperUnits.from_run_info(json.loads(received[0].data))
-    rclpy.logging.get_logger(NODE_NAME).warning(
+    rclpy.logging.get_logger(f"{NODE_NAME}_run_info").warning(
         f"no {topics.RUN_INFO} within {timeout_s:g} s: the 2D views use the scales of preset "
         f"{DEFAULT_PRESET!r} (override with --preset)")
     return PaperUnits.load(DEFAULT_PRESET)
