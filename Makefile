@@ -20,7 +20,7 @@ export PYTHONUNBUFFERED := 1
 RUN_DIR ?= runs/$(shell date -u +%Y%m%dT%H%M%SZ)
 RUN_SECONDS ?= 0
 
-.PHONY: venv run test lint bench clean colcon figures
+.PHONY: venv run test lint bench clean colcon figures docs
 
 venv: $(VENV)/.stamp
 
@@ -63,11 +63,16 @@ run: venv
 	echo "[run] replay: $(BIN)/mcap_replay $(RUN_DIR)/run.mcap   view: $(BIN)/rerun $(RUN_DIR)/run.rrd"
 
 test: venv
-	$(BIN)/ruff check drill_sim_ros tests benchmarks
+	$(BIN)/ruff check drill_sim_ros tests benchmarks docs
 	$(BIN)/pytest
 
 lint: venv
-	$(BIN)/ruff check drill_sim_ros tests benchmarks
+	$(BIN)/ruff check drill_sim_ros tests benchmarks docs
+
+# The generated tables of the docs (parameters, topics) from the code's own tables;
+# tests/test_docs.py fails when a committed page differs from what this writes.
+docs: venv
+	$(PY) docs/generate.py
 
 # Benchmarks print figures (no pass/fail): kernel ns/step, node CPU and real-time factor,
 # MCAP throughput, rerun bridge CPU, recording loss, maps, closed loop, lockstep.

@@ -61,13 +61,14 @@ def telemetry_sample(raw: bytes) -> tuple[np.ndarray, int]:
 
 
 def measured_sample(raw: bytes) -> tuple[SurfaceMeasurement, int]:
-    """A drill/surface/measured payload (joints top_drive, quill: MEASURED_JOINTS):
-    (measurement, stamp ns)."""
+    """A drill/surface/measured payload (joints top_drive, quill, hook, wob_estimate:
+    MEASURED_JOINTS): (measurement, stamp ns)."""
     msg = deserialize_message(raw, JointState)
     time_ns = stamp_ns(msg.header.stamp)
     return SurfaceMeasurement(time_s=time_ns / 1e9, drive_speed_rad_s=msg.velocity[0],
                               motor_torque_nm=msg.effort[0],
-                              string_torque_nm=msg.effort[1]), time_ns
+                              string_torque_nm=msg.effort[1], hook_load_n=msg.effort[2],
+                              applied_wob_estimate_n=msg.effort[3]), time_ns
 
 
 SAMPLE_DECODERS = {topics.TELEMETRY: telemetry_sample, topics.SURFACE_MEASURED: measured_sample}

@@ -97,7 +97,8 @@ def session_config(values: dict[str, Any], preset: Any) -> SessionConfig:
         top_drive_accel_rpm_s=values["limits.top_drive_accel_rpm_s"],
         wob_rate_n_s=values["limits.wob_rate_n_s"], window_s=values["diagnostics.window_s"],
         submerged_weight_n=values["model.submerged_string_weight_n"],
-        top_drive=top_drive(values), sensors=rig_sensors(values))
+        top_drive=top_drive(values), sensors=rig_sensors(values),
+        command_delay_s=values["commands.delay_s"])
 
 
 def top_drive(values: dict[str, Any]) -> TopDrivePhysical:

@@ -28,7 +28,7 @@ from tests.ros.harness import Probe, Ros, overrides, ros_context
 
 pytestmark = pytest.mark.ros
 F = topics.TELEMETRY_INDEX
-FIELD = "field_8p5in_shale"
+FIELD = "field_8p5in_shale_lumped"
 PERIOD_S = 0.01          # publish_rate_hz 100 (the default)
 NODE = f"/{topics.NODE_NAME}"
 FAST = 10.0             # a real-time factor the probe keeps up with, even on a busy machine
