@@ -19,6 +19,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from drill_sim_ros.model.defaults import MAX_SURFACE_RPM
 from drill_sim_ros.model.errors import ParameterError
 from drill_sim_ros.model.params import structure
 from drill_sim_ros.model.presets import Preset
@@ -34,7 +35,7 @@ class RigPhysics:
     impedance_nm_s: float            # Z = J_p sqrt(G rho)
     max_torque_nm: float             # the drive's motor torque limit (inf: none)
     bit_area_m2: float               # pi a^2, for the specific energy
-    max_surface_rpm: float = 300.0   # sim_node's default limits.max_surface_rpm
+    max_surface_rpm: float = MAX_SURFACE_RPM   # limits.max_surface_rpm's default
 
     @property
     def first_mode_rad_s(self) -> float:

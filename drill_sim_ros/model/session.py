@@ -16,6 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from drill_sim_ros.model import defaults
 from drill_sim_ros.model import kernel as k
 from drill_sim_ros.model.analysis import Severity, severity_of
 from drill_sim_ros.model.errors import ParameterError
@@ -43,18 +44,19 @@ class SessionConfig:
 
     preset: Preset
     publish_rate_hz: float = 100.0
-    dtau_max: float = 1e-4
-    n_nodes: int = 2048
+    dtau_max: float = defaults.DTAU
+    n_nodes: int = defaults.N_NODES
     perturb_v: float = 0.0
     applied_wob_n: float | None = None
     surface_rpm: float | None = None
     top_drive_accel_rpm_s: float = 0.0   # 0: no limit
     wob_rate_n_s: float = 0.0            # 0: no limit
-    window_s: float = 20.0
+    window_s: float = defaults.WINDOW_S
     submerged_weight_n: float = 0.0      # for the hook load
     top_drive: TopDrivePhysical | None = None   # None: the preset's drive
     sensors: RigSensors | None = None           # None: perfect surface sensors
     command_delay_s: float = 0.0         # transport delay of the set_* inputs (0: none)
+    formation: tuple[dict, ...] = ()     # rock layers by depth (model.formation, SI keys)
 
 
 @dataclass(slots=True)
@@ -110,6 +112,8 @@ class SimSession:
         period_tau = self.period_ns / NS_PER_S / self.scales.time_s
         self.steps = steps_per_period(period_tau, cfg.dtau_max)
         self.sim = build_simulator(cfg, period_tau, self.steps)
+        if cfg.formation:
+            self.set_formation(list(cfg.formation))
         self.submerged_weight_n = cfg.submerged_weight_n
         self.command_stamp_ns: int | None = None    # stamp of the command in force, if any
         self.sensors = cfg.sensors or RigSensors()
