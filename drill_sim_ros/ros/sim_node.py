@@ -2,7 +2,9 @@
 
 Publishes the bit and surface state at ``publish_rate_hz`` of simulated time (stamps in
 simulated time, one stamp per sample on every topic), /diagnostics at 1 Hz wall and /clock;
-takes surface-rpm and WOB setpoints; serves ~/reset, ~/pause and ~/step (lockstep).
+takes surface-rpm and WOB setpoints; serves ~/reset, ~/pause and ~/step (lockstep). With
+drill_sim_msgs installed, drill/typed/* carry the same samples, run info and command typed
+(:mod:`drill_sim_ros.ros.typed`).
 Pacing follows the monotonic clock without drift (:mod:`drill_sim_ros.realtime.pacing`).
 
 One tick path: the ticker thread (real time, free run) or the ``~/step`` callback (lockstep,
