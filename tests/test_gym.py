@@ -37,7 +37,7 @@ def test_a_policy_rollout_is_the_bench_run_bit_for_bit(controller: str, mode: st
     env = gymnasium.make(drill_gym.ENV_ID, scenario=scenario)
     obs, info = env.reset(seed=scenario.sensors["seed"])
     law = build_controller(scenario, env.unwrapped.bench.preset)
-    command, steps, done = law.update(None), 0, False
+    command, steps, done = law.update(info["measurement"]), 0, False   # answers t = 0
     while not done:
         obs, reward, terminated, truncated, info = env.step(action_of(command, mode))
         assert env.observation_space.contains(obs) and math.isfinite(reward)
