@@ -39,7 +39,7 @@ def _top_waves_through_bench(scenario: Scenario, preset: Preset, pulse: bool,
     speed_col = TELEMETRY_INDEX["surface_rpm"]
     count = bench.periods - settle_periods
     a, b = np.empty(count), np.empty(count)
-    command = controller.update(None)
+    command = controller.update(bench.measurement())
     for i in range(bench.periods):
         if pulse and i == settle_periods:
             width = si.PULSE_WIDTH_S / (bench.preset.scales.time_s * sim.config.dtau)

@@ -120,7 +120,7 @@ def run_entry(scenario_data: dict[str, Any], key: str) -> EntryResult:
     start = time.perf_counter()
     bench = Bench(scenario)
     controller = build_controller(scenario, bench.preset)
-    command, fault = controller.update(None), None
+    command, fault = controller.update(bench.measurement()), None   # answers t = 0
     try:
         while not bench.done:
             bench.step(command)
