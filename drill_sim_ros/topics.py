@@ -121,8 +121,9 @@ DESCRIPTIONS: dict[str, str] = {
     CLOCK: "simulated time (when `publish_clock`)",
     RUN_INFO: "JSON of what runs (preset, groups, scales, sampling, string), once",
     STRING_TORSION: "the distributed string along depth at `string.rate_hz` (default 10 Hz) "
-                    "of sim time, `string.depths` (<= 64) joints top to bottom; not for a "
-                    "lumped string",
+                    "of sim time, `string.depths` (<= 64) joints top to bottom, joint "
+                    "`string_DDDD.Dm` at DDDD.D m below the top (e.g. `string_0021.1m`); "
+                    "not for a lumped string",
     CMD_SURFACE_RPM: "top-drive speed setpoint, rev/min",
     CMD_WOB: "applied WOB setpoint, N",
     CMD_TOP_DRIVE: "the controller's command; `header.stamp` = the stamp of the sample it "
