@@ -73,5 +73,7 @@ def test_compiled_si_rows_equal_the_vectorised_reference_bit_for_bit():
     ref[:, F["drive_speed_measured_rad_s"]] = ref[:, F["surface_rpm"]] / RPM_PER_RAD_S
     ref[:, F["motor_torque_measured_nm"]] = ref[:, F["motor_torque_nm"]]
     ref[:, F["string_torque_measured_nm"]] = ref[:, F["surface_torque_nm"]]
+    ref[:, F["hook_load_measured_n"]] = ref[:, F["hook_load_n"]]
+    ref[:, F["applied_wob_estimate_n"]] = weight_n - ref[:, F["hook_load_measured_n"]]
     rows = si_rows(data, offsets, factors, times_s, weight_n, stamp_s)
     assert rows.tobytes() == ref.tobytes()
