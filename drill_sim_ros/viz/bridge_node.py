@@ -37,7 +37,7 @@ from std_msgs.msg import Float64MultiArray, String
 
 from drill_sim_ros import topics
 from drill_sim_ros.archive.output import OutputError, check_output
-from drill_sim_ros.model.presets import DEFAULT_PRESET
+from drill_sim_ros.model.presets import DEFAULT_PRESET, load_preset
 from drill_sim_ros.ros.messages import RUN_INFO_QOS
 from drill_sim_ros.viz.analytics_off import disable_analytics
 from drill_sim_ros.viz.blueprint import build_blueprint, has_string_views
@@ -240,6 +240,15 @@ def wait_run_info(timeout_s: float = RUN_INFO_WAIT_S) -> dict[str, Any] | None:
     return json.loads(received[0].data) if received else None
 
 
+def string_shown(info: dict[str, Any] | None, preset: str | None) -> bool:
+    """Whether the dashboard has the string views: the run info's string is distributed;
+    without run info (the sim not started yet), ``preset``'s (default: the default
+    preset's)."""
+    if info is not None:
+        return has_string_views(info)
+    return load_preset(preset or DEFAULT_PRESET).string.distributed
+
+
 class StartError(Exception):
     """The bridge cannot start as asked (one line)."""
 
@@ -309,7 +318,7 @@ def open_outputs(args: argparse.Namespace, logger: Any) -> Outputs:
     units = run_units(args.preset, info)
     window = default_window_s(units) if args.window_s is None else args.window_s
     frames = view_frames(units, Extents.typical())     # live: the data is not known yet
-    blueprint = build_blueprint(window, frames, has_string_views(info))
+    blueprint = build_blueprint(window, frames, string_shown(info, args.preset))
     recording_id = str(uuid.uuid4())                    # one recording on every sink
     stored = None
     if args.save or args.serve:
