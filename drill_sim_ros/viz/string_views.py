@@ -2,7 +2,8 @@
 the current speed and torque along depth, from drill/string/torsion.
 
 The picture is an RGB image, one row per depth (top drive at the top, bit at the bottom),
-one column per profile (newest at the right), the last :data:`IMAGE_PROFILES` profiles,
+one column per profile (newest at the right), the last :data:`IMAGE_PROFILES` profiles
+(white before the first),
 coloured by speed from 0 (dark blue) to :attr:`StringViews.full_scale_rpm` (dark red):
 torsional waves show as slanted stripes, stick-slip as dark blue bands at the bottom. It is
 logged at most once per :data:`IMAGE_PERIOD_S` of sim time (the viewer shows the latest).
@@ -22,7 +23,7 @@ from drill_sim_ros.model.params import RPM_PER_RAD_S
 from drill_sim_ros.model.telemetry import NS_PER_S
 from drill_sim_ros.viz import entities as ent
 
-IMAGE_PROFILES = 300        # 30 s at the sim's default string.rate_hz of 10 Hz
+IMAGE_PROFILES = 300        # 30 s at the default 10 Hz; a multiple of 4
 IMAGE_PERIOD_S = 1.0
 FULL_SCALE_OF_NOMINAL = 2.5  # the colour scale's top, times the nominal (surface) speed
 # colour stops from 0 to full scale: dark blue, blue, cyan, green, yellow, red, dark red
@@ -102,7 +103,11 @@ class StringViews:
         self.profiles += len(batch)
 
     def _log_image(self, t_s: float) -> None:
-        image = np.stack(self._columns, axis=1)                  # (depths, columns, 3)
+        # always IMAGE_PROFILES wide, white until there are as many profiles: a fixed
+        # picture, and rows of a multiple of 4 bytes (the web viewer draws no others)
+        columns = np.stack(self._columns, axis=1)                # (depths, profiles, 3)
+        image = np.full((columns.shape[0], IMAGE_PROFILES, 3), 255, dtype=np.uint8)
+        image[:, IMAGE_PROFILES - columns.shape[1]:] = columns
         fmt = rr.components.ImageFormat(width=image.shape[1], height=image.shape[0],
                                         color_model="RGB", channel_datatype="U8")
         self.rec.send_columns(ent.STRING_DEPTH_TIME, indexes=_at(t_s),

@@ -113,6 +113,10 @@ def test_depth_time_picture_rows_are_depths_columns_the_last_profiles(run: dict)
     full_scale = 2.5 * 60.0                 # the preset's 60 rpm
     np.testing.assert_array_equal(image[:, -1], speed_colors(last.speed_rad_s * RPM_PER_RAD_S,
                                                              full_scale))
+    first = data.columns["Image:format"][0][0]
+    assert (first["width"], first["height"]) == (IMAGE_PROFILES, len(run["depths"]))
+    first_image = np.frombuffer(bytes(data.columns["Image:buffer"][0][0]), dtype=np.uint8)
+    assert np.all(first_image.reshape(first["height"], -1, 3)[:, :-1] == 255)   # t = 0 only
     earlier = by_stamp[int(data.time_ns[-1]) - 100_000_000 * (IMAGE_PROFILES - 1)]
     np.testing.assert_array_equal(image[:, 0], speed_colors(
         earlier.speed_rad_s * RPM_PER_RAD_S, full_scale))
