@@ -62,7 +62,7 @@ def open_recording(blueprint: rrb.Blueprint, *, save: str | Path | None = None,
 class Recordings:
     """The recording streams the dashboard logs to at the moment.
 
-    It has the two methods the ``log_*`` functions call (``send_columns`` and ``log``) and
+    It has the methods the ``log_*`` functions call (``send_columns``, ``log``, ``set_time``) and
     hands each call to every attached stream, so one stream (a viewer's) can be attached
     and detached without touching the others (a FileSink cannot be re-attached: it would
     truncate its file).
@@ -84,6 +84,10 @@ class Recordings:
     def log(self, *args: Any, **kwargs: Any) -> None:
         for stream in self.streams:
             stream.log(*args, **kwargs)
+
+    def set_time(self, *args: Any, **kwargs: Any) -> None:
+        for stream in self.streams:
+            stream.set_time(*args, **kwargs)
 
 
 def flush_recording(rec: rr.RecordingStream, timeout_s: float) -> str | None:

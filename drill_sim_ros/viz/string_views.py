@@ -25,7 +25,7 @@ from drill_sim_ros.viz import entities as ent
 
 IMAGE_PROFILES = 300        # 30 s at the default 10 Hz; a multiple of 4
 IMAGE_PERIOD_S = 1.0
-FULL_SCALE_OF_NOMINAL = 2.5  # the colour scale's top, times the nominal (surface) speed
+FULL_SCALE_OF_NOMINAL = 2.0  # the colour scale's top, times the nominal speed (green: nominal)
 # colour stops from 0 to full scale: dark blue, blue, cyan, green, yellow, red, dark red
 _STOPS = np.array([(0, 0, 110), (30, 80, 220), (0, 200, 230), (60, 190, 60), (245, 225, 40),
                    (230, 50, 30), (120, 0, 0)], dtype=np.float64)
@@ -92,11 +92,12 @@ class StringViews:
             self._columns.clear()                 # other depths: a new picture
             self._depths_m = batch.depths_m
         rpm = batch.speed_rad_s * RPM_PER_RAD_S
-        self._log_bars(batch, rpm)
-        for t_s, column in zip(batch.sim_time_s.tolist(), rpm, strict=True):
+        for t_s, column, torque in zip(batch.sim_time_s.tolist(), rpm, batch.torque_nm,
+                                       strict=True):
             if t_s < self._last_image_s:
                 self._columns.clear()             # sim time went back: a reset
                 self._last_image_s = -np.inf
+            self._log_bars(t_s, column, torque)
             self._columns.append(speed_colors(column, self.full_scale_rpm))
             if t_s - self._last_image_s >= IMAGE_PERIOD_S:
                 self._log_image(t_s)
@@ -108,22 +109,18 @@ class StringViews:
         columns = np.stack(self._columns, axis=1)                # (depths, profiles, 3)
         image = np.full((columns.shape[0], IMAGE_PROFILES, 3), 255, dtype=np.uint8)
         image[:, IMAGE_PROFILES - columns.shape[1]:] = columns
-        fmt = rr.components.ImageFormat(width=image.shape[1], height=image.shape[0],
-                                        color_model="RGB", channel_datatype="U8")
-        self.rec.send_columns(ent.STRING_DEPTH_TIME, indexes=_at(t_s),
-                              columns=rr.Image.columns(buffer=[image.tobytes()], format=[fmt]))
+        self.rec.set_time(ent.TIMELINE, duration=t_s)
+        self.rec.log(ent.STRING_DEPTH_TIME, rr.Image(image, color_model="RGB"))
         self._last_image_s = t_s
 
-    def _log_bars(self, batch: StringBatch, rpm: np.ndarray) -> None:
-        """One bar chart row per profile: speed rpm and torque kN m over depth m."""
-        depths = batch.depths_m
+    def _log_bars(self, t_s: float, rpm: np.ndarray, torque_nm: np.ndarray) -> None:
+        """The bar charts of one profile: speed rpm and torque kN m over depth m. Logged
+        row by row (the stream's batcher merges them into chunks: one chunk per row, as
+        ``send_columns`` makes them, loads slowly in the web viewer)."""
+        depths = self._depths_m
         width = 0.9 * (float(np.diff(depths).min()) if len(depths) > 1 else 1.0)
-        for path, values, color in ((ent.STRING_SPEED, rpm, SPEED_COLOR),
-                                    (ent.STRING_TORQUE, batch.torque_nm * 1e-3, TORQUE_COLOR)):
-            for t_s, row in zip(batch.sim_time_s.tolist(), values, strict=True):
-                self.rec.send_columns(path, indexes=_at(t_s), columns=rr.BarChart.columns(
-                    values=row, abscissa=depths, widths=[width], color=[(*color, 255)]))
-
-
-def _at(t_s: float) -> list[rr.TimeColumn]:
-    return [rr.TimeColumn(ent.TIMELINE, duration=[t_s])]
+        self.rec.set_time(ent.TIMELINE, duration=t_s)
+        self.rec.log(ent.STRING_SPEED, rr.BarChart(rpm, abscissa=depths, widths=[width],
+                                                   color=SPEED_COLOR))
+        self.rec.log(ent.STRING_TORQUE, rr.BarChart(torque_nm * 1e-3, abscissa=depths,
+                                                    widths=[width], color=TORQUE_COLOR))

@@ -110,7 +110,7 @@ def test_depth_time_picture_rows_are_depths_columns_the_last_profiles(run: dict)
     assert image.shape == (len(run["depths"]), IMAGE_PROFILES, 3)
     by_stamp = {s.stamp_ns: s for s in run["strings"]}
     last = by_stamp[int(data.time_ns[-1])]
-    full_scale = 2.5 * 60.0                 # the preset's 60 rpm
+    full_scale = 2.0 * 60.0                 # twice the preset's 60 rpm
     np.testing.assert_array_equal(image[:, -1], speed_colors(last.speed_rad_s * RPM_PER_RAD_S,
                                                              full_scale))
     first = data.columns["Image:format"][0][0]
