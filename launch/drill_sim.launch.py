@@ -54,7 +54,9 @@ def generate_launch_description() -> LaunchDescription:
                     arguments=["-o", _arg("record_path")],
                     parameters=[{"use_sim_time": use_sim_time}],
                     condition=IfCondition(_arg("record")))
-    bridge = Node(package=PACKAGE, executable="rerun_bridge", name="rerun_bridge",
+    # no name=: launch_ros renames with __node:=, which would give the bridge's inner
+    # nodes its name too
+    bridge = Node(package=PACKAGE, executable="rerun_bridge",
                   namespace=namespace, output="screen",
                   arguments=["--save", _arg("bridge_path")],
                   parameters=[{"use_sim_time": use_sim_time}],

@@ -29,13 +29,13 @@ import numpy as np
 
 from drill_sim_ros.control.rig import RigPhysics
 from drill_sim_ros.control.schedule import Schedule
-from drill_sim_ros.model import analysis
+from drill_sim_ros.model import analysis, defaults
 from drill_sim_ros.model.params import RPM_PER_RAD_S
 from drill_sim_ros.model.telemetry import TELEMETRY_INDEX
 
 F = TELEMETRY_INDEX
 STUCK = 2
-WINDOW_S = 20.0
+WINDOW_S = defaults.WINDOW_S  # the severity window of sim_node's /diagnostics
 STALL_S = 10.0            # stuck this long at the end of a run: stalled (a stick phase of
                           # the field case's stick-slip lasts 2-4 s)
 SCORE_FIELDS = ("ssi_before_mean", "ssi_mean", "ssi_max", "ssi_last", "stick_fraction", "utr",

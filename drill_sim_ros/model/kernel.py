@@ -69,7 +69,8 @@ P_PARTS_T = 17      # distributed: parts of the torsional line (the axial ones f
 P_BIT_INERTIA = 18  # distributed: lumped inertia at the bit / I
 P_HOOK_KP = 19      # distributed: hook speed per unit force error (WOB loop, P)
 P_HOOK_KI = 20      # distributed: hook speed per unit force error x tau (WOB loop, I)
-P_OFF_BOTTOM = 21   # 1: the bit hangs free off bottom (T = W = 0) and the hook is fixed
+P_OFF_BOTTOM = 21   # 1: the bit hangs free off bottom (T = W = 0), the hook fixed; 2: and
+                    # the torsional line ends without reflection (an anechoic bottom)
 P_BHA_PART = 22     # distributed: the part at whose top the BHA speed is read
 N_PARAMS = 23
 
@@ -211,19 +212,24 @@ def _distributed_ends(prm: np.ndarray, wave: np.ndarray, wave_i: np.ndarray,
 
 @njit(cache=True, inline="always")
 def _distributed_move(prm: np.ndarray, wave: np.ndarray, wave_i: np.ndarray,
-                      wave_f: np.ndarray, omega_s_next: float, v_hook: float, v_new: float,
-                      omega_new: float) -> None:
+                      wave_f: np.ndarray, w_app: float, f_top: float, hook_int: float,
+                      omega_s_next: float, v_new: float, omega_new: float
+                      ) -> tuple[float, float]:
     """The distributed string moves on by one step: both lines take what the drive, the
-    hook (at ``v_hook`` over this step) and the bit send into them (a = b + 2 Z w at the
-    top, b = a - 2 Z w at the bottom)."""
+    hook (its WOB loop on ``f_top``, :func:`_hook`) and the bit send into them
+    (a = b + 2 Z w at the top, b = a - 2 Z w at the bottom). Returns the hook's speed over
+    the step and its loop integral."""
+    v_hook, hook_int = _hook(prm, w_app, f_top, hook_int)
     parts_t, parts = int(prm[P_PARTS_T]), wave_i.shape[1]
     z = wave_f[sg.W_Z]
     b_top_t, a_bot_t = sg.arriving(wave, wave_i, 0, parts_t)
     b_top_a, a_bot_a = sg.arriving(wave, wave_i, parts_t, parts)
+    anechoic = prm[P_OFF_BOTTOM] == 2.0       # nothing comes back from below
     sg.scatter(wave, wave_i, wave_f, 0, parts_t, b_top_t + 2.0 * z[0] * omega_s_next,
-               a_bot_t - 2.0 * z[parts_t - 1] * omega_new)
+               0.0 if anechoic else a_bot_t - 2.0 * z[parts_t - 1] * omega_new)
     sg.scatter(wave, wave_i, wave_f, parts_t, parts, b_top_a + 2.0 * z[parts_t] * v_hook,
                a_bot_a - 2.0 * z[parts - 1] * v_new)
+    return v_hook, hook_int
 
 
 @njit(cache=True, inline="always")
@@ -266,40 +272,22 @@ def advance(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarra
             hist: np.ndarray, meta: np.ndarray, acc: np.ndarray, out: np.ndarray,
             wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray,
             n_steps: int, every: int, exact: bool) -> tuple[int, int]:
-    """Advance up to ``n_steps``; a step is the bit law, the drive and the string.
-
-    Delay (eqs. 6-8, 26-28): ``exact=False`` (production) reads ``profile`` (shape
-    (n_nodes,), the rock height per node of one blade sector) and re-cuts it (module
-    bit_rock; pass :data:`NO_HISTORY`, :data:`NO_META`); ``exact=True`` (the reference path
-    of RGD07 Appendix C) solves eq. (7) in the (PHI, U) history ``hist`` (2, capacity) with
-    ``meta`` (int64: head, count, cursor). ``wave``, ``wave_i``, ``wave_f``: the delay lines
-    of a distributed string (ignored by the lumped one: pass :data:`NO_WAVE`, ...).
-    out: (rows, N_COLS); a row is written when the global step % every == 0. Stops after
-    the step at which the bit reaches ``prm[P_LAYER_U]`` (STATUS_LAYER).
-    Returns ``(status, rows_written)``. The state lives in locals during the loop.
-    """
+    """Up to ``n_steps`` of bit law, drive and string; delay from ``profile`` or ``hist``
+    (:func:`_surface`); ``wave*`` None: lumped; a row of ``out`` when step % every == 0;
+    stops after the step that reaches ``prm[P_LAYER_U]``. Returns (status, rows)."""
     u, v, phi, omega, phi_s, omega_s, w_app, stuck, node, frac, h_old, step, omega_ref, \
         integral, motor, v_hook, hook_int = _unpack(st)
-    dt, tau_avg, beta, lam = prm[P_DT], prm[P_TAU_AVG], prm[P_BETA], prm[P_LAM]
-    off_bottom, n_blades, psi = prm[P_OFF_BOTTOM] != 0.0, prm[P_N], prm[P_PSI]
+    dt, tau_avg, beta, lam, n_blades, psi, off_bottom, layer_u, cut_factor, sector, tgt_w, \
+        w_rate = _law_params(prm, tgt)
     head, count, cursor = meta[0], meta[1], meta[2]
-    sector = 2.0 * math.pi / prm[P_N]
-    inv_spacing = profile.shape[0] / sector
     td_mode, tgt_omega, tgt_torque, omega_rate, td_j, td_kp, td_ki, td_max, td_lag, _ = \
         _drive_params(prm, tgt)
-    tgt_w, w_rate, layer_u, cut_factor = tgt[I_W_APP], prm[P_W_RATE], prm[P_LAYER_U], prm[P_CUT]
-    stats = (acc[0], acc[1], acc[2], acc[3], acc[4], acc[5], acc[6], acc[7], acc[8], acc[9],
-             acc[10], acc[11], acc[12])
-    countdown = _first_countdown(step, every)
-    n_rows, status, probe = 0, STATUS_OK, 0.0  # NaN would vanish in the contact/stick logic
+    stats, countdown, n_rows, status, probe = _stats(acc), _first_countdown(step, every), 0, \
+        STATUS_OK, 0.0                       # (a NaN probe survives the contact logic)
     for _ in range(n_steps):
-        tau = step * dt
-        if exact:                             # delta = n (U - U(tau - tau_n)), eqs. 8, 26-28
-            surface, cursor = br.delayed_depth(hist[0], hist[1], head, count, cursor,
-                                               phi - sector)
-        else:
-            surface = br.profile_surface(profile, node, frac, h_old)
-        doc = n_blades * (u - surface)
+        surface, cursor = _surface(exact, hist, profile, head, count, cursor, node, frac,
+                                   h_old, phi - sector)
+        doc = n_blades * (u - surface)          # delta = n (U - U(tau - tau_n)), eq. 8
         if wave is None:                      # the lumped string (compiled apart)
             v0, kick_v, f_ext, omega0, kick_w, t_ext, t_top, f_top = _lumped_ends(
                 psi, dt, phi_s, phi, v, omega, w_app)
@@ -313,55 +301,90 @@ def advance(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarra
             td_mode, omega_s, omega_ref, integral, motor, t_top, tgt_omega, tgt_torque,
             omega_rate, td_j, td_kp, td_ki, td_max, td_lag, dt)
         probe += w_f + tob + motor
-        stats = _accumulate(stats, tau, tau_avg, mode, w_f, tob, doc, wob, omega, t_top, v)
-        if countdown == 0:
-            if n_rows < out.shape[0]:
-                omega_bha = omega if wave is None else \
-                    sg.speed_at_top_of(wave, wave_i, wave_f, int(prm[P_BHA_PART]))
-                _write_row(out[n_rows], tau, u, v, phi, omega, phi_s, omega_s, w_app, wob,
-                           tob, doc, w_f, t_top, mode, motor, omega_ref, f_top, omega_bha)
-                n_rows += 1
-            countdown = every - 1
-        else:
-            countdown -= 1
-        if wave is None:
-            # kinematic: the angle advances at the speed the step started with (as before
-            # the drive had inertia, bit for bit); an inertial drive: symplectic Euler
+        stats = _accumulate(stats, step * dt, tau_avg, mode, w_f, tob, doc, wob, omega, t_top, v)
+        if countdown == 0 and n_rows < out.shape[0]:
+            omega_bha = omega if wave is None else \
+                sg.speed_at_top_of(wave, wave_i, wave_f, int(prm[P_BHA_PART]))
+            _write_row(out[n_rows], step * dt, u, v, phi, omega, phi_s, omega_s, w_app, wob, tob,
+                       doc, w_f, t_top, mode, motor, omega_ref, f_top, omega_bha)
+            n_rows += 1
+        countdown = every - 1 if countdown == 0 else countdown - 1
+        if wave is None:    # kinematic: the angle moves at the step's starting speed
             phi_s += (omega_s if td_mode == TD_KINEMATIC else omega_s_next) * dt
         else:
-            v_hook, hook_int = _hook(prm, w_app, f_top, hook_int)
-            _distributed_move(prm, wave, wave_i, wave_f, omega_s_next, v_hook, v_new,
-                              omega_new)
+            v_hook, hook_int = _distributed_move(prm, wave, wave_i, wave_f, w_app, f_top,
+                                                 hook_int, omega_s_next, v_new, omega_new)
             phi_s += omega_s_next * dt
         omega_s = omega_s_next
-        # ---- symplectic Euler for the bit (eq. C.1 with the updated velocities)
-        u_new = u + v_new * dt
-        phi_new = phi + omega_new * dt
-        if exact:
-            head, count, cursor, ok = br.history_store(hist, head, count, cursor, phi,
-                                                       phi_new, u_new)
-        else:
-            node, frac, h_old, ok = br.profile_recut(profile, node, frac, h_old, u, u_new,
-                                                     (phi_new - phi) * inv_spacing)
+        u_new, phi_new = u + v_new * dt, phi + omega_new * dt     # symplectic Euler, eq. C.1
+        head, count, cursor, node, frac, h_old, ok = _remember(
+            exact, hist, profile, head, count, cursor, node, frac, h_old, u, u_new, phi,
+            phi_new, profile.shape[0] / sector)
         u, v, phi, omega = u_new, v_new, phi_new, omega_new
         w_app = ramp(w_app, tgt_w, w_rate, dt)
         step += 1
-        if not ok:
-            status = STATUS_HISTORY_FULL if exact else STATUS_RUNAWAY
+        if not ok or u >= layer_u:
+            status = STATUS_LAYER if ok else (STATUS_HISTORY_FULL if exact else STATUS_RUNAWAY)
             break
-        if u >= layer_u:
-            status = STATUS_LAYER
-            break
-    _pack(st, u, v, phi, omega, phi_s, omega_s, w_app, stuck, node, frac, h_old, step,
-          omega_ref, integral, motor, v_hook, hook_int, dt)
-    meta[0], meta[1], meta[2] = head, count, cursor
+    _pack(st, meta, u, v, phi, omega, phi_s, omega_s, w_app, stuck, node, frac, h_old, step,
+          omega_ref, integral, motor, v_hook, hook_int, dt, head, count, cursor)
+    return _finish(acc, stats, status, (u, v, phi, omega, omega_s, probe)), n_rows
+
+
+@njit(cache=True, inline="always")
+def _law_params(prm: np.ndarray, tgt: np.ndarray) -> tuple:
+    """dtau, the statistics window start, beta, lambda, n, psi, off bottom, the next layer's
+    top, the cutting factor, the blade sector 2 pi / n, the applied weight's target and its
+    ramp rate, read once for a run."""
+    return (prm[P_DT], prm[P_TAU_AVG], prm[P_BETA], prm[P_LAM], prm[P_N], prm[P_PSI],
+            prm[P_OFF_BOTTOM] != 0.0, prm[P_LAYER_U], prm[P_CUT], 2.0 * math.pi / prm[P_N],
+            tgt[I_W_APP], prm[P_W_RATE])
+
+
+@njit(cache=True, inline="always")
+def _stats(acc: np.ndarray) -> tuple:
+    """The statistics as a tuple of locals (``A_*`` order)."""
+    return (acc[0], acc[1], acc[2], acc[3], acc[4], acc[5], acc[6], acc[7], acc[8], acc[9],
+            acc[10], acc[11], acc[12])
+
+
+@njit(cache=True, inline="always")
+def _surface(exact: bool, hist: np.ndarray, profile: np.ndarray, head: int, count: int,
+             cursor: int, node: int, frac: float, h_old: float,
+             phi_target: float) -> tuple[float, int]:
+    """The rock height the bit cuts down to now, U(tau - tau_n) (eqs. 6-7, 26-28): from the
+    bottom-hole profile, or from the exact history at the angle one sector back."""
+    if exact:
+        return br.delayed_depth(hist[0], hist[1], head, count, cursor, phi_target)
+    return br.profile_surface(profile, node, frac, h_old), cursor
+
+
+@njit(cache=True, inline="always")
+def _remember(exact: bool, hist: np.ndarray, profile: np.ndarray, head: int, count: int,
+              cursor: int, node: int, frac: float, h_old: float, u: float, u_new: float,
+              phi: float, phi_new: float, inv_spacing: float) -> tuple:
+    """The delay's memory after the bit moved: the history stores (PHI, U), or the profile
+    nodes passed are re-cut. Returns (head, count, cursor, node, frac, h_old, ok)."""
+    if exact:
+        head, count, cursor, ok = br.history_store(hist, head, count, cursor, phi, phi_new,
+                                                   u_new)
+        return head, count, cursor, node, frac, h_old, ok
+    node, frac, h_old, ok = br.profile_recut(profile, node, frac, h_old, u, u_new,
+                                             (phi_new - phi) * inv_spacing)
+    return head, count, cursor, node, frac, h_old, ok
+
+
+@njit(cache=True, inline="always")
+def _finish(acc: np.ndarray, stats: tuple, status: int, values: tuple) -> int:
+    """The statistics back into ``acc``; a clean stop whose state is not finite becomes
+    STATUS_NONFINITE."""
     for i in range(N_ACC):
         acc[i] = stats[i]
-    if status in (STATUS_OK, STATUS_LAYER) and not (
-            math.isfinite(u) and math.isfinite(v) and math.isfinite(phi)
-            and math.isfinite(omega) and math.isfinite(omega_s) and math.isfinite(probe)):
-        status = STATUS_NONFINITE
-    return status, n_rows
+    if status in (STATUS_OK, STATUS_LAYER):
+        for x in values:
+            if not math.isfinite(x):
+                return STATUS_NONFINITE
+    return status
 
 
 @njit(cache=True, inline="always")
@@ -382,11 +405,13 @@ def _unpack(st: np.ndarray) -> tuple:
 
 
 @njit(cache=True, inline="always")
-def _pack(st: np.ndarray, u: float, v: float, phi: float, omega: float, phi_s: float,
-          omega_s: float, w_app: float, stuck: bool, node: int, frac: float, h_old: float,
-          step: int, omega_ref: float, integral: float, motor: float, v_hook: float,
-          hook_int: float, dt: float) -> None:
-    """The loop's locals back into the state vector."""
+def _pack(st: np.ndarray, meta: np.ndarray, u: float, v: float, phi: float, omega: float,
+          phi_s: float, omega_s: float, w_app: float, stuck: bool, node: int, frac: float,
+          h_old: float, step: int, omega_ref: float, integral: float, motor: float,
+          v_hook: float, hook_int: float, dt: float, head: int, count: int,
+          cursor: int) -> None:
+    """The loop's locals back into the state vector and the history's bookkeeping."""
+    meta[0], meta[1], meta[2] = head, count, cursor
     st[S_U], st[S_V], st[S_PHI], st[S_OMEGA] = u, v, phi, omega
     st[S_PHI_S], st[S_OMEGA_S], st[S_W_APP] = phi_s, omega_s, w_app
     st[S_STUCK] = 1.0 if stuck else 0.0

@@ -22,6 +22,7 @@ from typing import Any
 import yaml
 
 from drill_sim_ros.model.errors import ParameterError
+from drill_sim_ros.model.formation import Rock
 from drill_sim_ros.model.params import (
     UNIT_SCALES,
     DimensionlessParams,
@@ -64,6 +65,18 @@ class Preset:
     @property
     def is_physical(self) -> bool:
         return self.physical is not None
+
+    @property
+    def rock(self) -> Rock:
+        """The reference rock and bit that formation layers are scaled against."""
+        phys = self.physical
+        if phys is None:
+            raise ParameterError(f"preset '{self.name}' is dimensionless; formation layers "
+                                 "are given in SI and need a physical preset")
+        return Rock(eps_pa=phys.intrinsic_specific_energy_pa, zeta=phys.zeta,
+                    mu_gamma=phys.mu_gamma,
+                    sigma_l_n_per_m=phys.contact_stress_times_wearflat_n_per_m,
+                    length_m=self.scales.length_m)
 
     @property
     def kernel_string(self) -> KernelString:
@@ -119,6 +132,10 @@ def preset_from_dict(name: str, data: dict[str, Any]) -> Preset:
     if has_phys:
         physical = physical_from_dict(data["physical"])
         string = string_from_dict(data.get("string") or {}, physical)
+        shorthand = sorted(key for key in data["physical"] if key.startswith(("pipe_", "bha_")))
+        if shorthand and (data.get("string") or {}).get("sections") is not None:
+            raise ParameterError(f"preset '{name}': physical {', '.join(shorthand)} would be "
+                                 "ignored: string.sections defines the string (give one)")
         params, scales = scale(physical, string)
     else:
         if "string" in data:

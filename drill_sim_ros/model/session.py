@@ -16,10 +16,12 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
+from drill_sim_ros.model import defaults
 from drill_sim_ros.model import kernel as k
 from drill_sim_ros.model.analysis import Severity, severity_of
 from drill_sim_ros.model.depth_profile import MAX_DEPTHS, DepthSampler, StringSample
 from drill_sim_ros.model.errors import ParameterError
+from drill_sim_ros.model.formation import layers_from_dicts
 from drill_sim_ros.model.measurement import RigSensors
 from drill_sim_ros.model.params import GROUPS
 from drill_sim_ros.model.presets import Preset
@@ -43,18 +45,19 @@ class SessionConfig:
 
     preset: Preset
     publish_rate_hz: float = 100.0
-    dtau_max: float = 1e-4
-    n_nodes: int = 2048
+    dtau_max: float = defaults.DTAU
+    n_nodes: int = defaults.N_NODES
     perturb_v: float = 0.0
     applied_wob_n: float | None = None
     surface_rpm: float | None = None
     top_drive_accel_rpm_s: float = 0.0   # 0: no limit
     wob_rate_n_s: float = 0.0            # 0: no limit
-    window_s: float = 20.0
+    window_s: float = defaults.WINDOW_S
     submerged_weight_n: float = 0.0      # for the hook load
     top_drive: TopDrivePhysical | None = None   # None: the preset's drive
     sensors: RigSensors | None = None           # None: perfect surface sensors
     command_delay_s: float = 0.0         # transport delay of the set_* inputs (0: none)
+    formation: tuple[dict, ...] = ()     # rock layers by depth (model.formation, SI keys)
     string_rate_hz: float = 0.0          # string profiles per s of sim time (0: none)
     string_depths: int = MAX_DEPTHS      # depths of each profile
 
@@ -114,6 +117,8 @@ class SimSession:
         period_tau = self.period_ns / NS_PER_S / self.scales.time_s
         self.steps = steps_per_period(period_tau, cfg.dtau_max)
         self.sim = build_simulator(cfg, period_tau, self.steps)
+        if cfg.formation:
+            self.set_formation(list(cfg.formation))
         self.submerged_weight_n = cfg.submerged_weight_n
         self.command_stamp_ns: int | None = None    # stamp of the command in force, if any
         self.sensors = cfg.sensors or RigSensors()
@@ -325,6 +330,12 @@ class SimSession:
         """New drive gains, limit and mode (SI) from the next period, without a bump; the
         inertia is fixed for a session."""
         self.sim.set_top_drive(drive.scaled(self.scales))
+
+    def set_formation(self, layers: list[dict]) -> None:
+        """Rock layers by depth below the start (SI keys of model.formation.LAYER_KEYS), from
+        the next period; ``[]``: the preset's rock throughout."""
+        self.sim.set_formation(layers_from_dicts(layers, self.cfg.preset.rock) if layers
+                               else ())
 
     def reset(self) -> None:
         """Model back to its initial state and setpoints; the simulated clock runs on."""

@@ -19,6 +19,7 @@ from drill_sim_ros.model import string as sg
 from drill_sim_ros.model import top_drive as td
 from drill_sim_ros.model.analysis import TrivialSolution, trivial_solution
 from drill_sim_ros.model.errors import HistoryOverflow, NumericalFault, ParameterError
+from drill_sim_ros.model.formation import Layer
 from drill_sim_ros.model.params import UNIT_SCALES, DimensionlessParams, Scales
 
 METHODS = ("profile", "exact")
@@ -73,6 +74,7 @@ class Snapshot:
     top_drive_mode: float = td.TD_KINEMATIC
     wave: np.ndarray | None = None
     wave_pos: np.ndarray | None = None
+    layer_index: int = -1
 
 
 @dataclass
@@ -123,6 +125,8 @@ class Simulator:
         self.top_drive = top_drive or td.TopDrive()
         self.scales = scales
         self.string = string
+        self._layers: tuple[Layer, ...] = ()
+        self._layer_index = -1
         self._wave_layout()
         for name, value in (("perturb_v", perturb_v), ("perturb_omega", perturb_omega)):
             if not math.isfinite(value):
@@ -149,7 +153,7 @@ class Simulator:
         self._prm[k.P_TD_KP] = d.kp
         self._prm[k.P_TD_KI] = d.ki
         self._prm[k.P_TD_MAX_TORQUE] = d.max_torque
-        self._prm[k.P_TD_LAG_ALPHA] = 1.0
+        self._prm[k.P_TD_LAG_ALPHA] = d.lag_alpha(c.dtau)
         self._prm[k.P_CUT] = 1.0
         self._prm[k.P_LAYER_U] = math.inf
         s = self.string
@@ -221,6 +225,7 @@ class Simulator:
         self._init_profile(triv)
         self._init_history(triv)
         self._init_wave(triv)
+        self.set_formation(self._layers)
         self.fault: str | None = None
 
     def _init_profile(self, triv: TrivialSolution) -> None:
@@ -314,6 +319,7 @@ class Simulator:
         self._prm[k.P_TD_KP] = drive.kp
         self._prm[k.P_TD_KI] = drive.ki
         self._prm[k.P_TD_MAX_TORQUE] = drive.max_torque
+        self._prm[k.P_TD_LAG_ALPHA] = drive.lag_alpha(self.config.dtau)
         self.set_top_drive_mode(drive.mode)
 
     def set_speed_setpoint_rad_s(self, speed_rad_s: float) -> None:
@@ -403,10 +409,38 @@ class Simulator:
         self._close_run(n_steps, status)
         return written
 
+    # ---- formation layers (model.formation) --------------------------------------------
+    def set_formation(self, layers: tuple[Layer, ...]) -> None:
+        """Rock layers by depth (kernel terms, tops in L* below the start); the layer the bit
+        is in now applies from the next step, the others where the bit reaches their top.
+        An empty tuple is the preset's rock throughout."""
+        self._layers = layers
+        self._layer_index = -1
+        depth = self._state[k.S_U] + self._depth_offset
+        while (self._layer_index + 1 < len(layers)
+               and layers[self._layer_index + 1].top <= depth):
+            self._layer_index += 1
+        self._apply_layer()
+
+    def _apply_layer(self) -> None:
+        """The bit law's rock parameters of the current layer and the next layer's top."""
+        layers, i, p = self._layers, self._layer_index, self.params
+        layer = layers[i] if i >= 0 else None
+        self._prm[k.P_CUT] = 1.0 if layer is None else layer.cut_factor
+        self._prm[k.P_BETA] = p.beta if layer is None else layer.beta
+        self._prm[k.P_LAM] = p.lam if layer is None else layer.lam
+        self._prm[k.P_LAYER_U] = (layers[i + 1].top - self._depth_offset
+                                  if i + 1 < len(layers) else math.inf)
+
+    @property
+    def layer_index(self) -> int:
+        """The formation layer the bit is in (-1: the preset's rock, above the first)."""
+        return self._layer_index
+
     def _next_layer(self) -> None:
-        """The bit reached the next formation layer: no layers here (see subclasses of the
-        schedule); never reached, P_LAYER_U is inf."""
-        self._prm[k.P_LAYER_U] = math.inf
+        """The bit reached the next layer's top (kernel STATUS_LAYER)."""
+        self._layer_index += 1
+        self._apply_layer()
 
     def sample_into(self, out: np.ndarray) -> None:
         """The sample of the current state into ``out`` (one row of ``kernel.C_*`` columns,
@@ -480,6 +514,7 @@ class Simulator:
             if self._hist is not None:
                 self._hist[1] -= shift
             self._depth_offset += shift
+            self._apply_layer()                # the next top, in the new depth frame
         if abs(st[k.S_PHI]) > REBASE_DEPTH:
             turns = 2.0 * math.pi * math.floor(st[k.S_PHI] / (2.0 * math.pi))
             st[k.S_PHI] -= turns
@@ -507,6 +542,14 @@ class Simulator:
             return depth, speed * sc.length_m / sc.time_s, force * sc.force_n
         return depth, speed / sc.time_s, force * sc.torque_nm
 
+    def top_waves(self) -> tuple[float, float]:
+        """The torsional waves at the top of the string now, kernel units: (a, the one the
+        drive sent down last step; b, the one arriving from below)."""
+        wave, wave_i = self._wave, self._wave_i
+        off, n, pos = (int(wave_i[sg.W_OFF, 0]), int(wave_i[sg.W_LEN, 0]),
+                       int(wave_i[sg.W_POS, 0]))
+        return float(wave[off + (pos - 1) % n]), float(wave[off + n + pos])
+
     def string_energy(self) -> float:
         """Kinetic + strain energy of the distributed string now, in kernel units (torque
         unit C x rad for the torsional line, force unit x L* for the axial one)."""
@@ -517,11 +560,12 @@ class Simulator:
                 + sg.line_energy(self._wave, self._wave_i, self._wave_f, parts_t,
                                  self._wave_i.shape[1], dtau))
 
-    def hang_off_bottom(self) -> None:
+    def hang_off_bottom(self, anechoic: bool = False) -> None:
         """The bit hangs free off bottom (no bit-rock forces), the hook is fixed, and the
         string is at rest: no twist, no torque, no axial motion, turning at the drive's
-        speed, as the string instruments start (``drill_sim modes``, ``reflection``)."""
-        self._prm[k.P_OFF_BOTTOM] = 1.0
+        speed, as the string instruments start (``drill_sim modes``, ``reflection``).
+        ``anechoic``: the torsional line's bottom sends nothing back up (a matched end)."""
+        self._prm[k.P_OFF_BOTTOM] = 2.0 if anechoic else 1.0
         st = self._state
         if self.distributed:
             parts_t = self._parts[0]
@@ -548,7 +592,7 @@ class Simulator:
                         None if self._meta is None else self._meta.copy(),
                         self._depth_offset, self._angle_offset, float(self._prm[k.P_TD_MODE]),
                         *((self._wave.copy(), self._wave_i[sg.W_POS].copy())
-                          if self.distributed else (None, None)))
+                          if self.distributed else (None, None)), self._layer_index)
 
     def restore(self, snap: Snapshot) -> None:
         """Resume from a :meth:`snapshot` of a simulator with the same settings."""
@@ -563,6 +607,8 @@ class Simulator:
         self._depth_offset = snap.depth_offset
         self._angle_offset = snap.angle_offset
         self._prm[k.P_TD_MODE] = snap.top_drive_mode
+        self._layer_index = min(snap.layer_index, len(self._layers) - 1)
+        self._apply_layer()
         if snap.wave is not None and self.distributed:
             if snap.wave.shape != self._wave.shape:
                 raise ParameterError("snapshot string layout differs from this simulator's")

@@ -17,6 +17,7 @@ lines), off bottom with the hook fixed, after a short pulse sent up from the bit
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -48,17 +49,29 @@ class Modes:
                           "analytic_hz": self.axial_analytic_hz}}
 
 
-def _require_distributed(preset: Preset) -> None:
+def require_distributed(preset: Preset) -> None:
     if not preset.string.distributed:
         raise ParameterError(f"preset '{preset.name}' has a lumped string; the string "
                              "instruments need 'string: {model: distributed}'")
 
 
+def reflection_preset(preset: Preset) -> Preset:
+    """``preset`` with its string replaced by its top section twice over, undamped: a
+    uniform line in which a pulse from the bit meets only the top drive (the bottom is
+    made anechoic by :meth:`Simulator.hang_off_bottom`), so the waves that come back down
+    are the drive's reflection and nothing else. Scales, rock and drive are unchanged."""
+    require_distributed(preset)
+    top = replace(preset.string.sections[0], torsional_damping_per_s=0.0,
+                  axial_damping_per_s=0.0)
+    return replace(preset, string=replace(preset.string, sections=(top, top),
+                                          bit_inertia_kg_m2=0.0))
+
+
 def off_bottom_simulator(preset: Preset, drive: TopDrive, dtau: float | None = None,
-                         undamped: bool = False) -> Simulator:
+                         undamped: bool = False, anechoic: bool = False) -> Simulator:
     """A simulator of ``preset`` with the bit hanging free off bottom, the hook fixed, the
     string untwisted and turning at the preset's speed (no torque, no axial motion)."""
-    _require_distributed(preset)
+    require_distributed(preset)
     spec = preset.string
     if undamped:
         sections = tuple(replace(s, torsional_damping_per_s=0.0, axial_damping_per_s=0.0)
@@ -68,7 +81,7 @@ def off_bottom_simulator(preset: Preset, drive: TopDrive, dtau: float | None = N
     string = sg.kernel_string(spec, sc.time_s, sc.torque_nm, sc.length_m, sc.force_n)
     sim = Simulator(preset.params, SimConfig(dtau=dtau or preset.dtau, n_nodes=64),
                     top_drive=drive, scales=sc, string=string)
-    sim.hang_off_bottom()
+    sim.hang_off_bottom(anechoic)
     return sim
 
 
@@ -206,20 +219,44 @@ def _top_records(sim: Simulator, z_top: float, seconds: float, block: int = 32
             1.0 / (block * sim.config.dtau * sim.scales.time_s))
 
 
-def measure_reflection(preset: Preset, seconds: float = 600.0,
+def reflection_of(run: Callable[[bool], tuple[np.ndarray, np.ndarray]], sample_hz: float,
+                  f_hz: np.ndarray) -> np.ndarray:
+    """|r(f)| from two identical runs ``run(pulse)`` -> (a, b), with and without the pulse
+    from the bit: their difference is the pulse's own waves at the top (the loop is linear
+    off bottom), so a drive or controller that is not at rest when the pulse comes does not
+    count."""
+    a1, b1 = run(True)
+    a0, b0 = run(False)
+    return spectral_ratio(a1 - a0, b1 - b0, sample_hz, f_hz)
+
+
+def measure_reflection(preset: Preset, seconds: float = 120.0,
                        f_hz: np.ndarray | None = None) -> Reflection:
     """The reflection of torsional waves by ``preset``'s own drive (its speed loop),
-    measured in the time domain, with the analytic curve."""
+    measured in the time domain on :func:`reflection_preset` (one pulse up, its reflection
+    down, nothing else), with the analytic curve."""
     f_hz = reflection_frequencies() if f_hz is None else f_hz
     drive = preset.top_drive.with_(mode="speed")
-    sim = off_bottom_simulator(preset, drive)
-    z_top = float(sim.string_arrays()[2][sg.W_Z, 0])
-    width = PULSE_WIDTH_S / (preset.scales.time_s * sim.config.dtau)
-    send_pulse_from_bit(sim, False, 0.05 * preset.params.omega0 * z_top, width)
-    a, b, sample_hz = _top_records(sim, z_top, seconds)
-    ratio = spectral_ratio(a - a[0], b - b[0], sample_hz, f_hz)
+    line = reflection_preset(preset)
+
+    def run(pulse: bool) -> tuple[np.ndarray, np.ndarray]:
+        sim = off_bottom_simulator(line, drive, anechoic=True)
+        if pulse:
+            z_top = float(sim.string_arrays()[2][sg.W_Z, 0])
+            width = PULSE_WIDTH_S / (line.scales.time_s * sim.config.dtau)
+            send_pulse_from_bit(sim, False, 0.05 * line.params.omega0 * z_top, width)
+        a, b, _ = _top_records(sim, z_top_of(sim), seconds)
+        return a, b
+
+    sample_hz = 1.0 / (32 * line.dtau * line.scales.time_s)
+    ratio = reflection_of(run, sample_hz, f_hz)
     phys = drive.physical(preset.scales)
     z_si = preset.string.sections[0].torsional_impedance_nm_s
     analytic = analytic_reflection(z_si, phys.inertia_kg_m2, phys.kp_nm_s, phys.ki_nm, f_hz)
     return Reflection([float(f) for f in f_hz], [float(r) for r in ratio],
                       [float(r) for r in analytic])
+
+
+def z_top_of(sim: Simulator) -> float:
+    """The impedance of the string's top part, kernel units."""
+    return float(sim.string_arrays()[2][sg.W_Z, 0])

@@ -23,6 +23,7 @@ from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescri
 from rclpy.exceptions import InvalidParameterTypeException, InvalidParameterValueException
 from rclpy.impl.implementation_singleton import rclpy_implementation
 
+from drill_sim_ros.model import defaults
 from drill_sim_ros.model.errors import ParameterError
 from drill_sim_ros.model.measurement import MAX_DELAY_PERIODS, SIGNALS
 from drill_sim_ros.model.params import UNIT_SCALES
@@ -45,6 +46,7 @@ class ParamSpec:
     high: float | None = None
     read_only: bool = False
     choices: tuple[str, ...] = ()     # the allowed values of a string (empty: any)
+    unit: str | None = None           # None: the [unit] its description names, if any
 
     def default_for(self, preset: Preset | None) -> Any:
         return self.default(preset) if callable(self.default) else self.default
@@ -59,15 +61,11 @@ def _preset_rpm(preset: Preset | None) -> float:
 
 
 def _preset_dtau(preset: Preset | None) -> float:
-    return 1e-4 if preset is None else preset.dtau
-
-
-def _preset_nodes(preset: Preset | None) -> int:
-    return 2048 if preset is None or preset.n_nodes is None else preset.n_nodes
+    return defaults.DTAU if preset is None else preset.dtau
 
 
 def _max_wob_n(preset: Preset | None) -> float:
-    return max(10.0 * _preset_wob_n(preset), 1.0)
+    return defaults.max_wob_n(_preset_wob_n(preset))
 
 
 def _drive(preset: Preset | None) -> TopDrivePhysical:
@@ -98,7 +96,7 @@ def _sensor_specs() -> tuple[ParamSpec, ...]:
                       0.0, 1e9, read_only=True),
             ParamSpec(f"sensors.{signal}.delay_periods", INTEGER, 0,
                       f"Delay of the measured {signal} in whole publish periods.",
-                      0, MAX_DELAY_PERIODS, read_only=True),
+                      0, MAX_DELAY_PERIODS, read_only=True, unit="periods"),
         ]
     return tuple(out)
 
@@ -116,17 +114,18 @@ SPECS: tuple[ParamSpec, ...] = (
               "/drill/cmd/surface_rpm changes the live setpoint.", 0.0, 1e4, read_only=True),
     ParamSpec("model.dtau", DOUBLE, _preset_dtau,
               "Largest dimensionless integrator step (RGD07 units of t*); refined so that a "
-              "whole number of steps fills one publish period.", 1e-7, 0.05, read_only=True),
-    ParamSpec("model.n_nodes", INTEGER, _preset_nodes,
+              "whole number of steps fills one publish period.", 1e-7, 0.05, read_only=True,
+              unit="1"),
+    ParamSpec("model.n_nodes", INTEGER, defaults.n_nodes,
               "Bottom-hole profile nodes per blade sector.", 16, 1 << 22, read_only=True),
-    ParamSpec("model.perturb_v", DOUBLE, 1e-3,
+    ParamSpec("model.perturb_v", DOUBLE, defaults.PERTURB_V,
               "Dimensionless axial-velocity perturbation added at t = 0 (seeds the "
-              "instability).", -1e3, 1e3, read_only=True),
+              "instability).", -1e3, 1e3, read_only=True, unit="1"),
     ParamSpec("model.submerged_string_weight_n", DOUBLE, submerged_string_weight_n,
               "Buoyed weight of drill pipe + BHA [N]; hook load = this - applied WOB. "
               "Default: steel mass x g x (1 - 1200 kg/m3 mud / steel density); 0 for "
               "dimensionless presets.", 0.0, 1e10),
-    ParamSpec("limits.max_surface_rpm", DOUBLE, 300.0,
+    ParamSpec("limits.max_surface_rpm", DOUBLE, defaults.MAX_SURFACE_RPM,
               "Surface-rpm commands above this [rev/min] are clamped to it.", 0.0, 1e4),
     ParamSpec("limits.max_wob_n", DOUBLE, _max_wob_n,
               "WOB commands above this [N] are clamped to it (default: 10 x the preset's WOB).",
@@ -142,11 +141,13 @@ SPECS: tuple[ParamSpec, ...] = (
               "nearest it, also within a publish period; 0 = from the next step.", 0.0, 60.0,
               read_only=True),
     ParamSpec("publish_rate_hz", DOUBLE, 100.0,
-              "Samples published per second of SIMULATED time.", 1.0, 1000.0, read_only=True),
+              "Samples published per second of SIMULATED time.", 1.0, 1000.0, read_only=True,
+              unit="Hz"),
     ParamSpec("string.rate_hz", DOUBLE, 10.0,
               "String profiles on drill/string/torsion per second of SIMULATED time, on "
               "every round(publish_rate_hz / string.rate_hz)-th sample (at most one per "
-              "sample); 0 = off. A lumped string has none.", 0.0, 1000.0, read_only=True),
+              "sample); 0 = off. A lumped string has none.", 0.0, 1000.0, read_only=True,
+              unit="Hz"),
     ParamSpec("string.depths", INTEGER, 64,
               "Depths of each string profile: the middles of this many equal intervals of "
               "the string, top to bottom.", 1, 64, read_only=True),
@@ -156,9 +157,13 @@ SPECS: tuple[ParamSpec, ...] = (
               "one per sample (at or above publish_rate_hz, every sample).", 1.0, 1000.0,
               read_only=True),
     ParamSpec("real_time_factor", DOUBLE, 1.0,
-              "Simulated seconds per wall second; 0 = as fast as possible.", 0.0, 1000.0),
+              "Simulated seconds per wall second; 0 = as fast as possible.", 0.0, 1000.0,
+              unit="1"),
     ParamSpec("lockstep", BOOL, False,
               "Advance one publish period per trigger (lockstep_trigger) only; deterministic."),
+    ParamSpec("lockstep.warn_after_s", DOUBLE, 2.0,
+              "In lockstep, warn on /diagnostics and in the log after this many wall seconds "
+              "without a command (or a ~/step call) [s]; 0 = never.", 0.0, 1e6),
     ParamSpec("lockstep_trigger", STRING, "service",
               "What advances one period in lockstep: 'service' (a ~/step call) or 'command' "
               "(each message on drill/cmd/top_drive, applied first).",
@@ -182,7 +187,7 @@ SPECS: tuple[ParamSpec, ...] = (
     *_sensor_specs(),
     ParamSpec("run_seconds", DOUBLE, 0.0,
               "Exit cleanly after this many wall seconds; 0 = run until stopped.", 0.0, 1e9,
-              read_only=True),
+              read_only=True, unit="s"),
     ParamSpec("record.path", STRING, "",
               "Record every published message to this MCAP file (in process); '' = off. "
               "An existing file is refused unless record.overwrite.", read_only=True),
@@ -191,13 +196,13 @@ SPECS: tuple[ParamSpec, ...] = (
               "to start.", read_only=True),
     ParamSpec("record.split_size_mb", DOUBLE, 0.0,
               "Start a new numbered file (run_0000.mcap, ...) after this many MB; 0 = one "
-              "file.", 0.0, 1e6, read_only=True),
+              "file.", 0.0, 1e6, read_only=True, unit="MB"),
     ParamSpec("record.split_duration_s", DOUBLE, 0.0,
               "Start a new numbered file after this many simulated seconds; 0 = one file.",
-              0.0, 1e9, read_only=True),
-    ParamSpec("diagnostics.window_s", DOUBLE, 20.0,
+              0.0, 1e9, read_only=True, unit="s"),
+    ParamSpec("diagnostics.window_s", DOUBLE, defaults.WINDOW_S,
               "Simulated seconds of bit speed behind the stick-slip severity on /diagnostics.",
-              0.1, 3600.0, read_only=True),
+              0.1, 3600.0, read_only=True, unit="s"),
     ParamSpec("diagnostics.command_timeout_s", DOUBLE, 1.0,
               "Once a drill/cmd/top_drive command came, /diagnostics warns (controller "
               "silent) when none follows for this many SIMULATED seconds; 0 = never.", 0.0, 1e6),

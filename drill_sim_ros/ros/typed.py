@@ -7,15 +7,16 @@ time, framed by the rig, and one named field per telemetry value), ``drill/typed
 tools read them without the package. Without ``drill_sim_msgs`` installed (a ROS install
 that has not built msgs/ yet) :data:`AVAILABLE` is False and sim_node publishes only those.
 
-A block of samples is packed into Telemetry CDR in one vectorised numpy pass over a record
-type whose offsets are those of the message's CDR layout (:mod:`drill_sim_ros.ros.cdr`), so
-the typed topic costs a copy per sample, not a message object.
+Samples are packed into Telemetry CDR by one ``struct`` format laid out like the message
+(:mod:`drill_sim_ros.ros.cdr`), so the typed topic costs a pack per sample, not a message
+object and its serialization.
 """
 
 from __future__ import annotations
 
 import json
 import math
+import struct
 from typing import Any
 
 import numpy as np
@@ -41,37 +42,45 @@ def telemetry_fields() -> list[str]:
 
 
 class TelemetryPacker:
-    """Packs SI telemetry rows (``TELEMETRY_FIELDS`` order) into Telemetry payloads."""
+    """Packs SI telemetry rows (``TELEMETRY_FIELDS`` order) into Telemetry payloads.
+
+    One ``struct`` format covers the whole message: the fixed bytes before and after the
+    stamp (encapsulation, frame_id), then each value at its CDR offset, padding zeroed.
+    """
 
     def __init__(self, frame_id: str) -> None:
         cdr = CdrBuffer()
-        names, formats, offsets = ["sec", "nanosec"], ["<i4", "<u4"], [cdr.stamp()]
-        offsets.append(offsets[0] + 4)
+        stamp_at = cdr.stamp()
         cdr.string(frame_id)
-        self._fields = telemetry_fields()
-        for name in self._fields:
-            kind = Telemetry.get_fields_and_field_types()[name]
-            at = cdr.uint8() if kind == "uint8" else cdr.doubles(1, sequence=False)[0]
-            names.append(name)
-            formats.append("u1" if kind == "uint8" else "<f8")
-            offsets.append(at)
+        kinds = Telemetry.get_fields_and_field_types()
+        fields = telemetry_fields()
+        places = [(cdr.uint8(), "B") if kinds[name] == "uint8" else
+                  (cdr.doubles(1, sequence=False)[0], "d") for name in fields]
         template = cdr.layout().template
         self.size = len(template)
-        self._dtype = np.dtype({"names": names, "formats": formats, "offsets": offsets,
-                                "itemsize": self.size})
-        self._template = np.frombuffer(template, dtype=np.uint8)  # with the frame_id bytes
-        self._columns = [TELEMETRY_INDEX[name] for name in self._fields]
+        first = places[0][0]
+        fmt = f"<{stamp_at}siI{first - stamp_at - 8}s"
+        position = first
+        for at, code in places:
+            fmt += f"{at - position}x{code}" if at > position else code
+            position = at + struct.calcsize(code)
+        fmt += f"{self.size - position}x"
+        self._struct = struct.Struct(fmt)
+        self._fixed = (template[:stamp_at], template[stamp_at + 8:first])
+        self._columns = [TELEMETRY_INDEX[name] for name in fields]
+        self._byte_slots = [i for i, name in enumerate(fields) if kinds[name] == "uint8"]
 
     def pack(self, rows: np.ndarray, stamps_ns: np.ndarray) -> list[bytes]:
         """One payload per row (shape (N, F)), stamped ``stamps_ns`` (shape (N,))."""
-        raw = np.tile(self._template, rows.shape[0])     # a record copy would drop the gaps
-        records = raw.view(self._dtype)
-        records["sec"] = stamps_ns // NS_PER_S
-        records["nanosec"] = stamps_ns % NS_PER_S
-        for name, column in zip(self._fields, self._columns, strict=True):
-            records[name] = rows[:, column]
-        data = raw.tobytes()
-        return [data[i:i + self.size] for i in range(0, len(data), self.size)]
+        head, middle = self._fixed
+        out = []
+        for row, time_ns in zip(rows.tolist(), stamps_ns.tolist(), strict=True):
+            values = [row[c] for c in self._columns]
+            for slot in self._byte_slots:
+                values[slot] = int(values[slot])
+            sec, nanosec = divmod(time_ns, NS_PER_S)
+            out.append(self._struct.pack(head, sec, nanosec, middle, *values))
+        return out
 
 
 def run_info_message(info: dict[str, Any], values: dict[str, Any], time_ns: int,

@@ -27,12 +27,13 @@ import math
 
 import numpy as np
 
-from drill_sim_ros.control.bench import PERTURB_V, ClosedLoopRun, run_in_process
+from drill_sim_ros.control.bench import ClosedLoopRun, run_in_process
 from drill_sim_ros.control.rig import rig_physics
 from drill_sim_ros.control.scenario import Scenario
 from drill_sim_ros.control.scorecard import score
 from drill_sim_ros.model import analysis
 from drill_sim_ros.model import kernel as k
+from drill_sim_ros.model.defaults import PERTURB_V
 from drill_sim_ros.model.errors import NumericalFault
 from drill_sim_ros.model.params import DimensionlessParams, Scales
 from drill_sim_ros.model.telemetry import TELEMETRY_INDEX as F

@@ -25,10 +25,15 @@ from typing import Any
 import numpy as np
 
 from drill_sim_ros.control.bench import Bench, build_controller
-from drill_sim_ros.control.scenario import Scenario, load_scenario, scenario_from_dict
+from drill_sim_ros.control.scenario import (
+    Scenario,
+    load_scenario,
+    scenario_dir,
+    scenario_from_dict,
+    scenario_path,
+)
 from drill_sim_ros.control.scorecard import score
 from drill_sim_ros.model.errors import DrillSimError, NumericalFault, ParameterError
-from drill_sim_ros.model.presets import config_dirs
 from drill_sim_ros.model.telemetry import N_FIELDS, TELEMETRY_INDEX
 
 F = TELEMETRY_INDEX
@@ -77,29 +82,24 @@ class EntryResult:
         return out
 
 
-def scenario_dir() -> Path:
-    """config/scenarios of the first config directory that has it."""
-    for base in config_dirs():
-        if (base / "scenarios").is_dir():
-            return base / "scenarios"
-    raise DrillSimError("no config/scenarios directory found (set DRILL_SIM_CONFIG_DIR)")
+def code_fingerprint() -> str:
+    """The model and control code a result depends on (``store.model_fingerprint``), with
+    the sensors and this module."""
+    import hashlib
+
+    from drill_sim_ros.study.store import model_fingerprint
+    root = Path(__file__).resolve().parents[1]
+    digest = hashlib.sha256(model_fingerprint(controlled=True).encode())
+    for name in ("model/measurement.py", "study/suite.py"):
+        digest.update((root / name).read_bytes())
+    return digest.hexdigest()[:16]
 
 
 def scenario_files(names: Sequence[str] = ()) -> list[Path]:
-    """The named scenarios (file names without .yaml, or paths), default all, sorted."""
+    """The named scenarios (names of config/scenarios or paths), default all, sorted."""
     if not names:
         return sorted(scenario_dir().glob("*.yaml"))
-    out = []
-    for name in names:
-        path = Path(name)
-        if not (path.suffix in (".yaml", ".yml") and path.exists()):
-            path = scenario_dir() / f"{name}.yaml"
-        if not path.exists():
-            known = ", ".join(p.stem for p in sorted(scenario_dir().glob("*.yaml")))
-            raise DrillSimError(f"--scenario {name!r}: no such file or scenario (known: "
-                                f"{known})")
-        out.append(path)
-    return out
+    return [scenario_path(name) for name in names]
 
 
 def entries(paths: Sequence[Path], controllers: Sequence[str], mode: str) -> list[Entry]:

@@ -37,7 +37,7 @@ def add_parser(sub: Any) -> None:
 
 def cmd_suite(args: argparse.Namespace) -> int:
     from drill_sim_ros.control.registry import controller_class
-    from drill_sim_ros.study import engine, store, suite, suite_report
+    from drill_sim_ros.study import engine, suite, suite_report
     controllers = args.controller or list(suite.DEFAULT_CONTROLLERS)
     for name in controllers:
         controller_class(name)                     # a bad name fails here, in one line
@@ -48,8 +48,8 @@ def cmd_suite(args: argparse.Namespace) -> int:
     start = time.perf_counter()
     try:
         with engine.connect(args.scheduler, args.workers) as client:
-            result = suite.run_suite(entries, args.out, client,
-                                     store.model_fingerprint(controlled=True), progress)
+            result = suite.run_suite(entries, args.out, client, suite.code_fingerprint(),
+                                     progress)
     except KeyboardInterrupt:
         result = None
     finally:

@@ -29,6 +29,7 @@ from rclpy.clock import Clock, ClockType
 from rclpy.context import Context
 from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
+from rclpy.parameter import Parameter
 from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.signals import SignalHandlerOptions
 from rclpy.utilities import remove_ros_args
@@ -62,8 +63,10 @@ from drill_sim_ros.viz.viewer_link import Progress, ViewerLink
 
 NODE_NAME = "rerun_bridge"
 QUEUE_DEPTH = 1000          # 10 s of telemetry at the sim's default 100 Hz
-# The bridge's inner nodes, which nobody configures: no parameter services, no /rosout.
-HELPER_NODE = {"start_parameter_services": False, "enable_rosout": False}
+# The bridge's inner nodes, which nobody configures or asks: no parameter services, no
+# type description service, no /rosout.
+HELPER_NODE = {"start_parameter_services": False, "enable_rosout": False,
+               "parameter_overrides": [Parameter("start_type_description_service", value=False)]}
 
 
 def telemetry_qos(best_effort: bool = False) -> QoSProfile:
@@ -218,7 +221,7 @@ def run_units(preset: str | None, info: dict[str, Any] | None,
         return PaperUnits.load(preset)
     if info is not None:
         return PaperUnits.from_run_info(info)
-    rclpy.logging.get_logger(NODE_NAME).warning(
+    rclpy.logging.get_logger(f"{NODE_NAME}_run_info").warning(
         f"no {topics.RUN_INFO} within {timeout_s:g} s: the 2D views use the scales of preset "
         f"{DEFAULT_PRESET!r} (override with --preset)")
     return PaperUnits.load(DEFAULT_PRESET)

@@ -14,6 +14,7 @@ from rclpy.qos import QoSProfile
 
 from drill_sim_ros import topics
 from drill_sim_ros.archive.reader import ArchiveReader
+from drill_sim_ros.model.presets import DEFAULT_PRESET
 from drill_sim_ros.viz.mcap_telemetry import recorded_preset
 from tests.archive.helpers import BIN, counts_mcap_ros2, running, stop, wait_for
 from tests.archive.ros_fixtures import ros_node, step_sim
@@ -130,7 +131,7 @@ def test_in_process_recording_splits_by_simulated_duration(tmp_path) -> None:
     for part in parts:
         counts = counts_mcap_ros2(part)
         assert ArchiveReader(part).summary() is not None
-        assert recorded_preset(part) == "field_8p5in_shale_lumped"     # every part stands alone
+        assert recorded_preset(part) == DEFAULT_PRESET     # every part stands alone
         assert max(counts[t] for t in SAMPLE_TOPICS) <= 10 + 1
         for topic in SAMPLE_TOPICS:
             totals[topic] += counts[topic]

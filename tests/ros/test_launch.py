@@ -91,6 +91,8 @@ def test_every_executable_it_starts_is_a_console_script_of_this_package() -> Non
         assert isinstance(_keyword(call, "package"), ast.Name)     # PACKAGE
     assert f'PACKAGE = "{PACKAGE}"' in LAUNCH_FILE.read_text()
     assert _keyword(nodes["sim_node"], "name").value == topics.NODE_NAME
+    # a process of several nodes (the bridge) must not be renamed: __node:= renames them all
+    assert _keyword(nodes["rerun_bridge"], "name") is None
 
 
 def test_every_parameter_it_sets_is_declared_by_that_node() -> None:

@@ -106,6 +106,14 @@ def test_two_rigs_in_two_namespaces_each_recorded_and_bridged(tmp_path) -> None:
             for rig in rigs:
                 assert bridges[rig].wait_logged(STEPS + 1, 30), bridges[rig].output()
             ros.spin_for(1.5)                   # /diagnostics of both, at 1 Hz
+
+            def services() -> list[str]:
+                return [name for name, _ in node.get_service_names_and_types()]
+
+            # the bridge node offers its parameter services; its inner queue node none
+            assert ros.spin_until(lambda: all(
+                f"/{rig}/rerun_bridge/list_parameters" in services() for rig in rigs), 10)
+            assert not [name for name in services() if "rerun_bridge_" in name]
     finally:
         codes = {f"{kind} {rig}": stop(process) for kind, group in
                  (("bridge", {r: b.proc for r, b in bridges.items()}), ("recorder", recorders),
@@ -164,7 +172,8 @@ def test_every_node_runs_on_use_sim_time(tmp_path) -> None:
             assert summary["periods"] == periods
             # the sim now stands idle: no sample, no /clock; its diagnostics and the
             # bridge's flushes run on the steady clock
-            assert bridge.wait_logged(periods + 1, 30), bridge.output()
+            # (t = 0 went out when the sim started, before the bridge matched: not counted)
+            assert bridge.wait_logged(periods, 30), bridge.output()
             with ros_context() as ros:
                 node = ros.add(Node("diag_listener", context=ros.context))
                 heard: list[DiagnosticArray] = []
@@ -178,9 +187,11 @@ def test_every_node_runs_on_use_sim_time(tmp_path) -> None:
     messages = mcap_messages(recording)
     telemetry = [(log_ns, m.data[F["sim_time_s"]]) for t, log_ns, m in messages
                  if t == f"/{rig}/drill/telemetry"]
-    assert len(telemetry) == periods + 1
-    last_stamp_ns = round(telemetry[-1][1] * 1e9)
-    assert last_stamp_ns == periods * 10_000_000
+    stamps_ns = [round(t_s * 1e9) for _, t_s in telemetry]
+    # every period, and t = 0 if the recorder matched before the sim published it
+    assert stamps_ns[-periods:] == [k * 10_000_000 for k in range(1, periods + 1)]
+    assert len(stamps_ns) in (periods, periods + 1)
+    last_stamp_ns = stamps_ns[-1]
     # logged at the sim's /clock as the recorder last heard it: never past the last stamp,
     # and never the wall-clock date (about 1.8e18 ns)
     assert all(0 <= log_ns <= last_stamp_ns for log_ns, _ in telemetry)
