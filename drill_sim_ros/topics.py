@@ -26,6 +26,8 @@ TELEMETRY = "/drill/telemetry"                # std_msgs/Float64MultiArray (TELE
 DIAGNOSTICS = "/diagnostics"                  # diagnostic_msgs/DiagnosticArray, 1 Hz
 CLOCK = "/clock"                              # rosgraph_msgs/Clock (publish_clock)
 RUN_INFO = "/drill/run_info"                  # std_msgs/String, JSON; latched (transient local)
+# distributed string only, at string.rate_hz (10 Hz) of sim time: one joint per depth
+STRING_TORSION = "/drill/string/torsion"      # sensor_msgs/JointState (STRING_JOINT_PATTERN)
 
 # ---- subscribed by sim_node ------------------------------------------------------------
 CMD_SURFACE_RPM = "/drill/cmd/surface_rpm"    # std_msgs/Float64, rev/min
@@ -36,6 +38,8 @@ CMD_TOP_DRIVE = "/drill/cmd/top_drive"        # sensor_msgs/JointState (COMMAND_
 # command reacts to. Each array is empty or as long as name; other messages are rejected.
 COMMAND_JOINTS = ("top_drive", "hook")
 COMMANDS = (CMD_SURFACE_RPM, CMD_WOB, CMD_TOP_DRIVE)
+# published at a lower rate than the samples (not one message per sample)
+PROFILE_TOPICS = (STRING_TORSION,)
 
 # ---- typed twins (drill_sim_msgs, when installed; drill_sim_ros.ros.typed) --------------
 TYPED_TELEMETRY = "/drill/typed/telemetry"    # drill_sim_msgs/Telemetry, one per sample
@@ -71,6 +75,7 @@ MSG_TYPES: dict[str, str] = {
     DIAGNOSTICS: "diagnostic_msgs/msg/DiagnosticArray",
     CLOCK: "rosgraph_msgs/msg/Clock",
     RUN_INFO: "std_msgs/msg/String",
+    STRING_TORSION: "sensor_msgs/msg/JointState",
     CMD_SURFACE_RPM: "std_msgs/msg/Float64",
     CMD_WOB: "std_msgs/msg/Float64",
     CMD_TOP_DRIVE: "sensor_msgs/msg/JointState",
@@ -84,6 +89,8 @@ SURFACE_JOINTS = ("top_drive", "hook")
 # top_drive: angle rad, speed rad/s, surface (pipe) torque N m
 # hook:      bit depth m, rate of penetration m/s, applied WOB N (the weight the hook sets
 #            down: submerged string weight - hook load; the hook load is in the telemetry)
+# drill/string/torsion: string_<depth below the top, m, as 0000.0>m, top to bottom
+STRING_JOINT_PATTERN = "string_DDDD.Dm"
 # What the rig's surface sensors give (the only signals a controller should read):
 MEASURED_JOINTS = ("top_drive", "quill", "hook", "wob_estimate")
 # top_drive:    angle rad, measured speed rad/s (encoder), measured motor torque N m
@@ -112,7 +119,11 @@ DESCRIPTIONS: dict[str, str] = {
     TELEMETRY: "one record per sample, fields `TELEMETRY_FIELDS` (SI)",
     DIAGNOSTICS: "two statuses, 1 Hz of wall time",
     CLOCK: "simulated time (when `publish_clock`)",
-    RUN_INFO: "JSON of what runs (preset, groups, scales, sampling), once",
+    RUN_INFO: "JSON of what runs (preset, groups, scales, sampling, string), once",
+    STRING_TORSION: "the distributed string along depth at `string.rate_hz` (default 10 Hz) "
+                    "of sim time, `string.depths` (<= 64) joints top to bottom, joint "
+                    "`string_DDDD.Dm` at DDDD.D m below the top (e.g. `string_0021.1m`); "
+                    "not for a lumped string",
     CMD_SURFACE_RPM: "top-drive speed setpoint, rev/min",
     CMD_WOB: "applied WOB setpoint, N",
     CMD_TOP_DRIVE: "the controller's command; `header.stamp` = the stamp of the sample it "
@@ -125,6 +136,7 @@ JOINTS: dict[str, tuple[str, ...]] = {
     SURFACE_JOINT_STATES: SURFACE_JOINTS,
     SURFACE_MEASURED: MEASURED_JOINTS,
     CMD_TOP_DRIVE: COMMAND_JOINTS,
+    STRING_TORSION: (STRING_JOINT_PATTERN,),
 }
 
 # What position, velocity and effort of each joint mean, per topic ("-": unused).
@@ -142,6 +154,10 @@ JOINT_FIELDS: dict[str, dict[str, tuple[str, str, str]]] = {
         "quill": ("angle rad", "speed rad/s", "string torque N m (torque sub)"),
         "hook": ("-", "-", "measured hook load N"),
         "wob_estimate": ("-", "-", "applied WOB estimate N (submerged weight - hook load)"),
+    },
+    STRING_TORSION: {
+        STRING_JOINT_PATTERN: ("-", "angular speed rad/s at that depth",
+                               "torque N m at that depth (twisting the string below it)"),
     },
     CMD_TOP_DRIVE: {
         "top_drive": ("-", "speed setpoint rad/s (kinematic, speed modes)",

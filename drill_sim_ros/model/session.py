@@ -12,13 +12,14 @@ from __future__ import annotations
 import math
 from collections import deque
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
 from drill_sim_ros.model import defaults
 from drill_sim_ros.model import kernel as k
 from drill_sim_ros.model.analysis import Severity, severity_of
+from drill_sim_ros.model.depth_profile import MAX_DEPTHS, DepthSampler, StringSample
 from drill_sim_ros.model.errors import ParameterError
 from drill_sim_ros.model.formation import layers_from_dicts
 from drill_sim_ros.model.measurement import RigSensors
@@ -57,18 +58,22 @@ class SessionConfig:
     sensors: RigSensors | None = None           # None: perfect surface sensors
     command_delay_s: float = 0.0         # transport delay of the set_* inputs (0: none)
     formation: tuple[dict, ...] = ()     # rock layers by depth (model.formation, SI keys)
+    string_rate_hz: float = 0.0          # string profiles per s of sim time (0: none)
+    string_depths: int = MAX_DEPTHS      # depths of each profile
 
 
 @dataclass(slots=True)
 class Block:
     """Samples of one run: ``rows`` (count, N_FIELDS) SI in ``TELEMETRY_FIELDS`` order,
     ``stamps_ns`` (count,) their simulated time, ``offsets`` the (depth, angle) rebasing
-    offsets already added to the rows' depth and angles. (Not frozen: a frozen dataclass
-    costs microseconds per tick to build.)"""
+    offsets already added to the rows' depth and angles, ``strings`` the string profiles
+    taken in the block (at :attr:`SimSession.string_depths_m`; see ``string_rate_hz``).
+    (Not frozen: a frozen dataclass costs microseconds per tick to build.)"""
 
     rows: np.ndarray
     stamps_ns: np.ndarray
     offsets: tuple[float, float]
+    strings: list[StringSample] = field(default_factory=list)
 
     def __len__(self) -> int:
         return len(self.stamps_ns)
@@ -138,6 +143,19 @@ class SimSession:
             raise ParameterError(f"command delay {cfg.command_delay_s!r} s must be >= 0")
         self._in_transit: deque[tuple[int, Callable[[float], None], float]] = deque()
         self._part = np.empty((2, k.N_COLS))      # one part of a split period
+        self._strings = string_sampler(cfg, self.sim)
+        self.string_every = string_every(cfg) if self._strings else 0   # periods
+        self._taken: list[StringSample] = []      # string profiles of the run under way
+
+    @property
+    def string_depths_m(self) -> np.ndarray:
+        """The depths of the string profiles, m (empty: none are taken)."""
+        return self._strings.depths_m if self._strings else np.zeros(0)
+
+    @property
+    def string_names(self) -> list[str]:
+        """The joint name of each of :attr:`string_depths_m`."""
+        return self._strings.names if self._strings else []
 
     @property
     def dtau(self) -> float:
@@ -152,6 +170,7 @@ class SimSession:
         """The sample of the current state, stamped :attr:`sim_time_ns` (at start: t = 0, the
         sample a controller reacts to before the first period)."""
         self.sim.sample_into(self._samples[0])
+        self._take_string()
         return self._block(self._samples[:1], self.next_index)
 
     def run(self, periods: int) -> Block:
@@ -167,13 +186,31 @@ class SimSession:
         done = 0
         while self._in_transit and done < periods:      # inputs arrive within a period
             self._samples[done + 1] = self._split_period()
+            self._take_string()
             done += 1
-        if done < periods:
-            # rows 0..n-1: the state at the start of each period; row n: the end
-            rows = self.sim.advance_into(self._samples[done:], (periods - done) * self.steps,
+        while done < periods:
+            # rows 0..n-1: the state at the start of each period; row n: the end (the same
+            # state as the next part's row 0); parts end where a string profile is due
+            part = self._periods_to_string(periods - done)
+            rows = self.sim.advance_into(self._samples[done:], part * self.steps,
                                          self.steps, sample_end=True)
             self._advanced(rows - 1)
+            self._take_string()
+            done += part
         return self._block(self._samples[1:periods + 1], first + 1)
+
+    def _periods_to_string(self, left: int) -> int:
+        """Periods to run before the next string profile is due, at most ``left``."""
+        every = self.string_every
+        if every == 0:
+            return left
+        return min(left, every - self.next_index % every)
+
+    def _take_string(self) -> None:
+        """The string profile of the current state, when one is due at this stamp."""
+        if self.string_every and self.next_index % self.string_every == 0:
+            self._taken.append(self._strings.sample(self.sim.string_profile(),
+                                                    self.sim_time_ns))
 
     def _split_period(self) -> np.ndarray:
         """One period with the inputs due in it applied at their step (the step nearest
@@ -212,7 +249,10 @@ class SimSession:
         if not self._perfect_sensors:          # si_rows gives the truth, perfect sensors
             set_measured(rows, self.sensors.measure(surface_truth(rows)),
                          float(self.submerged_weight_n))
-        return Block(rows, stamps_ns, offsets)
+        if not self._taken:
+            return Block(rows, stamps_ns, offsets)
+        strings, self._taken = self._taken, []
+        return Block(rows, stamps_ns, offsets, strings)
 
     def _advanced(self, count: int) -> None:
         """Count ``count`` samples advanced and take the severity window's snapshot when it
@@ -251,7 +291,21 @@ class SimSession:
             "force_unit_n": sc.force_n, "torque_unit_nm": sc.torque_nm,
             "publish_rate_hz": self.cfg.publish_rate_hz, "period_ns": self.period_ns,
             "dtau": self.dtau, "steps_per_period": self.steps,
+            "string": self.string_info(),
         }
+
+    def string_info(self) -> dict[str, object]:
+        """The string of the run: its model and, when distributed, the sections top to
+        bottom (radii and length m, density kg/m^3, moduli Pa, damping rates 1/s), the lumped
+        bit inertia kg m^2 and the depths m of the string profiles (none: not sampled)."""
+        spec = self.cfg.preset.string
+        if not spec.distributed:
+            return {"model": spec.model}
+        return {"model": spec.model,
+                "sections": [asdict(section) for section in spec.sections],
+                "bit_inertia_kg_m2": spec.bit_inertia_kg_m2, "length_m": spec.length_m,
+                "profile_depths_m": self.string_depths_m.tolist(),
+                "profile_period_ns": self.string_every * self.period_ns}
 
     def set_surface_rpm(self, rpm: float) -> None:
         """The drive's speed setpoint, from now plus the command delay."""
@@ -290,3 +344,18 @@ class SimSession:
         self._in_transit.clear()
         self._snapshots.clear()
         self._bucket_end = self.next_index + self._bucket_samples
+
+
+def string_sampler(cfg: SessionConfig, sim: Simulator) -> DepthSampler | None:
+    """The sampler of the string profiles (None: a lumped string or ``string_rate_hz`` 0)."""
+    spec = cfg.preset.string
+    if not (spec.distributed and cfg.string_rate_hz > 0):
+        return None
+    return DepthSampler(sim.string_profile()[0], spec.length_m, cfg.string_depths)
+
+
+def string_every(cfg: SessionConfig) -> int:
+    """Publish periods between string profiles: the nearest whole number to
+    publish_rate_hz / string_rate_hz, at least 1 (profiles go out on the samples whose index
+    is a multiple of it, at most one per sample)."""
+    return max(1, round(cfg.publish_rate_hz / cfg.string_rate_hz))

@@ -43,6 +43,7 @@ TELEMETRY_FIELDS = (
     "command_stamp_s",             # stamp of the drill/cmd/top_drive command in force (-1: none)
     "hook_load_measured_n",        # deadline load cell (model.measurement)
     "applied_wob_estimate_n",      # the driller's WOB: submerged weight - measured hook load
+    "bha_rpm",                     # BHA speed: bottom of the string (lumped: the bit's)
 )
 TELEMETRY_INDEX = {name: i for i, name in enumerate(TELEMETRY_FIELDS)}
 N_FIELDS = len(TELEMETRY_FIELDS)
@@ -55,6 +56,7 @@ SOURCE_COLUMNS = {
     "mode": k.C_MODE, "surface_angle_rad": k.C_PHI_S, "surface_rpm": k.C_OMEGA_S,
     "surface_torque_nm": k.C_T_PIPE, "applied_wob_n": k.C_W_APP,
     "motor_torque_nm": k.C_MOTOR_TORQUE, "speed_setpoint_rpm": k.C_OMEGA_REF,
+    "bha_rpm": k.C_OMEGA_BHA,
 }
 _SOURCE_FIELDS = np.array([F[name] for name in SOURCE_COLUMNS], dtype=np.int64)
 _SOURCE_KERNEL_COLUMNS = np.array(list(SOURCE_COLUMNS.values()), dtype=np.int64)
@@ -69,7 +71,7 @@ _ANGLES = [F["bit_angle_rad"], F["surface_angle_rad"]]
 def field_scales(scales: Scales) -> np.ndarray:
     """SI factor of each telemetry field (1 for sim time, mode and hook load), shape (F,)."""
     rpm = RPM_PER_RAD_S / scales.time_s
-    factors = {"bit_rpm": rpm, "surface_rpm": rpm, "speed_setpoint_rpm": rpm,
+    factors = {"bit_rpm": rpm, "surface_rpm": rpm, "speed_setpoint_rpm": rpm, "bha_rpm": rpm,
                "motor_torque_nm": scales.torque_nm, "bit_depth_m": scales.length_m,
                "rop_m_s": scales.length_m / scales.time_s, "depth_of_cut_m": scales.length_m,
                "wob_n": scales.force_n, "wearflat_wob_n": scales.force_n,

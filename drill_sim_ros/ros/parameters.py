@@ -143,6 +143,14 @@ SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("publish_rate_hz", DOUBLE, 100.0,
               "Samples published per second of SIMULATED time.", 1.0, 1000.0, read_only=True,
               unit="Hz"),
+    ParamSpec("string.rate_hz", DOUBLE, 10.0,
+              "String profiles on drill/string/torsion per second of SIMULATED time, on "
+              "every round(publish_rate_hz / string.rate_hz)-th sample (at most one per "
+              "sample); 0 = off. A lumped string has none.", 0.0, 1000.0, read_only=True,
+              unit="Hz"),
+    ParamSpec("string.depths", INTEGER, 64,
+              "Depths of each string profile: the middles of this many equal intervals of "
+              "the string, top to bottom.", 1, 64, read_only=True),
     ParamSpec("publish_clock", BOOL, True, "Publish /clock (rosgraph_msgs/Clock) in sim time."),
     ParamSpec("clock_rate_hz", DOUBLE, 100.0,
               "/clock messages per second of SIMULATED time, on the samples' stamps: at most "

@@ -66,6 +66,7 @@ from drill_sim_ros.ros.parameters import (
     validate,
 )
 from drill_sim_ros.ros.sinks import SampleSinks, TypedTelemetry
+from drill_sim_ros.ros.string_sink import StringTorsionSink, string_topics
 from drill_sim_ros.terminal import StatusLine, format_status
 
 RCLError = rclpy_implementation.RCLError
@@ -101,7 +102,8 @@ def session_config(values: dict[str, Any], preset: Any) -> SessionConfig:
         wob_rate_n_s=values["limits.wob_rate_n_s"], window_s=values["diagnostics.window_s"],
         submerged_weight_n=values["model.submerged_string_weight_n"],
         top_drive=top_drive(values), sensors=rig_sensors(values),
-        command_delay_s=values["commands.delay_s"])
+        command_delay_s=values["commands.delay_s"],
+        string_rate_hz=values["string.rate_hz"], string_depths=values["string.depths"])
 
 
 def top_drive(values: dict[str, Any]) -> TopDrivePhysical:
@@ -178,8 +180,9 @@ class SimNode(Node):
         self._pubs = {t: self.create_publisher(messages.type_of(t), topics.node_relative(t),
                                                self._qos(t), event_callbacks=QUIET_PUBLISHER)
                       for t in (*SAMPLE_TOPICS, topics.CLOCK, topics.DIAGNOSTICS,
-                                topics.RUN_INFO)}
+                                topics.RUN_INFO, *string_topics(self._preset, self._values))}
         self._sinks = SampleSinks(self._pubs)
+        self._string_sink: StringTorsionSink | None = None     # made by start()
         self._command_names: dict[str, str] = {}      # command topic -> its resolved name
         self._command_subs = {}
         for topic, callback in ((topics.CMD_SURFACE_RPM, self._on_surface_rpm),
@@ -239,6 +242,7 @@ class SimNode(Node):
         with self._lock.urgent():
             session = SimSession(session_config(self._values, self._preset))
             self._session = session
+            self._string_sink = StringTorsionSink(self._sinks, session.string_names)
             self._sinks.warm_up()
             self._sinks.clock_period_ns = round(NS_PER_S / self._values["clock_rate_hz"])
             self._pacer = Pacer(self._wall_period_ns(self._rtf))
@@ -403,6 +407,8 @@ class SimNode(Node):
     def _emit(self, block: Block) -> None:
         """Hand ``block`` to the sinks (call with the lock held)."""
         self._sinks.emit(block, self._values["publish_clock"])
+        if block.strings:
+            self._string_sink.emit(block.strings)
         if len(block):
             self._last_row = block.rows[-1]
             self._handshake.published(int(block.stamps_ns[-1]), time.monotonic())

@@ -12,6 +12,7 @@ import rerun.blueprint as rrb
 from drill_sim_ros.topics import MODE_NAMES
 from drill_sim_ros.viz import entities as ent
 from drill_sim_ros.viz.frames import Frame2D, ViewFrames
+from drill_sim_ros.viz.string_views import FULL_SCALE_OF_NOMINAL, IMAGE_PROFILES
 
 NO_LEGEND = rrb.PlotLegend(visible=False)
 MODE_TITLE = "mode: " + " \u00b7 ".join(f"{i} {n.replace('_', ' ')}"
@@ -41,7 +42,8 @@ def time_series_column() -> rrb.Vertical:
         series("/timeseries/wob", "WOB [kN]: bit (blue), applied (grey), off bottom (purple)"),
         series("/timeseries/torque", "torque [kN m]: on bit (green), surface (grey)"),
         series("/timeseries/rop", "ROP [m/h]"),
-        series("/timeseries/rpm", "speed [rpm]: bit (blue), top drive (grey), stuck (red)"),
+        series("/timeseries/rpm", "speed [rpm]: bit (blue), BHA (cyan), top drive (grey), "
+                                    "stuck (red)"),
         series("/timeseries/mode", MODE_TITLE,
                axis_y=rrb.ScalarAxis(range=(-0.3, len(MODE_NAMES) - 0.7), zoom_lock=True)),
         row_shares=[2, 2, 2, 2, 1.4],
@@ -78,12 +80,37 @@ def paper_views(window_s: float, frames: ViewFrames) -> rrb.Vertical:
     )
 
 
-def build_blueprint(window_s: float, frames: ViewFrames) -> rrb.Blueprint:
-    """Time series on the left, the paper's figures on the right; side panels collapsed."""
+def string_views() -> rrb.Horizontal:
+    """The distributed string: depth x time picture of its speed, speed and torque profiles."""
+    full = f"{FULL_SCALE_OF_NOMINAL:g}x"
+    return rrb.Horizontal(
+        rrb.Spatial2DView(origin=ent.STRING_DEPTH_TIME,
+                          name=f"string speed, depth (down: top drive to bit) x last "
+                               f"{IMAGE_PROFILES} profiles (right: now); 0 dark blue .. "
+                               f"{full} nominal rpm dark red"),
+        rrb.BarChartView(origin=ent.STRING_SPEED, name="string speed [rpm] over depth [m]",
+                         plot_legend=NO_LEGEND),
+        rrb.BarChartView(origin=ent.STRING_TORQUE, name="string torque [kN m] over depth [m]",
+                         plot_legend=NO_LEGEND),
+        column_shares=[2, 1, 1],
+    )
+
+
+def build_blueprint(window_s: float, frames: ViewFrames, string: bool = False
+                    ) -> rrb.Blueprint:
+    """Time series on the left, the paper's figures on the right; with ``string`` (a
+    distributed string), its views below; side panels collapsed."""
+    top = rrb.Horizontal(time_series_column(), paper_views(window_s, frames),
+                         column_shares=[1, 1.15])
     return rrb.Blueprint(
-        rrb.Horizontal(time_series_column(), paper_views(window_s, frames),
-                       column_shares=[1, 1.15]),
+        rrb.Vertical(top, string_views(), row_shares=[3, 1]) if string else top,
         rrb.BlueprintPanel(state="collapsed"),
         rrb.SelectionPanel(state="collapsed"),
         rrb.TimePanel(state="collapsed"),
     )
+
+
+def has_string_views(run_info: dict | None) -> bool:
+    """The run info (``/drill/run_info``) names a distributed string."""
+    string = (run_info or {}).get("string") or {}
+    return isinstance(string, dict) and string.get("model") == "distributed"

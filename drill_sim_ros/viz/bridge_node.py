@@ -33,14 +33,15 @@ from rclpy.parameter import Parameter
 from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.signals import SignalHandlerOptions
 from rclpy.utilities import remove_ros_args
+from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray, String
 
 from drill_sim_ros import topics
 from drill_sim_ros.archive.output import OutputError, check_output
-from drill_sim_ros.model.presets import DEFAULT_PRESET
+from drill_sim_ros.model.presets import DEFAULT_PRESET, load_preset
 from drill_sim_ros.ros.messages import RUN_INFO_QOS
 from drill_sim_ros.viz.analytics_off import disable_analytics
-from drill_sim_ros.viz.blueprint import build_blueprint
+from drill_sim_ros.viz.blueprint import build_blueprint, has_string_views
 from drill_sim_ros.viz.dashboard import Dashboard
 from drill_sim_ros.viz.frames import Extents, view_frames
 from drill_sim_ros.viz.paper_units import PaperUnits
@@ -56,6 +57,7 @@ from drill_sim_ros.viz.recording import (
     viewer_listening,
 )
 from drill_sim_ros.viz.running_stats import default_window_s
+from drill_sim_ros.viz.string_views import string_batch
 from drill_sim_ros.viz.telemetry import N_FIELDS, TelemetryBatch, field_order
 from drill_sim_ros.viz.viewer_link import Progress, ViewerLink
 
@@ -81,10 +83,11 @@ class TelemetryQueue:
     costs far more per message than the logging does).
     """
 
-    def __init__(self, context: Context | None = None, best_effort: bool = False) -> None:
-        self.node = Node(f"{NODE_NAME}_telemetry", context=context, **HELPER_NODE)
-        self._sub = self.node.create_subscription(Float64MultiArray,
-                                                  topics.node_relative(topics.TELEMETRY),
+    def __init__(self, context: Context | None = None, best_effort: bool = False,
+                 topic: str = topics.TELEMETRY, msg_type: Any = Float64MultiArray) -> None:
+        name = topic.rsplit("/", 1)[-1]
+        self.node = Node(f"{NODE_NAME}_{name}", context=context, **HELPER_NODE)
+        self._sub = self.node.create_subscription(msg_type, topics.node_relative(topic),
                                                   lambda _msg: None, telemetry_qos(best_effort))
 
     @property
@@ -122,6 +125,8 @@ class RerunBridge(Node):
         self._dashboard = dashboard
         self._viewer = viewer
         self._queue = TelemetryQueue(self.context, best_effort)
+        self._strings = TelemetryQueue(self.context, best_effort, topics.STRING_TORSION,
+                                       JointState)
         self.telemetry_topic = self._queue.topic_name
         self._order: np.ndarray | None = None
         self.dropped = 0
@@ -144,6 +149,9 @@ class RerunBridge(Node):
         rows = self._rows(self._queue.take_all())
         if rows:
             self._dashboard.log_batch(TelemetryBatch.from_rows(np.stack(rows), self._order))
+        strings = string_batch(self._strings.take_all())
+        if strings is not None:
+            self._dashboard.log_strings(strings)
         if self._viewer is not None:
             self._viewer.poll(time.monotonic(), progress(self._dashboard))
         self._status(force=False)
@@ -164,6 +172,7 @@ class RerunBridge(Node):
             self.flush()
         self._status(force=True)
         self._queue.destroy()
+        self._strings.destroy()
 
 
 def parse_args(argv: list[str]) -> argparse.Namespace:
@@ -204,11 +213,23 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
     return args
 
 
-def run_units(preset: str | None, timeout_s: float = RUN_INFO_WAIT_S) -> PaperUnits:
-    """``preset``'s units if given; else those of the running sim's /drill/run_info (waited
-    for up to ``timeout_s``); else the default preset's, with a warning naming it."""
+def run_units(preset: str | None, info: dict[str, Any] | None,
+              timeout_s: float = RUN_INFO_WAIT_S) -> PaperUnits:
+    """``preset``'s units if given; else those of the running sim's run ``info``; else the
+    default preset's, with a warning naming it."""
     if preset:
         return PaperUnits.load(preset)
+    if info is not None:
+        return PaperUnits.from_run_info(info)
+    rclpy.logging.get_logger(f"{NODE_NAME}_run_info").warning(
+        f"no {topics.RUN_INFO} within {timeout_s:g} s: the 2D views use the scales of preset "
+        f"{DEFAULT_PRESET!r} (override with --preset)")
+    return PaperUnits.load(DEFAULT_PRESET)
+
+
+def wait_run_info(timeout_s: float = RUN_INFO_WAIT_S) -> dict[str, Any] | None:
+    """The running sim's /drill/run_info (JSON), waited for up to ``timeout_s``; None if it
+    did not come."""
     node = Node(f"{NODE_NAME}_run_info", **HELPER_NODE)
     received: list[String] = []
     node.create_subscription(String, topics.node_relative(topics.RUN_INFO), received.append,
@@ -219,12 +240,16 @@ def run_units(preset: str | None, timeout_s: float = RUN_INFO_WAIT_S) -> PaperUn
             rclpy.spin_once(node, timeout_sec=0.1)
     finally:
         node.destroy_node()
-    if received:
-        return PaperUnits.from_run_info(json.loads(received[0].data))
-    rclpy.logging.get_logger(f"{NODE_NAME}_run_info").warning(
-        f"no {topics.RUN_INFO} within {timeout_s:g} s: the 2D views use the scales of preset "
-        f"{DEFAULT_PRESET!r} (override with --preset)")
-    return PaperUnits.load(DEFAULT_PRESET)
+    return json.loads(received[0].data) if received else None
+
+
+def string_shown(info: dict[str, Any] | None, preset: str | None) -> bool:
+    """Whether the dashboard has the string views: the run info's string is distributed;
+    without run info (the sim not started yet), ``preset``'s (default: the default
+    preset's)."""
+    if info is not None:
+        return has_string_views(info)
+    return load_preset(preset or DEFAULT_PRESET).string.distributed
 
 
 class StartError(Exception):
@@ -292,10 +317,11 @@ class Outputs:
 
 def open_outputs(args: argparse.Namespace, logger: Any) -> Outputs:
     """The dashboard logging to --save/--serve, and to --connect while a viewer listens."""
-    units = run_units(args.preset)
+    info = wait_run_info()       # also with --preset: it says whether the string is shown
+    units = run_units(args.preset, info)
     window = default_window_s(units) if args.window_s is None else args.window_s
     frames = view_frames(units, Extents.typical())     # live: the data is not known yet
-    blueprint = build_blueprint(window, frames)
+    blueprint = build_blueprint(window, frames, string_shown(info, args.preset))
     recording_id = str(uuid.uuid4())                    # one recording on every sink
     stored = None
     if args.save or args.serve:

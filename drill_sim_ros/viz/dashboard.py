@@ -6,6 +6,7 @@ from collections.abc import Iterable
 
 import rerun as rr
 
+from drill_sim_ros.model.params import RPM_PER_RAD_S
 from drill_sim_ros.viz import log_views as lv
 from drill_sim_ros.viz.frames import Extents, ViewFrames, view_frames
 from drill_sim_ros.viz.paper_units import PaperUnits
@@ -13,6 +14,7 @@ from drill_sim_ros.viz.plot_values import pattern_point, pattern_radius, phase_p
 from drill_sim_ros.viz.recording import Recordings
 from drill_sim_ros.viz.running_stats import default_window_s, new_window, running_stats
 from drill_sim_ros.viz.static_views import log_static
+from drill_sim_ros.viz.string_views import StringBatch, StringViews
 from drill_sim_ros.viz.telemetry import TelemetryBatch
 from drill_sim_ros.viz.turns import TurnTracker
 
@@ -35,6 +37,7 @@ class Dashboard:
         self._last_turn: list = []
         self.samples = 0
         self.last_time_s: float | None = None
+        self.strings = StringViews(rec, units.omega0 / units.scales.time_s * RPM_PER_RAD_S)
         self.log_static(rec)
 
     def log_static(self, rec: rr.RecordingStream | Recordings) -> None:
@@ -46,6 +49,10 @@ class Dashboard:
         for part in batch.monotonic_parts():
             for start in range(0, len(part), MAX_ROWS):
                 self._log_part(TelemetryBatch(part.rows[start:start + MAX_ROWS]))
+
+    def log_strings(self, batch: StringBatch) -> None:
+        """The string views of ``batch`` (drill/string/torsion profiles)."""
+        self.strings.log(batch)
 
     def _restart(self) -> None:
         """Sim time went back (a reset): new window, new paths, new revolutions."""

@@ -19,6 +19,7 @@ TORQUE_SURFACE = "/timeseries/torque/surface"    # kN m
 ROP = "/timeseries/rop/bit"                      # m/h
 RPM_BIT = "/timeseries/rpm/bit"                  # rev/min
 RPM_SURFACE = "/timeseries/rpm/surface"          # rev/min
+RPM_BHA = "/timeseries/rpm/bha"                  # rev/min, bottom of the string
 RPM_STICK = "/timeseries/rpm/stick"              # rev/min, markers at stuck samples only
 MODE = "/timeseries/mode/mode"                   # 0 cutting .. 3 off_bottom (MODE_NAMES)
 
@@ -30,6 +31,7 @@ SCALAR_SERIES: tuple[tuple[str, str, float, str], ...] = (
     (TORQUE_SURFACE, "surface_torque_nm", 1e-3, "surface torque [kN m]"),
     (ROP, "rop_m_s", 3600.0, "ROP [m/h]"),
     (RPM_BIT, "bit_rpm", 1.0, "bit [rpm]"),
+    (RPM_BHA, "bha_rpm", 1.0, "BHA [rpm]"),
     (RPM_SURFACE, "surface_rpm", 1.0, "surface [rpm]"),
     (MODE, "mode", 1.0, "mode: " + ", ".join(f"{i} {n}" for i, n in enumerate(MODE_NAMES))),
 )
@@ -58,6 +60,11 @@ SEVERITY = "/severity"
 SSI = "/severity/ssi"
 STICK_FRACTION = "/severity/stick_fraction"
 INFO = "/info"
+
+# ---- the distributed string (drill/string/torsion; viz.string_views) --------------------
+STRING_DEPTH_TIME = "/string/depth_time"         # RGB image: depth (rows) x profiles (columns)
+STRING_SPEED = "/string/speed"                   # bar chart: rpm over depth m
+STRING_TORQUE = "/string/torque"                 # bar chart: kN m over depth m
 
 # Every path that carries one row per telemetry sample.
 PER_SAMPLE = (*(s[0] for s in SCALAR_SERIES), PHASE_TRAJECTORY, SSI, STICK_FRACTION)

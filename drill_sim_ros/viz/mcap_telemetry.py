@@ -19,6 +19,7 @@ from mcap_ros2.decoder import DecoderFactory
 from drill_sim_ros import topics
 from drill_sim_ros.archive.reader import ArchiveReader, RecordedChannel
 from drill_sim_ros.archive.recovery import DAMAGE
+from drill_sim_ros.viz.string_views import StringBatch, string_batch
 from drill_sim_ros.viz.telemetry import N_FIELDS, TelemetryBatch, field_order
 
 PRESET_KEYS = ("preset", "model.preset")
@@ -62,6 +63,24 @@ def read_telemetry(path: str | Path | ArchiveReader,
     if not seen:
         raise NoTelemetryError(f"{reader.path}: no readable {topics.TELEMETRY} messages with "
                                f"{N_FIELDS} fields")
+
+
+def read_string_profiles(path: str | Path | ArchiveReader,
+                         batch_profiles: int = 1000) -> Iterator[StringBatch]:
+    """Yield the drill/string/torsion profiles in file order, ``batch_profiles`` at a time
+    (none for a lumped string or a recording made before the topic existed)."""
+    reader = path if isinstance(path, ArchiveReader) else ArchiveReader(path)
+    messages: list[Any] = []
+    decode = None
+    for message in reader.messages(lambda topic: topic == topics.STRING_TORSION):
+        decode = decode or _decoder(message.channel)
+        messages.append(decode(message.data))
+        if len(messages) >= batch_profiles:
+            if (batch := string_batch(messages)) is not None:
+                yield batch
+            messages = []
+    if messages and (batch := string_batch(messages)) is not None:
+        yield batch
 
 
 def recorded_run_info(path: str | Path) -> dict[str, Any] | None:

@@ -28,11 +28,12 @@ from drill_sim_ros.archive.signals import stop_on_signals
 from drill_sim_ros.model.errors import ParameterError
 from drill_sim_ros.model.presets import DEFAULT_PRESET
 from drill_sim_ros.viz.analytics_off import disable_analytics
-from drill_sim_ros.viz.blueprint import build_blueprint
+from drill_sim_ros.viz.blueprint import build_blueprint, has_string_views
 from drill_sim_ros.viz.dashboard import Dashboard, data_extents
 from drill_sim_ros.viz.frames import view_frames
 from drill_sim_ros.viz.mcap_telemetry import (
     NoTelemetryError,
+    read_string_profiles,
     read_telemetry,
     recorded_preset,
     recorded_run_info,
@@ -72,16 +73,19 @@ def convert(mcap: Path, output: Path, preset: str | None = None,
     batches = read_telemetry(reader)
     first = next(batches)                # NoTelemetryError before anything else is said
     units = recorded_units(mcap, preset)
+    string = has_string_views(recorded_run_info(mcap))
     window = default_window_s(units) if window_s is None else window_s
     frames = view_frames(units, data_extents(read_telemetry(mcap), units, window))
     temporary = temporary_beside(output, overwrite)
     try:
-        rec = open_recording(build_blueprint(window, frames), save=temporary)
+        rec = open_recording(build_blueprint(window, frames, string), save=temporary)
         try:
             dashboard = Dashboard(rec, units, window, frames)
             dashboard.log_batch(first)
             for batch in batches:
                 dashboard.log_batch(batch)
+            for profiles in read_string_profiles(reader):
+                dashboard.log_strings(profiles)
         finally:
             close_recording(rec)
         commit(temporary, output, overwrite)

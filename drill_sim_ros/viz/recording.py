@@ -55,6 +55,10 @@ def open_recording(blueprint: rrb.Blueprint, *, save: str | Path | None = None,
     if not sinks:
         raise ValueError("no rerun sink: give save, connect or serve_port")
     rec = rr.RecordingStream(APP_ID, recording_id=recording_id)
+    # sim_time is the only timeline: what is logged row by row (``log``) gets no wall-clock
+    # log_time or log_tick, so two recordings of one run give the same dashboard
+    rec.set_log_time_enabled(False)
+    rec.set_log_tick_enabled(False)
     rec.set_sinks(*sinks, default_blueprint=blueprint)
     return rec
 
@@ -62,10 +66,10 @@ def open_recording(blueprint: rrb.Blueprint, *, save: str | Path | None = None,
 class Recordings:
     """The recording streams the dashboard logs to at the moment.
 
-    It has the two methods the ``log_*`` functions call (``send_columns`` and ``log``) and
-    hands each call to every attached stream, so one stream (a viewer's) can be attached
-    and detached without touching the others (a FileSink cannot be re-attached: it would
-    truncate its file).
+    It has the methods the ``log_*`` functions call (``send_columns``, ``log`` and
+    ``set_time``) and hands each call to every attached stream, so one stream (a viewer's)
+    can be attached and detached without touching the others (a FileSink cannot be
+    re-attached: it would truncate its file).
     """
 
     def __init__(self, *streams: rr.RecordingStream) -> None:
@@ -84,6 +88,10 @@ class Recordings:
     def log(self, *args: Any, **kwargs: Any) -> None:
         for stream in self.streams:
             stream.log(*args, **kwargs)
+
+    def set_time(self, *args: Any, **kwargs: Any) -> None:
+        for stream in self.streams:
+            stream.set_time(*args, **kwargs)
 
 
 def flush_recording(rec: rr.RecordingStream, timeout_s: float) -> str | None:

@@ -21,6 +21,7 @@ LABEL = (55, 55, 55)         # label box; rerun writes the text in a contrasting
 _LINE_COLORS = {ent.WOB_BIT: (31, 119, 180), ent.WOB_APPLIED: (170, 170, 170),
                 ent.TORQUE_BIT: (44, 160, 44), ent.TORQUE_SURFACE: (170, 170, 170),
                 ent.ROP: (196, 130, 100), ent.RPM_BIT: (31, 119, 180),
+                ent.RPM_BHA: (23, 190, 207),
                 ent.RPM_SURFACE: (170, 170, 170), ent.MODE: (200, 200, 200)}
 SSI_COLOR, STICK_COLOR = (214, 39, 40), (148, 103, 189)
 # Several samples sharing a pixel column keep both their min and their max: the peaks a

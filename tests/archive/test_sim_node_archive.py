@@ -29,7 +29,7 @@ pytestmark = pytest.mark.ros
 
 STEPS = 40
 SAMPLE_TOPICS = [t for t in topics.MSG_TYPES
-                 if t not in (*topics.COMMANDS, topics.DIAGNOSTICS,
+                 if t not in (*topics.COMMANDS, *topics.PROFILE_TOPICS, topics.DIAGNOSTICS,
                               topics.RUN_INFO)]
 
 

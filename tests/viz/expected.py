@@ -23,6 +23,7 @@ SCALARS = {
     "/timeseries/torque/surface": ("surface_torque_nm", 1e-3),
     "/timeseries/rop/bit": ("rop_m_s", 3600.0),
     "/timeseries/rpm/bit": ("bit_rpm", 1.0),
+    "/timeseries/rpm/bha": ("bha_rpm", 1.0),
     "/timeseries/rpm/surface": ("surface_rpm", 1.0),
     "/timeseries/mode/mode": ("mode", 1.0),
 }

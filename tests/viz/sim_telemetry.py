@@ -63,6 +63,7 @@ def telemetry_rows(preset: Preset, seconds: float, rate_hz: float = 100.0) -> np
         "command_stamp_s": np.full(len(samples), -1.0),
         "hook_load_measured_n": -sc.wob_n(col(k.C_W_APP)),
         "applied_wob_estimate_n": sc.wob_n(col(k.C_W_APP)),
+        "bha_rpm": sc.rpm(col(k.C_OMEGA_BHA)),
     }
     return np.column_stack([fields[name] for name in topics.TELEMETRY_FIELDS])
 

@@ -16,7 +16,7 @@ import pytest
 from drill_sim_ros import topics
 from tests.viz import expected as ex
 from tests.viz.bridge_process import BridgeProcess, private_topic, remap_telemetry
-from tests.viz.rrd_read import read_recording
+from tests.viz.rrd_read import read_recording, view_origins
 
 pytestmark = [
     pytest.mark.ros,
@@ -80,3 +80,7 @@ def test_sim_node_telemetry_reaches_the_rrd(tmp_path: Path) -> None:
     np.testing.assert_array_equal(logged.scalars()[t_logged >= start],
                                   heard[keep, F["bit_rpm"]])
     assert set(ex.SCALARS) <= set(read_recording(rrd))
+    # the default preset's string is distributed: its profiles at 10 Hz of sim time
+    bars = read_recording(rrd)["/string/speed"]
+    assert len(bars.time_ns) >= 3 and np.all(bars.time_ns % 100_000_000 == 0)
+    assert {"/string/depth_time", "/string/speed"} <= set(view_origins(rrd).values())

@@ -25,7 +25,8 @@ from tests.viz.rrd_read import read_recording
 pytestmark = pytest.mark.ros
 STEPS = 300                       # 3 s of simulated time at 100 Hz
 SAMPLE_TOPICS = [t for t in topics.MSG_TYPES
-                 if t not in (*topics.COMMANDS, topics.DIAGNOSTICS, topics.RUN_INFO)]
+                 if t not in (*topics.COMMANDS, *topics.PROFILE_TOPICS, topics.DIAGNOSTICS,
+                              topics.RUN_INFO)]
 
 
 def _record_twice(tmp: Path) -> tuple[Path, Path, int, int]:
