@@ -126,6 +126,7 @@ class Simulator:
         self.scales = scales
         self.string = string
         self._layers: tuple[Layer, ...] = ()
+        self._cell_depths: dict[bool, np.ndarray] = {}
         self._layer_index = -1
         self._wave_layout()
         for name, value in (("perturb_v", perturb_v), ("perturb_omega", perturb_omega)):
@@ -536,7 +537,10 @@ class Simulator:
         parts_t = self._parts[0]
         lo, hi = (parts_t, self._wave_i.shape[1]) if axial else (0, parts_t)
         force, speed, _ = sg.line_state(self._wave, self._wave_i, self._wave_f, lo, hi)
-        depth = sg.cell_depths_m(self.string.lines[1 if axial else 0], self._wave_i, lo)
+        if axial not in self._cell_depths:       # the layout is fixed: computed once
+            self._cell_depths[axial] = sg.cell_depths_m(self.string.lines[1 if axial else 0],
+                                                        self._wave_i, lo)
+        depth = self._cell_depths[axial]
         sc = self.scales
         if axial:
             return depth, speed * sc.length_m / sc.time_s, force * sc.force_n

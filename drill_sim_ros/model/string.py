@@ -382,19 +382,31 @@ def bottom_end(a_in: float, z: float, mass: float, v: float,
 def line_state(wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray, lo: int,
                hi: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(force, speed, impedance) of every cell of parts lo..hi-1, top to bottom, now."""
-    forces, speeds, zs = [], [], []
+    cells = int(wave_i[W_LEN, lo:hi].sum())
+    force, speed, z = np.empty(cells), np.empty(cells), np.empty(cells)
+    _line_state_into(wave, wave_i, wave_f, lo, hi, force, speed, z)
+    return force, speed, z
+
+
+@njit(cache=True)
+def _line_state_into(wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray, lo: int,
+                     hi: int, force: np.ndarray, speed: np.ndarray, zs: np.ndarray) -> None:
+    """:func:`line_state` into the caller's arrays. The slot pos - 1 - k holds the a that
+    entered k steps ago (k cells below the top); the b at k cells below the top entered
+    n - 1 - k steps ago at the bottom (slot pos + k)."""
+    i = 0
     for j in range(lo, hi):
-        n, off, pos, z = (int(wave_i[W_LEN, j]), int(wave_i[W_OFF, j]),
-                          int(wave_i[W_POS, j]), float(wave_f[W_Z, j]))
-        # slot pos - 1 - k holds the a that entered k steps ago (k cells below the top);
-        # b at k cells below the top entered n - 1 - k steps ago at the bottom
-        k = np.arange(n)
-        a = wave[off + (pos - 1 - k) % n]
-        b = wave[off + n + (pos - n + k) % n]
-        forces.append(0.5 * (a + b))
-        speeds.append((a - b) / (2.0 * z))
-        zs.append(np.full(n, z))
-    return np.concatenate(forces), np.concatenate(speeds), np.concatenate(zs)
+        n, off, pos, z = wave_i[W_LEN, j], wave_i[W_OFF, j], wave_i[W_POS, j], wave_f[W_Z, j]
+        ia = pos - 1 if pos > 0 else n - 1     # walks down the a slots, wrapping
+        ib = pos                               # walks up the b slots, wrapping
+        for _ in range(n):
+            a, b = wave[off + ia], wave[off + n + ib]
+            force[i] = 0.5 * (a + b)
+            speed[i] = (a - b) / (2.0 * z)
+            zs[i] = z
+            i += 1
+            ia = ia - 1 if ia > 0 else n - 1
+            ib = ib + 1 if ib + 1 < n else 0
 
 
 def cell_depths_m(line: WaveLine, wave_i: np.ndarray, lo: int) -> np.ndarray:
