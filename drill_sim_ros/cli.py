@@ -27,6 +27,7 @@ from drill_sim_ros.model.params import GROUPS, UNIT_SCALES, DimensionlessParams,
 from drill_sim_ros.model.presets import Preset, available_presets, load_preset
 from drill_sim_ros.model.simulator import SimConfig, Simulator
 from drill_sim_ros.model.top_drive import MODES, TopDrive
+from drill_sim_ros.model.validate_input import load_checked_preset
 from drill_sim_ros.study import cli as study_cli
 from drill_sim_ros.terminal import StatusLine
 
@@ -123,7 +124,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 def _resolve(args: argparse.Namespace) -> RunSpec:
     """Turn parsed arguments into a validated :class:`RunSpec`."""
-    preset: Preset | None = load_preset(args.params) if args.params else None
+    preset: Preset | None = load_checked_preset(args.params) if args.params else None
     base = preset.params if preset else DimensionlessParams()
     overrides = {g: getattr(args, g) for g in GROUPS if getattr(args, g) is not None}
     params = base.with_(**overrides) if overrides else base
@@ -376,7 +377,7 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
 
 
 def _cmd_info(args: argparse.Namespace) -> int:
-    preset = load_preset(args.preset)
+    preset = load_checked_preset(args.preset)
     p = preset.params
     print(f"{preset.name}: {preset.description}")
     print("  groups  " + "  ".join(f"{g}={getattr(p, g):.4g}" for g in GROUPS))
@@ -405,8 +406,11 @@ def main(argv: Sequence[str] | None = None) -> int:
                 "map-plot": study_cli.cmd_map_plot,
                 "figures": study_cli.cmd_figures}[args.command](args)
     except DrillSimError as exc:
-        print(f"drill_sim: error: {exc}", file=sys.stderr)
+        print(f"drill_sim: error: {' '.join(str(exc).splitlines())}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:
+        print(f"drill_sim {args.command}: interrupted", file=sys.stderr)
+        return 130
 
 
 if __name__ == "__main__":

@@ -23,6 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from drill_sim_ros.control.command import CommandLimits, apply_command, measurement_of_row
+from drill_sim_ros.control.isolation import IsolatedController, build_isolated
 from drill_sim_ros.control.registry import make_controller
 from drill_sim_ros.control.rig import RigPhysics, rig_physics
 from drill_sim_ros.control.scenario import Scenario
@@ -55,6 +56,7 @@ class ClosedLoopRun:
     # ``snapshot_after`` when asked (differences of the sums are window sums)
     accumulators: np.ndarray | None = None
     snapshot: np.ndarray | None = None
+    interrupted: bool = False     # Ctrl-C: ``rows`` holds the periods done
 
 
 def drive_of(preset: Preset, mode: str) -> TopDrivePhysical:
@@ -89,12 +91,13 @@ def sim_node_parameters(scenario: Scenario, preset: Preset) -> dict[str, object]
     return out
 
 
-def build_controller(scenario: Scenario, preset: Preset) -> object:
-    """The scenario's controller, tuned from the preset's physics."""
-    return make_controller(scenario.controller, rig=rig_physics(preset),
-                           schedule=scenario.setpoints(preset), mode=scenario.mode,
-                           period_s=scenario.period_s, enable_at_s=scenario.enable_at_s,
-                           **scenario.params)
+def build_controller(scenario: Scenario, preset: Preset) -> IsolatedController:
+    """The scenario's controller, tuned from the preset's physics, isolated
+    (:mod:`~drill_sim_ros.control.isolation`: its failures are one ControllerError line)."""
+    return build_isolated(scenario.controller, lambda: make_controller(
+        scenario.controller, rig=rig_physics(preset), schedule=scenario.setpoints(preset),
+        mode=scenario.mode, period_s=scenario.period_s, enable_at_s=scenario.enable_at_s,
+        **scenario.params), scenario.period_s)
 
 
 def run_in_process(scenario: Scenario,
@@ -114,20 +117,27 @@ def run_in_process(scenario: Scenario,
     start = time.perf_counter()
     command, stamp_ns = controller.update(None), 0
     snapshot = session.sim.accumulators if snapshot_after == 0 else None
-    for i in range(periods):
-        for applied, why in apply_command(session, command, limits):
-            if not applied:
-                raise ParameterError(f"the controller commanded {why}; commands must be finite")
-        session.command_stamp_ns = stamp_ns
-        block = session.run(1)
-        rows[i + 1] = block.rows[0]
-        stamp_ns = int(block.stamps_ns[0])
-        if snapshot_after == i + 1:
-            snapshot = session.sim.accumulators
-        if i + 1 < periods:
-            command = controller.update(measurement_of_row(block.rows[0], stamp_ns))
-        if progress is not None and (i + 1) % 1000 == 0:
-            progress(i + 1, periods)
+    done, interrupted = 0, False
+    try:
+        for i in range(periods):
+            for applied, why in apply_command(session, command, limits):
+                if not applied:
+                    raise ParameterError(f"the controller commanded {why}; commands must be "
+                                         "finite")
+            session.command_stamp_ns = stamp_ns
+            block = session.run(1)
+            rows[i + 1] = block.rows[0]
+            done = i + 1
+            stamp_ns = int(block.stamps_ns[0])
+            if snapshot_after == i + 1:
+                snapshot = session.sim.accumulators
+            if i + 1 < periods:
+                command = controller.update(measurement_of_row(block.rows[0], stamp_ns))
+            if progress is not None and (i + 1) % 1000 == 0:
+                progress(i + 1, periods)
+    except KeyboardInterrupt:
+        interrupted = True
     wall_s = time.perf_counter() - start
-    return ClosedLoopRun(scenario, rows, wall_s, int(getattr(controller, "clamped_commands", 0)),
-                         session.sim.accumulators, snapshot)
+    return ClosedLoopRun(scenario, rows[:done + 1], wall_s,
+                         int(getattr(controller, "clamped_commands", 0)),
+                         session.sim.accumulators, snapshot, interrupted)

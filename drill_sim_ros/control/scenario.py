@@ -28,10 +28,12 @@ from typing import Any
 
 import yaml
 
+from drill_sim_ros.control.scenario_check import check_scenario_mapping, check_scenario_size
 from drill_sim_ros.control.schedule import Schedule, schedule_from_list
 from drill_sim_ros.model.errors import ParameterError
 from drill_sim_ros.model.measurement import SIGNALS, RigSensors, SignalSpec
-from drill_sim_ros.model.presets import DEFAULT_PRESET, Preset, load_preset
+from drill_sim_ros.model.presets import DEFAULT_PRESET, Preset
+from drill_sim_ros.model.validate_input import load_checked_preset
 
 SCENARIO_KEYS = ("preset", "duration_s", "control_rate_hz", "mode", "controller", "params",
                  "enable_at_s", "schedule", "sensors")
@@ -56,6 +58,7 @@ class Scenario:
             value = getattr(self, name)
             if not (isinstance(value, (int, float)) and math.isfinite(value) and value > low):
                 raise ParameterError(f"scenario: '{name}' = {value!r} must be a number > 0")
+        check_scenario_size(self.duration_s, self.control_rate_hz)
         if not (math.isfinite(self.enable_at_s) and 0.0 <= self.enable_at_s <= self.duration_s):
             raise ParameterError(f"scenario: 'enable_at_s' = {self.enable_at_s!r} must lie in "
                                  f"[0, duration_s = {self.duration_s:g}]")
@@ -76,7 +79,7 @@ class Scenario:
         return 1.0 / self.control_rate_hz
 
     def load_preset(self) -> Preset:
-        return load_preset(self.preset)
+        return load_checked_preset(self.preset)
 
     def setpoints(self, preset: Preset) -> Schedule:
         """The schedule, starting from the preset's rpm and WOB where it does not say."""
@@ -111,20 +114,7 @@ def scenario_from_dict(data: dict[str, Any]) -> Scenario:
     unknown = sorted(set(data) - set(SCENARIO_KEYS))
     if unknown:
         raise ParameterError(f"scenario: unknown key(s) {unknown}; known: {list(SCENARIO_KEYS)}")
-    values = dict(data)
-    values["schedule"] = tuple(values.get("schedule") or ())
-    values["params"] = dict(values.get("params") or {})
-    values["sensors"] = dict(values.get("sensors") or {})
-    for key in ("duration_s", "control_rate_hz", "enable_at_s"):
-        if key in values:
-            values[key] = _float(key, values[key])
-    return Scenario(**values)
-
-
-def _float(key: str, value: Any) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise ParameterError(f"scenario: '{key}' = {value!r} must be a number")
-    return float(value)
+    return Scenario(**check_scenario_mapping(data))
 
 
 def load_scenario(path: str | Path) -> Scenario:
