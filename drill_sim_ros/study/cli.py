@@ -81,19 +81,21 @@ def map_spec_from(args: argparse.Namespace,
 def cmd_map(args: argparse.Namespace, resolve: Callable[[argparse.Namespace], Any]) -> int:
     if args.batch is not None and not 1 <= args.batch <= 100_000:
         raise DrillSimError(f"--batch = {args.batch} must be in [1, 100000]")
-    from drill_sim_ros.study import engine
+    from drill_sim_ros.study import engine, store
     spec = map_spec_from(args, resolve)
     bar = MapProgress(args.progress or _isatty())
     try:
-        with engine.connect(args.scheduler, args.workers) as client:
-            result = engine.run_map(spec, args.out, client, progress=bar, batch=args.batch)
+        with store.map_lock(args.out), engine.connect(args.scheduler, args.workers) as client:
+            result = engine.run_map(spec, args.out, client, progress=bar, batch=args.batch,
+                                    log=bar.say)
     except KeyboardInterrupt:
         result = None
     finally:
         bar.close()
     if result is None or result.interrupted:
-        print(f"drill_sim map: interrupted; the points done are kept in {args.out}; "
-              "re-run the same command to resume")
+        kept = f"the points done are kept in {args.out}" if args.out.exists() else \
+            "no point was done"
+        print(f"drill_sim map: interrupted; {kept}; re-run the same command to resume")
         return 130
     done = int(result.dataset["done"].sum())
     rate = result.computed / result.seconds if result.seconds > 0 else 0.0
