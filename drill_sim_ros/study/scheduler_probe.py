@@ -30,9 +30,11 @@ def parse_address(scheduler: str) -> tuple[str, int]:
     return match.group(1).strip("[]"), int(match.group(2))
 
 
-def check_scheduler(scheduler: str, timeout_s: float = PROBE_TIMEOUT_S) -> str:
-    """``scheduler`` as ``tcp://HOST:PORT`` once it has answered like a Dask scheduler."""
+def check_scheduler(scheduler: str, timeout_s: float | None = None) -> str:
+    """``scheduler`` as ``tcp://HOST:PORT`` once it has answered like a Dask scheduler
+    within ``timeout_s`` (default PROBE_TIMEOUT_S)."""
     host, port = parse_address(scheduler)
+    timeout_s = PROBE_TIMEOUT_S if timeout_s is None else timeout_s
     try:
         with socket.create_connection((host, port), timeout=timeout_s) as sock:
             sock.settimeout(timeout_s)
