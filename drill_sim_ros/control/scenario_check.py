@@ -15,6 +15,7 @@ from typing import Any
 
 from drill_sim_ros.model.errors import ParameterError
 from drill_sim_ros.model.measurement import MAX_DELAY_PERIODS, SIGNALS
+from drill_sim_ros.model.validate_input import as_number
 
 CONTROL_RATE_RANGE_HZ = (1.0, 1000.0)      # sim_node's publish_rate_hz
 MAX_PERIODS = 2_000_000                    # 2e6 rows x 21 float64 = 336 MB per run
@@ -23,23 +24,22 @@ _STRINGS = ("preset", "mode", "controller")
 _NUMBERS = ("duration_s", "control_rate_hz", "enable_at_s")
 
 
-def _is_number(value: Any) -> bool:
-    return not isinstance(value, bool) and isinstance(value, (int, float))
-
-
 def check_number(where: str, value: Any) -> float:
-    """``value`` as a float if it is a finite number (not a bool, not a string)."""
-    if not _is_number(value) or not math.isfinite(value):
+    """``value`` as a float if it is a finite number (not a bool; YAML 1.1's ``1.0e7`` is a
+    string that is a number, ``abc`` is not)."""
+    number = as_number(value)
+    if number is None or not math.isfinite(number):
         raise ParameterError(f"scenario: '{where}' = {value!r} must be a finite number")
-    return float(value)
+    return float(number)
 
 
 def check_integer(where: str, value: Any, low: int, high: int) -> int:
     """``value`` if it is a whole number in [low, high]."""
-    if not _is_number(value) or not float(value).is_integer() or not low <= value <= high:
+    number = as_number(value)
+    if number is None or not float(number).is_integer() or not low <= number <= high:
         raise ParameterError(f"scenario: '{where}' = {value!r} must be a whole number in "
                              f"[{low}, {high}]")
-    return int(value)
+    return int(number)
 
 
 def check_params(params: Any) -> dict[str, float]:
@@ -78,10 +78,15 @@ def check_sensors(sensors: Any) -> dict[str, Any]:
                                  f"'sensors.{name}'; known: {', '.join(SIGNAL_KEYS)}")
         for key, value in spec.items():
             if key == "delay_periods":
-                check_integer(f"sensors.{name}.{key}", value, 0, MAX_DELAY_PERIODS)
-            elif check_number(f"sensors.{name}.{key}", value) < 0.0:
+                spec[key] = check_integer(f"sensors.{name}.{key}", value, 0,
+                                          MAX_DELAY_PERIODS)
+                continue
+            spec[key] = check_number(f"sensors.{name}.{key}", value)
+            if spec[key] < 0.0:
                 raise ParameterError(f"scenario: 'sensors.{name}.{key}' = {value!r} must "
                                      "be >= 0")
+    if "seed" in sensors:
+        sensors["seed"] = check_integer("sensors.seed", sensors["seed"], 0, 2**32 - 1)
     return dict(sensors)
 
 
@@ -105,7 +110,7 @@ def check_scenario_size(duration_s: float, control_rate_hz: float) -> None:
     """The rate within CONTROL_RATE_RANGE_HZ and the run within MAX_PERIODS periods."""
     low, high = CONTROL_RATE_RANGE_HZ
     if not low <= control_rate_hz <= high:
-        raise ParameterError(f"scenario: 'control_rate_hz' = {control_rate_hz!r} is outside "
+        raise ParameterError(f"scenario: 'control_rate_hz' = {control_rate_hz:g} is outside "
                              f"[{low:g}, {high:g}] Hz (sim_node's publish_rate_hz)")
     periods = duration_s * control_rate_hz
     if periods > MAX_PERIODS:

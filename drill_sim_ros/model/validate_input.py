@@ -33,7 +33,7 @@ def _names(cls: type) -> tuple[str, ...]:
     return tuple(f.name for f in fields(cls))
 
 
-def _number(value: Any) -> float | int | None:
+def as_number(value: Any) -> float | int | None:
     """``value`` as a number; YAML 1.1 reads ``79.3e9`` (no dot, no exponent sign) as a
     string, so a string that is a number counts as one (``abc`` does not)."""
     if isinstance(value, bool):
@@ -54,7 +54,7 @@ def check_value(where: str, key: str, value: Any) -> None:
         if not isinstance(value, str):
             raise ParameterError(f"'{where}.{key}' = {value!r} must be a string")
         return
-    number = _number(value)
+    number = as_number(value)
     if number is None:
         raise ParameterError(f"'{where}.{key}' = {value!r} must be a number")
     if key in INTEGER_KEYS and not float(number).is_integer():
@@ -84,7 +84,7 @@ def check_numerics(values: Any) -> None:
     """``numerics``: dtau in DTAU_RANGE, n_nodes a whole number in N_NODES_RANGE."""
     check_section("numerics", values, NUMERICS_KEYS, required=False)
     for key, (low, high) in (("dtau", DTAU_RANGE), ("n_nodes", N_NODES_RANGE)):
-        if key in values and not low <= _number(values[key]) <= high:
+        if key in values and not low <= as_number(values[key]) <= high:
             raise ParameterError(f"'numerics.{key}' = {values[key]!r} is outside the allowed "
                                  f"range [{low:g}, {high:g}]")
 

@@ -39,11 +39,10 @@ def flatten(values: dict[Any, Any], prefix: str = "") -> dict[str, Any]:
 
 
 def _unknown(path: str, name: str, known: set[str], node_name: str) -> ParameterError:
+    groups = {k.rsplit(".", 1)[0] for k in known if "." in k}
     close = difflib.get_close_matches(name, sorted(known), n=1, cutoff=0.6)
-    groups = sorted({k.split(".")[0] for k in known if "." in k})
-    hint = f"; did you mean {close[0]}?" if close else \
-        (f"; '{name}' is a group: give its parameters ({name}.NAME: value)"
-         if name in groups else "")
+    hint = f"; '{name}' is a group: give its parameters ({name}: {{NAME: value}})" \
+        if name in groups else (f"; did you mean {close[0]}?" if close else "")
     return ParameterError(f"--params-file {path}: {node_name} has no parameter '{name}'"
                           f"{hint} (ros2 param list /{node_name} lists them)")
 
