@@ -5,6 +5,7 @@ controller is one line, the estimate and the rate are measured, Ctrl-C keeps the
 from __future__ import annotations
 
 import http.server
+import queue
 import signal
 import socket
 import subprocess
@@ -191,12 +192,18 @@ def test_ctrl_c_keeps_the_points_done(tmp_path: Path) -> None:
          "beta=0.1:0.5:200", "--tau-end", "100", "--workers", "1", "--batch", "1",
          "--out", str(out)], cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
         text=True)
-    line = process.stderr.readline()             # the size line, then the first result
-    assert line.startswith("drill_sim map: 200 points"), line
-    line = process.stderr.readline()
-    assert line.startswith("drill_sim map: the first 1 points"), line
+    lines: queue.Queue[str] = queue.Queue()
+    reader = threading.Thread(target=lambda: [lines.put(x) for x in process.stderr],
+                              daemon=True)
+    reader.start()
+    seen = []
+    while not any(x.startswith("drill_sim map: the first 1 points") for x in seen):
+        seen.append(lines.get(timeout=120))      # the size line, then the first result
+    assert seen[0].startswith("drill_sim map: 200 points"), seen
     process.send_signal(signal.SIGINT)
-    stdout, err = process.communicate(timeout=60)
+    stdout, _ = process.communicate(timeout=60)
+    reader.join(timeout=10)
+    err = "".join(seen) + "".join(lines.queue)
     assert process.returncode == 130, err
     assert "Traceback" not in err
     assert stdout.strip().splitlines() == [
