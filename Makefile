@@ -20,24 +20,31 @@ export PYTHONUNBUFFERED := 1
 RUN_DIR ?= runs/$(shell date -u +%Y%m%dT%H%M%SZ)
 RUN_SECONDS ?= 0
 
-.PHONY: venv run test lint bench clean colcon figures
+.PHONY: venv run test lint bench clean colcon figures docs
 
 venv: $(VENV)/.stamp
 
 # Use a sourced ROS 2 Jazzy when there is one; otherwise rclpy comes from PyPI wheels.
-$(VENV)/.stamp: requirements.txt requirements-ros.txt setup.py
+MSGS := $(wildcard msgs/drill_sim_msgs/msg/*.msg) msgs/drill_sim_msgs/CMakeLists.txt \
+  msgs/drill_sim_msgs/package.xml msgs/build_in_venv.sh
+$(VENV)/.stamp: requirements.txt requirements-ros.txt requirements-msgs.txt setup.py $(MSGS)
 	@if [ "$${ROS_DISTRO:-}" = "jazzy" ] && $(SYSTEM_PYTHON) -c 'import rclpy' 2>/dev/null; then \
 	  echo "[venv] using the sourced ROS 2 Jazzy"; \
 	  $(SYSTEM_PYTHON) -m venv --system-site-packages $(VENV); ros_req=""; \
 	else \
 	  echo "[venv] no ROS 2 Jazzy sourced: installing rclpy from PyPI wheels"; \
-	  $(SYSTEM_PYTHON) -m venv $(VENV); ros_req="-r requirements-ros.txt"; \
+	  $(SYSTEM_PYTHON) -m venv $(VENV); ros_req="-r requirements-ros.txt -r requirements-msgs.txt"; \
 	fi; \
 	pipi() { $(PY) -m pip install --disable-pip-version-check "$$@" > $(VENV)/pip.log 2>&1 \
 	  || { grep -v 'is ignored' $(VENV)/pip.log; echo "[venv] pip install failed"; exit 1; }; }; \
 	echo "[venv] installing dependencies (first run: a few minutes, ~1 GB)"; \
 	pipi $$ros_req -r requirements.txt; \
 	pipi --no-build-isolation --no-deps -e .; \
+	if [ -n "$$ros_req" ]; then \
+	  echo "[venv] building the drill_sim_msgs interface package (about 30 s)"; \
+	  msgs/build_in_venv.sh $(VENV) > $(VENV)/msgs-build.log 2>&1 \
+	    || { tail -30 $(VENV)/msgs-build.log; echo "[venv] drill_sim_msgs failed to build"; exit 1; }; \
+	fi; \
 	$(PY) -c 'import rclpy, numba, mcap, rerun, drill_sim_ros' ; \
 	$(PY) -m drill_sim_ros.viz.analytics_off; \
 	touch $(VENV)/COLCON_IGNORE; \
@@ -56,11 +63,16 @@ run: venv
 	echo "[run] replay: $(BIN)/mcap_replay $(RUN_DIR)/run.mcap   view: $(BIN)/rerun $(RUN_DIR)/run.rrd"
 
 test: venv
-	$(BIN)/ruff check drill_sim_ros tests benchmarks
+	$(BIN)/ruff check drill_sim_ros tests benchmarks docs
 	$(BIN)/pytest
 
 lint: venv
-	$(BIN)/ruff check drill_sim_ros tests benchmarks
+	$(BIN)/ruff check drill_sim_ros tests benchmarks docs
+
+# The generated tables of the docs (parameters, topics) from the code's own tables;
+# tests/test_docs.py fails when a committed page differs from what this writes.
+docs: venv
+	$(PY) docs/generate.py
 
 # Benchmarks print figures (no pass/fail): kernel ns/step, node CPU and real-time factor,
 # MCAP throughput, rerun bridge CPU, recording loss, maps, closed loop, lockstep.
@@ -82,7 +94,8 @@ figures: venv
 
 # The ament_python install tree that `ros2 run drill_sim_ros sim_node` uses.
 colcon: venv
-	$(BIN)/colcon build --base-paths . --build-base build --install-base install
+	$(BIN)/colcon build --base-paths . --build-base build --install-base install \
+	  $(if $(wildcard $(VENV)/share/drill_sim_msgs),--packages-skip drill_sim_msgs)
 	@echo "source install/setup.sh, then: ros2 run drill_sim_ros sim_node (or install/drill_sim_ros/lib/drill_sim_ros/sim_node)"
 
 clean:

@@ -1,5 +1,5 @@
-"""Offline command line: ``drill_sim run | sweep | presets | info | closed-loop | map |
-map-plot | figures``.
+"""Offline command line: ``drill_sim run | sweep | presets | info | closed-loop | suite |
+map | map-plot | figures``.
 
 ``drill_sim run`` integrates the RGD07 model without ROS and prints a summary (or one JSON
 object with ``--json``). The run is dimensionless unless ``--params`` names a physical
@@ -19,6 +19,7 @@ from dataclasses import dataclass, fields
 from pathlib import Path
 from typing import Any, TextIO
 
+from drill_sim_ros import string_cli
 from drill_sim_ros.control import closed_loop_cli
 from drill_sim_ros.model import analysis, telemetry
 from drill_sim_ros.model import kernel as k
@@ -29,6 +30,7 @@ from drill_sim_ros.model.simulator import SimConfig, Simulator
 from drill_sim_ros.model.top_drive import MODES, TopDrive
 from drill_sim_ros.model.validate_input import load_checked_preset
 from drill_sim_ros.study import cli as study_cli
+from drill_sim_ros.study import suite_cli
 from drill_sim_ros.terminal import StatusLine
 
 TRACE_COLUMNS = ("tau", "omega", "v", "wob", "tob", "depth_of_cut", "surface_torque", "mode")
@@ -119,6 +121,8 @@ def build_parser() -> argparse.ArgumentParser:
     info = sub.add_parser("info", help="groups, scales and stability of a preset")
     info.add_argument("preset", nargs="?", default="field_8p5in_shale")
     study_cli.add_parsers(sub, _add_model_args)
+    string_cli.add_parsers(sub)
+    suite_cli.add_parser(sub)
     return parser
 
 
@@ -403,8 +407,10 @@ def main(argv: Sequence[str] | None = None) -> int:
             return study_cli.cmd_map(args, _resolve)
         return {"run": _cmd_run, "sweep": _cmd_sweep, "info": _cmd_info,
                 "closed-loop": closed_loop_cli.cmd_closed_loop,
+                "suite": suite_cli.cmd_suite,
                 "map-plot": study_cli.cmd_map_plot,
-                "figures": study_cli.cmd_figures}[args.command](args)
+                "figures": study_cli.cmd_figures, "modes": string_cli.cmd_modes,
+                "reflection": string_cli.cmd_reflection}[args.command](args)
     except DrillSimError as exc:
         print(f"drill_sim: error: {' '.join(str(exc).splitlines())}", file=sys.stderr)
         return 2

@@ -32,9 +32,20 @@ CMD_SURFACE_RPM = "/drill/cmd/surface_rpm"    # std_msgs/Float64, rev/min
 CMD_WOB = "/drill/cmd/wob"                    # std_msgs/Float64, N
 CMD_TOP_DRIVE = "/drill/cmd/top_drive"        # sensor_msgs/JointState (COMMAND_JOINTS)
 # top_drive: velocity = speed setpoint rad/s, effort = motor torque N m (torque mode);
-# hook: effort = applied WOB N. header.stamp: the stamp of the sample the command reacts to.
+# hook: effort = applied WOB N, as in the state. header.stamp: the stamp of the sample the
+# command reacts to. Each array is empty or as long as name; other messages are rejected.
 COMMAND_JOINTS = ("top_drive", "hook")
 COMMANDS = (CMD_SURFACE_RPM, CMD_WOB, CMD_TOP_DRIVE)
+
+# ---- typed twins (drill_sim_msgs, when installed; drill_sim_ros.ros.typed) --------------
+TYPED_TELEMETRY = "/drill/typed/telemetry"    # drill_sim_msgs/Telemetry, one per sample
+TYPED_RUN_INFO = "/drill/typed/run_info"      # drill_sim_msgs/RunInfo; latched
+TYPED_CMD_TOP_DRIVE = "/drill/typed/cmd/top_drive"  # drill_sim_msgs/TopDriveCommand (subscribed)
+TYPED_MSG_TYPES: dict[str, str] = {
+    TYPED_TELEMETRY: "drill_sim_msgs/msg/Telemetry",
+    TYPED_RUN_INFO: "drill_sim_msgs/msg/RunInfo",
+    TYPED_CMD_TOP_DRIVE: "drill_sim_msgs/msg/TopDriveCommand",
+}
 
 # sim_node names its topics relative to its namespace (`-r __ns:=/rig1` moves them all),
 # except these two, which ROS conventions keep absolute. The names above are those of the
@@ -71,11 +82,70 @@ BIT_JOINTS = ("bit_rotation", "bit_axial")
 # bit_axial:    depth m (down positive), rate of penetration m/s, weight on bit N
 SURFACE_JOINTS = ("top_drive", "hook")
 # top_drive: angle rad, speed rad/s, surface (pipe) torque N m
-# hook:      bit depth m, rate of penetration m/s, hook load N
+# hook:      bit depth m, rate of penetration m/s, applied WOB N (the weight the hook sets
+#            down: submerged string weight - hook load; the hook load is in the telemetry)
 # What the rig's surface sensors give (the only signals a controller should read):
-MEASURED_JOINTS = ("top_drive", "quill")
-# top_drive: angle rad, measured speed rad/s (encoder), measured motor torque N m
-# quill:     angle rad, measured speed rad/s, measured string torque N m (torque sub)
+MEASURED_JOINTS = ("top_drive", "quill", "hook", "wob_estimate")
+# top_drive:    angle rad, measured speed rad/s (encoder), measured motor torque N m
+# quill:        angle rad, measured speed rad/s, measured string torque N m (torque sub)
+# hook:         bit depth m, rate of penetration m/s, measured hook load N (load cell)
+# wob_estimate: bit depth m, rate of penetration m/s, applied WOB estimate N
+#               (submerged string weight - measured hook load)
 
 # /drill/telemetry carries one row of the model's telemetry record per sample, and its
 # layout.dim[0].label lists TELEMETRY_FIELDS (drill_sim_ros.model.telemetry).
+
+# What each topic carries, with its unit: the topic table of docs/sim_node.md is generated
+# from MSG_TYPES, this, JOINTS and JOINT_FIELDS (`make docs`); a topic or joint without a
+# description fails that test.
+DESCRIPTIONS: dict[str, str] = {
+    BIT_WOB: "weight on bit, N",
+    BIT_TOB: "torque on bit, N m",
+    BIT_ROP: "rate of penetration, m/s",
+    BIT_RPM: "bit speed, rev/min",
+    BIT_DEPTH_OF_CUT: "depth of cut per revolution, m (negative: bit above the rock)",
+    BIT_MODE: "0 cutting, 1 lost_contact, 2 stuck, 3 off_bottom",
+    BIT_JOINT_STATES: "the bit, true values",
+    SURFACE_JOINT_STATES: "the surface, true values",
+    SURFACE_MEASURED: "what the rig's sensors give (`sensors.*`); the only topic a "
+                      "controller should read",
+    TELEMETRY: "one record per sample, fields `TELEMETRY_FIELDS` (SI)",
+    DIAGNOSTICS: "two statuses, 1 Hz of wall time",
+    CLOCK: "simulated time (when `publish_clock`)",
+    RUN_INFO: "JSON of what runs (preset, groups, scales, sampling), once",
+    CMD_SURFACE_RPM: "top-drive speed setpoint, rev/min",
+    CMD_WOB: "applied WOB setpoint, N",
+    CMD_TOP_DRIVE: "the controller's command; `header.stamp` = the stamp of the sample it "
+                   "answers; NaN or a missing entry commands nothing",
+}
+
+# The joints of each JointState topic, in order.
+JOINTS: dict[str, tuple[str, ...]] = {
+    BIT_JOINT_STATES: BIT_JOINTS,
+    SURFACE_JOINT_STATES: SURFACE_JOINTS,
+    SURFACE_MEASURED: MEASURED_JOINTS,
+    CMD_TOP_DRIVE: COMMAND_JOINTS,
+}
+
+# What position, velocity and effort of each joint mean, per topic ("-": unused).
+JOINT_FIELDS: dict[str, dict[str, tuple[str, str, str]]] = {
+    BIT_JOINT_STATES: {
+        "bit_rotation": ("angle rad", "speed rad/s", "TOB N m"),
+        "bit_axial": ("depth m (down positive)", "ROP m/s", "WOB N"),
+    },
+    SURFACE_JOINT_STATES: {
+        "top_drive": ("angle rad", "speed rad/s", "surface (pipe) torque N m"),
+        "hook": ("bit depth m", "ROP m/s", "applied WOB N"),
+    },
+    SURFACE_MEASURED: {
+        "top_drive": ("angle rad", "encoder speed rad/s", "motor torque N m"),
+        "quill": ("angle rad", "speed rad/s", "string torque N m (torque sub)"),
+        "hook": ("-", "-", "measured hook load N"),
+        "wob_estimate": ("-", "-", "applied WOB estimate N (submerged weight - hook load)"),
+    },
+    CMD_TOP_DRIVE: {
+        "top_drive": ("-", "speed setpoint rad/s (kinematic, speed modes)",
+                      "motor torque N m (torque mode)"),
+        "hook": ("-", "-", "applied WOB N"),
+    },
+}

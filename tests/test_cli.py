@@ -43,7 +43,7 @@ def test_run_json_fig8(beta: str, sticks: bool, tmp_path: Path) -> None:
 
 
 def test_physical_preset_reports_si(tmp_path: Path) -> None:
-    result = drill_sim("run", "--params", "field_8p5in_shale", "--t-end", "5", "--json")
+    result = drill_sim("run", "--params", "field_8p5in_shale_lumped", "--t-end", "5", "--json")
     assert result.returncode == 0, result.stderr
     si = json.loads(result.stdout)["si"]
     assert si["t_star_s"] > 0 and si["mean_wob_n"] > 0
@@ -74,11 +74,11 @@ def test_info_and_presets() -> None:
     info = drill_sim("info", "fig5_8a")
     assert info.returncode == 0 and "critical delay" in info.stdout
     listing = drill_sim("presets")
-    assert "field_8p5in_shale" in listing.stdout and "fig10" in listing.stdout
+    assert "field_8p5in_shale_lumped" in listing.stdout and "fig10" in listing.stdout
 
 
 def test_top_drive_options_and_the_field_preset_drive() -> None:
-    field = json.loads(drill_sim("run", "--params", "field_8p5in_shale", "--t-end", "2",
+    field = json.loads(drill_sim("run", "--params", "field_8p5in_shale_lumped", "--t-end", "2",
                                  "--json").stdout)
     assert field["top_drive"]["mode"] == "speed"               # the field preset's default
     paper = json.loads(drill_sim("run", "--params", "fig5_8a", "--tau-end", "2",

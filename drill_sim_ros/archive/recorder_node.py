@@ -3,7 +3,8 @@
     mcap_recorder -o FILE.mcap [--topics REGEX] [--compression zstd|none]
                   [--split-size MB | --split-duration S]
 
-Topics matching REGEX (default: every /drill/... topic, /diagnostics and /clock) are found by
+Topics matching REGEX (default: every drill/... topic of the recorder's namespace, so
+``-r __ns:=/rig1`` records /rig1/drill/..., plus /diagnostics and /clock) are found by
 discovery as they appear. Each is subscribed with raw=True, so the serialized CDR bytes go to
 the file unchanged, with a QoS compatible with what its publishers offer; the offered profiles
 are stored in the channel metadata. SIGINT, SIGTERM or SIGHUP finishes the file with its
@@ -18,8 +19,10 @@ import logging
 import re
 import sys
 from collections.abc import Callable
+from typing import Any
 
 import rclpy
+from rclpy.clock import Clock, ClockType
 from rclpy.executors import ExternalShutdownException
 from rclpy.impl.implementation_singleton import rclpy_implementation
 from rclpy.node import Node
@@ -36,22 +39,34 @@ from drill_sim_ros.terminal import StatusLine
 _log = logging.getLogger(__name__)
 
 RCLError = rclpy_implementation.RCLError
-DEFAULT_TOPICS = r"/drill/.*|/diagnostics|/clock"
+DEFAULT_TOPICS = r"/drill/.*|/diagnostics|/clock"    # of the root namespace
 DISCOVERY_PERIOD_S = 0.5
 STATUS_PERIOD_S = 0.5
+
+
+def default_topics(namespace: str) -> str:
+    """The sim's topics under ``namespace`` (``/rig1``: ``/rig1/drill/.*``), /diagnostics and
+    /clock, as a regex."""
+    prefix = re.escape(namespace.rstrip("/"))
+    return rf"{prefix}/drill/.*|/diagnostics|/clock"
 
 
 class McapRecorder(Node):
     """Subscribes to matching topics as they appear and queues their raw bytes to ``sink``."""
 
-    def __init__(self, sink: BackgroundWriter, topics_regex: str = DEFAULT_TOPICS) -> None:
-        super().__init__("mcap_recorder")
+    def __init__(self, sink: BackgroundWriter, topics_regex: str | None = None,
+                 **node_kwargs: Any) -> None:
+        super().__init__("mcap_recorder", **node_kwargs)
         self._sink = sink
-        self._pattern = re.compile(topics_regex)
+        self._pattern = re.compile(topics_regex or default_topics(self.get_namespace()))
         self._recorded: dict[str, object] = {}
         self._skipped: set[str] = set()
-        self._discovery = self.create_timer(DISCOVERY_PERIOD_S, self.discover)
-        self._health = self.create_timer(DISCOVERY_PERIOD_S, self._stop_if_failed)
+        # steady: discovery goes on while a sim's /clock (use_sim_time) stands still
+        self.steady = Clock(clock_type=ClockType.STEADY_TIME)
+        self._discovery = self.create_timer(DISCOVERY_PERIOD_S, self.discover,
+                                            clock=self.steady)
+        self._health = self.create_timer(DISCOVERY_PERIOD_S, self._stop_if_failed,
+                                         clock=self.steady)
 
     def _stop_if_failed(self) -> None:
         """A recorder that cannot write stops (the writer thread has said why)."""
@@ -99,8 +114,9 @@ class McapRecorder(Node):
 def _parse(argv: list[str]) -> argparse.Namespace:
     parser = argparse.ArgumentParser(prog="mcap_recorder", description=__doc__.splitlines()[0])
     parser.add_argument("-o", "--output", required=True, help="output .mcap file")
-    parser.add_argument("--topics", default=DEFAULT_TOPICS,
-                        help=f"regex that topic names must match (default: {DEFAULT_TOPICS})")
+    parser.add_argument("--topics", default=None,
+                        help=f"regex that topic names must match (default: {DEFAULT_TOPICS}, "
+                             "under the node's namespace)")
     parser.add_argument("--compression", choices=("zstd", "none"), default="zstd")
     parser.add_argument("--overwrite", action="store_true",
                         help="replace an existing output file (default: refuse)")
@@ -113,7 +129,7 @@ def _parse(argv: list[str]) -> argparse.Namespace:
     if (args.split_size or 1) <= 0 or (args.split_duration or 1) <= 0:
         parser.error("split limits must be positive")
     try:
-        re.compile(args.topics)
+        re.compile(args.topics or DEFAULT_TOPICS)
     except re.error as exc:
         parser.error(f"bad --topics regex: {exc}")
     return args
@@ -134,7 +150,8 @@ def _status_text(files: RotatingWriter, sink: BackgroundWriter, node: McapRecord
 def _spin(node: McapRecorder, files: RotatingWriter, sink: BackgroundWriter) -> None:
     status = StatusLine()
     if status.active:
-        node.create_timer(STATUS_PERIOD_S, lambda: status.show(_status_text(files, sink, node)))
+        node.create_timer(STATUS_PERIOD_S, lambda: status.show(_status_text(files, sink, node)),
+                          clock=node.steady)
     try:
         rclpy.spin(node)
     except (KeyboardInterrupt, ExternalShutdownException):

@@ -4,11 +4,15 @@
 
 Messages are sent as the stored CDR bytes (``publisher.publish(bytes)``: no decode, no
 re-encode) on publishers of the recorded types and offered QoS, spaced by their log times
-divided by R. ``--clock`` publishes /clock (rosgraph_msgs/Clock) from the log time, so nodes
-with use_sim_time follow the replay. A missing or non-MCAP file is an error (exit 2); of a
-damaged or cut file, every intact chunk is replayed, with a warning naming what was skipped
-(exit 1). A file with no ROS 2 channel or a ``--start-offset`` past its end is refused (exit 2);
-a replay that sent nothing exits 1. SIGINT, SIGTERM and SIGHUP stop it alike.
+divided by R. ``--clock`` publishes one /clock (rosgraph_msgs/Clock), so nodes with
+use_sim_time follow the replay: the log time moved onto the recorded stamps' base (the first
+recorded /clock, else the first header stamp, minus its log time), never going back within a
+pass; the recorded /clock channel is then not replayed.
+
+A missing or non-MCAP file is an error (exit 2); of a damaged or cut file, every intact chunk
+is replayed, with a warning naming what was skipped (exit 1). A file with no ROS 2 channel or
+a ``--start-offset`` past its end is refused (exit 2); a replay that sent nothing exits 1.
+SIGINT, SIGTERM and SIGHUP stop it alike.
 """
 
 from __future__ import annotations
@@ -27,22 +31,26 @@ from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.publisher import Publisher
 from rclpy.qos import QoSProfile
+from rclpy.serialization import deserialize_message
 from rclpy.utilities import remove_ros_args
 from rosgraph_msgs.msg import Clock
 
 from drill_sim_ros.archive.errors import ArchiveError
 from drill_sim_ros.archive.pacing import Pacer
 from drill_sim_ros.archive.qos import replay_qos
-from drill_sim_ros.archive.reader import ArchiveReader, RecordedChannel
+from drill_sim_ros.archive.reader import ArchiveReader, RecordedChannel, RecordedMessage
 from drill_sim_ros.archive.ros_types import message_class
 from drill_sim_ros.archive.signals import interrupt_on_hangup
 from drill_sim_ros.archive.writer import MESSAGE_ENCODING
+from drill_sim_ros.model.telemetry import NS_PER_S
 from drill_sim_ros.terminal import StatusLine
 
 _log = logging.getLogger(__name__)
 
 PROGRESS_PERIOD_S = 0.2
 CLOCK_TOPIC = "/clock"
+CLOCK_TYPE = "rosgraph_msgs/msg/Clock"
+BASE_SCAN_MESSAGES = 1000    # how far into the file the stamps' base is looked for
 
 
 @dataclass
@@ -87,16 +95,52 @@ def _plan_from_summary(reader: ArchiveReader, topics: re.Pattern[str]) -> Plan |
 DELIVERY_TIMEOUT_S = 2.0    # before exiting, let reliable subscribers receive the tail
 
 
+def recorded_stamp_ns(message: RecordedMessage) -> int | None:
+    """The time a message carries: a Clock's clock, else its header stamp (None: neither)."""
+    try:
+        decoded = deserialize_message(message.data, message_class(message.channel.type_name))
+    except Exception:      # an unknown type or bytes that do not decode carry no stamp
+        return None
+    stamped = getattr(decoded, "clock", None) or getattr(getattr(decoded, "header", None),
+                                                          "stamp", None)
+    return None if stamped is None else stamped.sec * NS_PER_S + stamped.nanosec
+
+
+def clock_offset_ns(reader: ArchiveReader, scan: int = BASE_SCAN_MESSAGES) -> int:
+    """Recorded stamp minus log time, from the first recorded /clock among the first ``scan``
+    messages, else the first stamped message; 0 (the log time itself) if none is stamped."""
+    first_header = None
+    for count, message in enumerate(reader.messages()):
+        if count >= scan:
+            break
+        is_clock = message.channel.type_name == CLOCK_TYPE
+        if not is_clock and first_header is not None:
+            continue
+        stamp_ns = recorded_stamp_ns(message)
+        if stamp_ns is None:
+            continue
+        if is_clock:
+            return stamp_ns - message.log_time_ns
+        first_header = stamp_ns - message.log_time_ns
+    return first_header or 0
+
+
 class Replayer:
     """Publishers for the recorded topics (plus /clock) on one node."""
 
-    def __init__(self, node: Node, channels: list[RecordedChannel], clock: bool) -> None:
+    def __init__(self, node: Node, channels: list[RecordedChannel], clock: bool,
+                 clock_offset_ns: int = 0) -> None:
         self.node = node
         self.publishers: dict[int, Publisher] = {}
         for channel in channels:
+            if clock and channel.topic == CLOCK_TOPIC:
+                _log.info("--clock: the recorded %s is not replayed (one clock)", CLOCK_TOPIC)
+                continue
             self._add(channel)
         qos = QoSProfile(depth=100)
         self.clock = node.create_publisher(Clock, CLOCK_TOPIC, qos) if clock else None
+        self.clock_offset_ns = clock_offset_ns
+        self.last_clock_ns: int | None = None
         self.sent = 0
 
     def _add(self, channel: RecordedChannel) -> None:
@@ -126,7 +170,13 @@ class Replayer:
         return all(p.wait_for_all_acked(deadline) for p in pubs)
 
     def publish_clock(self, log_time_ns: int) -> None:
-        sec, nanosec = divmod(log_time_ns, 1_000_000_000)
+        """/clock at ``log_time_ns`` on the stamps' base, unless that is not later than the
+        last one sent (a file out of log-time order does not turn the clock back)."""
+        clock_ns = log_time_ns + self.clock_offset_ns
+        if self.last_clock_ns is not None and clock_ns <= self.last_clock_ns:
+            return
+        self.last_clock_ns = clock_ns
+        sec, nanosec = divmod(clock_ns, NS_PER_S)
         self.clock.publish(Clock(clock=Time(sec=sec, nanosec=nanosec)))
 
 
@@ -158,16 +208,15 @@ def play_once(reader: ArchiveReader, replayer: Replayer, pacer: Pacer, options: 
     """Replay the file once; False if interrupted."""
     topics = re.compile(options.topics)
     start_ns = pacer.first_log_ns
-    last_clock_ns = None
+    replayer.last_clock_ns = None           # a --loop pass starts the clock over
     for message in reader.messages(topics.fullmatch):
         publisher = replayer.publishers.get(message.channel.channel_id)
         if publisher is None or message.log_time_ns < start_ns:
             continue
         if not pacer.wait_until(message.log_time_ns, rclpy.ok):
             return False
-        if replayer.clock is not None and message.log_time_ns != last_clock_ns:
+        if replayer.clock is not None:
             replayer.publish_clock(message.log_time_ns)
-            last_clock_ns = message.log_time_ns
         publisher.publish(message.data)
         replayer.sent += 1
         progress.update(message.log_time_ns, replayer.sent)
@@ -182,7 +231,9 @@ def _parse(argv: list[str]) -> argparse.Namespace:
     parser.add_argument("--start-offset", type=float, default=0.0, metavar="S",
                         help="skip the first S seconds of log time")
     parser.add_argument("--topics", default=".*", help="regex of topics to replay (default all)")
-    parser.add_argument("--clock", action="store_true", help="publish /clock from log time")
+    parser.add_argument("--clock", action="store_true",
+                        help="publish /clock from the log time on the recorded stamps' base "
+                             "(the recorded /clock is not replayed)")
     parser.add_argument("--delay", type=float, default=0.5, metavar="S",
                         help="wait S seconds after creating publishers (discovery)")
     parser.add_argument("--wait-for-subscribers", type=float, default=0.0, metavar="S",
@@ -199,7 +250,8 @@ def _parse(argv: list[str]) -> argparse.Namespace:
 
 def _replay(reader: ArchiveReader, extent: Plan, options: argparse.Namespace) -> int:
     node = Node("mcap_replay")
-    replayer = Replayer(node, extent.channels, options.clock)
+    offset_ns = clock_offset_ns(reader) if options.clock else 0
+    replayer = Replayer(node, extent.channels, options.clock, offset_ns)
     progress = Progress(extent, options.rate)
     try:
         if options.wait_for_subscribers > 0:

@@ -22,7 +22,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from drill_sim_ros.control.command import CommandLimits, apply_command, measurement_of_row
+from drill_sim_ros.control.command import (
+    Command,
+    CommandLimits,
+    SurfaceMeasurement,
+    apply_command,
+    measurement_of_row,
+)
 from drill_sim_ros.control.isolation import IsolatedController, build_isolated
 from drill_sim_ros.control.registry import make_controller
 from drill_sim_ros.control.rig import RigPhysics, rig_physics
@@ -74,7 +80,10 @@ def session_config(scenario: Scenario, preset: Preset) -> SessionConfig:
         n_nodes=preset.n_nodes or 2048, perturb_v=PERTURB_V,
         applied_wob_n=schedule.wob_at(0.0), surface_rpm=schedule.rpm_at(0.0),
         window_s=WINDOW_S, submerged_weight_n=submerged_string_weight_n(preset),
-        top_drive=drive_of(preset, scenario.mode), sensors=scenario.rig_sensors())
+        top_drive=drive_of(preset, scenario.mode), sensors=scenario.rig_sensors(),
+        top_drive_accel_rpm_s=float(scenario.drive.get("accel_rpm_s", 0.0)),
+        wob_rate_n_s=float(scenario.drive.get("wob_rate_n_s", 0.0)),
+        command_delay_s=float(scenario.drive.get("command_delay_s", 0.0)))
 
 
 def sim_node_parameters(scenario: Scenario, preset: Preset) -> dict[str, object]:
@@ -88,7 +97,17 @@ def sim_node_parameters(scenario: Scenario, preset: Preset) -> dict[str, object]
     for signal in SIGNALS:
         for key, value in (scenario.sensors.get(signal) or {}).items():
             out[f"sensors.{signal}.{key}"] = value
+    for key, name in DRIVE_PARAMETERS.items():
+        if key in scenario.drive:
+            out[name] = float(scenario.drive[key])
     return out
+
+
+# scenario drive keys -> sim_node parameters (motor_lag_s: not yet a parameter)
+DRIVE_PARAMETERS = {"accel_rpm_s": "limits.top_drive_accel_rpm_s",
+                    "wob_rate_n_s": "limits.wob_rate_n_s",
+                    "max_torque_nm": "top_drive.max_torque_nm",
+                    "command_delay_s": "commands.delay_s"}
 
 
 def build_controller(scenario: Scenario, preset: Preset) -> IsolatedController:
@@ -100,44 +119,81 @@ def build_controller(scenario: Scenario, preset: Preset) -> IsolatedController:
         **scenario.params), scenario.period_s)
 
 
+class Bench:
+    """The closed loop one control period at a time (module doc): :meth:`step` applies a
+    command with sim_node's limits, stamps it with the sample it reacts to and runs one
+    period. ``rows`` (periods + 1, N_FIELDS) fills as it goes, the t = 0 sample first; the
+    sample at the end of the last period is ``rows[period]``. One implementation behind
+    :func:`run_in_process` and the Gymnasium environment."""
+
+    def __init__(self, scenario: Scenario, preset: Preset | None = None) -> None:
+        scenario.check_supported()
+        self.scenario = scenario
+        self.preset = scenario.load_preset() if preset is None else preset
+        self.rig = rig_physics(self.preset)
+        self.schedule = scenario.setpoints(self.preset)
+        self.limits = command_limits(self.preset, self.rig)
+        self.session = SimSession(session_config(scenario, self.preset))
+        self.periods = scenario.periods
+        self.rows = np.empty((self.periods + 1, N_FIELDS))
+        self.rows[0] = self.session.current().rows[0]
+        self.period = 0
+        self.stamp_ns = 0            # stamp of the newest sample (what a command reacts to)
+
+    @property
+    def done(self) -> bool:
+        return self.period >= self.periods
+
+    @property
+    def row(self) -> np.ndarray:
+        """The newest sample (SI, TELEMETRY_FIELDS)."""
+        return self.rows[self.period]
+
+    def measurement(self) -> SurfaceMeasurement:
+        """What the rig's surface sensors give in the newest sample."""
+        return measurement_of_row(self.rows[self.period], self.stamp_ns)
+
+    def step(self, command: Command) -> np.ndarray:
+        """Apply ``command`` (ParameterError if not finite) and run one period under it;
+        the sample at its end. Raises ``NumericalFault``."""
+        if self.done:
+            raise ParameterError(f"the scenario's {self.periods} periods are done")
+        for applied, why in apply_command(self.session, command, self.limits):
+            if not applied:
+                raise ParameterError(f"the controller commanded {why}; commands must be finite")
+        self.session.command_stamp_ns = self.stamp_ns
+        block = self.session.run(1)
+        self.period += 1
+        self.rows[self.period] = block.rows[0]
+        self.stamp_ns = int(block.stamps_ns[0])
+        return self.rows[self.period]
+
+
 def run_in_process(scenario: Scenario,
                    progress: Callable[[int, int], None] | None = None,
                    snapshot_after: int | None = None) -> ClosedLoopRun:
     """Run ``scenario``: its telemetry, the t = 0 sample first (see the module doc); the
     kernel's accumulators at the end and, if ``snapshot_after`` is given, after that many
     periods (0: before the first)."""
-    preset = scenario.load_preset()
-    rig = rig_physics(preset)
-    controller = build_controller(scenario, preset)
-    limits = command_limits(preset, rig)
-    session = SimSession(session_config(scenario, preset))
-    periods = scenario.periods
-    rows = np.empty((periods + 1, N_FIELDS))
-    rows[0] = session.current().rows[0]
+    bench = Bench(scenario)
+    controller = build_controller(scenario, bench.preset)
+    sim = bench.session.sim
     start = time.perf_counter()
-    command, stamp_ns = controller.update(None), 0
-    snapshot = session.sim.accumulators if snapshot_after == 0 else None
-    done, interrupted = 0, False
+    command = controller.update(None)
+    snapshot = sim.accumulators if snapshot_after == 0 else None
+    interrupted = False
     try:
-        for i in range(periods):
-            for applied, why in apply_command(session, command, limits):
-                if not applied:
-                    raise ParameterError(f"the controller commanded {why}; commands must be "
-                                         "finite")
-            session.command_stamp_ns = stamp_ns
-            block = session.run(1)
-            rows[i + 1] = block.rows[0]
-            done = i + 1
-            stamp_ns = int(block.stamps_ns[0])
+        for i in range(bench.periods):
+            bench.step(command)
             if snapshot_after == i + 1:
-                snapshot = session.sim.accumulators
-            if i + 1 < periods:
-                command = controller.update(measurement_of_row(block.rows[0], stamp_ns))
+                snapshot = sim.accumulators
+            if not bench.done:
+                command = controller.update(bench.measurement())
             if progress is not None and (i + 1) % 1000 == 0:
-                progress(i + 1, periods)
+                progress(i + 1, bench.periods)
     except KeyboardInterrupt:
         interrupted = True
     wall_s = time.perf_counter() - start
-    return ClosedLoopRun(scenario, rows[:done + 1], wall_s,
-                         int(getattr(controller, "clamped_commands", 0)),
-                         session.sim.accumulators, snapshot, interrupted)
+    return ClosedLoopRun(scenario, bench.rows[:bench.period + 1], wall_s,
+                         int(getattr(controller, "clamped_commands", 0)), sim.accumulators,
+                         snapshot, interrupted)

@@ -19,7 +19,7 @@ from drill_sim_ros.control.bench import ClosedLoopRun, run_in_process
 from drill_sim_ros.control.controllers import CONTROL_MODES
 from drill_sim_ros.control.rig import rig_physics
 from drill_sim_ros.control.scenario import Scenario, load_scenario
-from drill_sim_ros.control.scorecard import SCORE_FIELDS, score
+from drill_sim_ros.control.scorecard import SCORE_FIELDS, score, status_text
 from drill_sim_ros.model.errors import DrillSimError
 from drill_sim_ros.model.presets import Preset
 from drill_sim_ros.terminal import StatusLine
@@ -32,7 +32,8 @@ LABELS = {"ssi_before_mean": "SSI before switch-on (mean)", "ssi_mean": "SSI aft
           "rop_m_h": "mean ROP [m/h]", "mse_mpa": "MSE at the bit [MPa]",
           "quill_torque_peak_nm": "quill torque peak [N m]",
           "quill_torque_rms_nm": "quill torque RMS [N m]",
-          "motor_energy_mj": "motor energy [MJ]", "saturation_count": "saturated samples"}
+          "motor_energy_mj": "motor energy [MJ]", "saturation_count": "saturated samples",
+          "status": "status", "stall_time_s": "stalled at [s]"}
 
 
 def add_parser(sub: Any) -> None:
@@ -51,9 +52,10 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
                    help="a controller parameter, e.g. --set damping_ratio=0.3 (repeatable)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
-    p.add_argument("--plot", type=Path, help="PNG (or .svg, .pdf) of bit rpm and quill "
-                   "torque against time, beside the uncontrolled run; an existing file is "
-                   "kept unless --overwrite")
+    p.add_argument("--plot", type=Path, help="PNG of speeds with the setpoint, quill and "
+                   "motor torque with its limit, WOB; stuck and saturated spans shaded; "
+                   "beside the uncontrolled run; also .svg or .pdf; an existing file is kept "
+                   "unless --overwrite")
     p.add_argument("--overwrite", action="store_true", help="replace an existing --plot file")
     p.add_argument("--no-baseline", action="store_true", help="skip the uncontrolled run "
                    "(by default it runs too, for the comparison)")
@@ -97,7 +99,7 @@ def _table(columns: dict[str, dict[str, Any]]) -> str:
     def cell(value: Any) -> str:
         if value is None:
             return "-"
-        if isinstance(value, int):
+        if isinstance(value, (int, str)):
             return str(value)
         return f"{value:.4g}" if math.isfinite(value) else "-"
     names = list(columns)
@@ -174,10 +176,15 @@ def _closed_loop(args: argparse.Namespace, scenario: Scenario, preset: Preset,
               f"{'over DDS' if args.ros else 'in process'}: {rate:,.0f} periods/s "
               f"({rate * scenario.period_s:,.0f}x real time)")
     if plot_tmp is not None:
-        from drill_sim_ros.control.plot import plot_runs
-        plot_runs(plot_tmp, controlled.rows, None if baseline is None else baseline.rows,
-                  scenario.enable_at_s, f"{preset.name}: {label}, switched on at "
-                  f"{scenario.enable_at_s:g} s")
+        from drill_sim_ros.control.plot import PlotContext, PlotRun, plot_runs, schedule_events
+        runs = [PlotRun(name, rows, speed_mode, status_text(columns[name]))
+                for name, rows, speed_mode in (
+                    ("no control", None if baseline is None else baseline.rows, True),
+                    (label, controlled.rows, scenario.mode == "speed")) if rows is not None]
+        plot_runs(plot_tmp, runs, PlotContext(
+            f"{preset.name}: {label}, switched on at {scenario.enable_at_s:g} s", schedule,
+            scenario.enable_at_s, rig.max_torque_nm, rig.max_surface_rpm,
+            schedule_events(schedule)))
         try:
             commit(plot_tmp, args.plot, args.overwrite)
         except OutputError as exc:

@@ -1,7 +1,8 @@
 """What a top-drive controller reads and what it commands (SI, ROS-free).
 
 A controller sees only what a rig measures at the surface (:class:`SurfaceMeasurement`: the
-drive's encoder, its motor torque and the torque sub at the quill, ``model.measurement``) and
+drive's encoder, its motor torque, the torque sub at the quill and the hook load with the
+applied-WOB estimate from it, ``model.measurement``) and
 answers with a :class:`Command`, the content of one ``drill/cmd/top_drive`` message.
 """
 
@@ -37,6 +38,8 @@ class SurfaceMeasurement:
     drive_speed_rad_s: float     # encoder
     motor_torque_nm: float       # the drive's own torque estimate
     string_torque_nm: float      # torque sub at the quill
+    hook_load_n: float = math.nan              # deadline load cell
+    applied_wob_estimate_n: float = math.nan   # submerged string weight - hook load
 
 
 def measurement_of_row(row: np.ndarray, time_ns: int) -> SurfaceMeasurement:
@@ -45,7 +48,9 @@ def measurement_of_row(row: np.ndarray, time_ns: int) -> SurfaceMeasurement:
     return SurfaceMeasurement(time_s=time_ns / 1e9,
                               drive_speed_rad_s=float(row[F["drive_speed_measured_rad_s"]]),
                               motor_torque_nm=float(row[F["motor_torque_measured_nm"]]),
-                              string_torque_nm=float(row[F["string_torque_measured_nm"]]))
+                              string_torque_nm=float(row[F["string_torque_measured_nm"]]),
+                              hook_load_n=float(row[F["hook_load_measured_n"]]),
+                              applied_wob_estimate_n=float(row[F["applied_wob_estimate_n"]]))
 
 
 @dataclass(frozen=True)

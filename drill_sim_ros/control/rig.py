@@ -2,10 +2,12 @@
 
 From a physical preset (RGD07 eq. 1 and the top drive of ``model.top_drive``):
 
-* C, the torsional stiffness of the drill pipe, G J_p / L (N m/rad);
+* C, the torsional stiffness of the drill pipe, G J_p / L (N m/rad) (of a distributed
+  string: its lumped equivalent, string.lumped_equivalent);
 * I, the lumped inertia of eq. 1: BHA + a third of the pipe (kg m^2);
 * J, the top drive's inertia referred to the quill (kg m^2);
-* Z = J_p sqrt(G rho), the torsional characteristic impedance of the drill pipe (N m s/rad):
+* Z = J_p sqrt(G rho), the torsional characteristic impedance of the drill pipe (of a
+  distributed string: of its top section, the one the drive meets) (N m s/rad):
   the torque a torsional wave carries per unit of angular speed, so a top end that turns at
   -T/Z absorbs an arriving wave without reflection (the principle of the impedance-matching
   soft-torque systems, Dwars 2015, SPE/IADC-173037-MS);
@@ -52,11 +54,15 @@ def rig_physics(preset: Preset) -> RigPhysics:
     if phys is None:
         raise ParameterError(f"preset '{preset.name}' is dimensionless; the controllers are "
                              "tuned in SI and need a physical preset (e.g. field_8p5in_shale)")
-    s = structure(phys)
-    pipe_polar_m4 = 0.5 * math.pi * (phys.pipe_outer_radius_m**4 - phys.pipe_inner_radius_m**4)
+    s = structure(phys, preset.string)
+    if preset.string.sections:                  # Z of the top section: what the drive meets
+        impedance = preset.string.sections[0].torsional_impedance_nm_s
+    else:
+        pipe_polar_m4 = 0.5 * math.pi * (phys.pipe_outer_radius_m**4
+                                         - phys.pipe_inner_radius_m**4)
+        impedance = pipe_polar_m4 * math.sqrt(phys.shear_modulus_pa * phys.density_kg_m3)
     drive = preset.top_drive.physical(preset.scales)
     return RigPhysics(
         stiffness_nm_rad=s.stiffness_nm_per_rad, bit_inertia_kg_m2=s.inertia_kg_m2,
-        drive_inertia_kg_m2=drive.inertia_kg_m2,
-        impedance_nm_s=pipe_polar_m4 * math.sqrt(phys.shear_modulus_pa * phys.density_kg_m3),
+        drive_inertia_kg_m2=drive.inertia_kg_m2, impedance_nm_s=impedance,
         max_torque_nm=drive.max_torque_nm, bit_area_m2=math.pi * phys.bit_radius_m**2)

@@ -17,6 +17,23 @@ does not give it)::
     sensors:                      # model.measurement: per signal noise_std, quantum,
       seed: 0                     # delay_periods; the noise seed
       string_torque_nm: {noise_std: 50.0}
+    description: a short text     # shown in the suite's report
+    overrides:                    # changes to the preset's own sections (in process only)
+      physical: {pipe_length_m: 4000.0}
+    drive:                        # the drive and the command path (sim_node's parameters)
+      accel_rpm_s: 10             # speed ramp limit, rev/min per s (limits.top_drive_accel_rpm_s)
+      wob_rate_n_s: 2000          # applied-WOB rate limit, N/s (limits.wob_rate_n_s)
+      max_torque_nm: 20000        # motor torque limit, N m (top_drive.max_torque_nm)
+      command_delay_s: 0.004      # command transport delay, s, also < a period
+                                  # (commands.delay_s)
+      motor_lag_s: 0.05           # first-order motor torque lag: NOT YET SUPPORTED
+    formation:                    # rock layers by depth: NOT YET SUPPORTED (model core)
+      - {top_m: 0.0, intrinsic_specific_energy_pa: 230e6}
+    needs: [distributed_string]   # model features the scenario needs (see MODEL_FEATURES)
+
+A scenario that uses a feature the model core does not have yet (``formation``,
+``drive.motor_lag_s``, a ``needs`` entry not in :data:`MODEL_FEATURES`) parses, lists it in
+:meth:`Scenario.unsupported`, and refuses to run with one line naming it.
 """
 
 from __future__ import annotations
@@ -32,11 +49,23 @@ from drill_sim_ros.control.scenario_check import check_scenario_mapping, check_s
 from drill_sim_ros.control.schedule import Schedule, schedule_from_list
 from drill_sim_ros.model.errors import ParameterError
 from drill_sim_ros.model.measurement import SIGNALS, RigSensors, SignalSpec
-from drill_sim_ros.model.presets import DEFAULT_PRESET, Preset
-from drill_sim_ros.model.validate_input import load_checked_preset
+from drill_sim_ros.model.presets import (
+    DEFAULT_PRESET,
+    Preset,
+    config_dirs,
+    preset_from_dict,
+    preset_path,
+)
+from drill_sim_ros.model.validate_input import check_preset_mapping, load_checked_preset
 
 SCENARIO_KEYS = ("preset", "duration_s", "control_rate_hz", "mode", "controller", "params",
-                 "enable_at_s", "schedule", "sensors")
+                 "enable_at_s", "schedule", "sensors", "description", "overrides", "drive",
+                 "formation", "needs")
+DRIVE_KEYS = ("accel_rpm_s", "wob_rate_n_s", "max_torque_nm", "command_delay_s",
+              "motor_lag_s")
+# what this model core can run beyond the keys above; the lead's kernel adds the others
+MODEL_FEATURES: frozenset[str] = frozenset()
+FEATURES = ("formation_layers", "motor_lag", "distributed_string")
 
 
 @dataclass(frozen=True)
@@ -52,6 +81,11 @@ class Scenario:
     enable_at_s: float = 60.0
     schedule: tuple[dict[str, Any], ...] = ()
     sensors: dict[str, Any] = field(default_factory=dict)
+    description: str = ""
+    overrides: dict[str, Any] = field(default_factory=dict)
+    drive: dict[str, float] = field(default_factory=dict)
+    formation: tuple[dict[str, Any], ...] = ()
+    needs: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         for name, low in (("duration_s", 0.0), ("control_rate_hz", 0.0)):
@@ -66,6 +100,31 @@ class Scenario:
             raise ParameterError(f"scenario: 'mode' = {self.mode!r} must be speed or torque")
         if not isinstance(self.params, dict):
             raise ParameterError(f"scenario: 'params' must be a mapping, got {self.params!r}")
+        _check_drive(self.drive)
+        for need in self.needs:
+            if need not in FEATURES:
+                raise ParameterError(f"scenario: needs {need!r} is not one of {list(FEATURES)}")
+        if not isinstance(self.overrides, dict) or not all(
+                isinstance(v, dict) for v in self.overrides.values()):
+            raise ParameterError("scenario: 'overrides' maps preset sections (physical, "
+                                 "top_drive, numerics) to mappings of their keys")
+
+    def unsupported(self) -> list[str]:
+        """The model features this scenario needs that the model core does not have."""
+        wanted = set(self.needs)
+        if self.formation:
+            wanted.add("formation_layers")
+        if self.drive.get("motor_lag_s"):
+            wanted.add("motor_lag")
+        return sorted(wanted - MODEL_FEATURES)
+
+    def check_supported(self) -> None:
+        """ParameterError naming what the model core cannot run yet."""
+        missing = self.unsupported()
+        if missing:
+            raise ParameterError(f"scenario needs {', '.join(missing)}: not yet supported by "
+                                 "this model core (issue 23: the model core's formation layers "
+                                 "and motor lag, issue 21: the distributed string)")
 
     def with_(self, **changes: Any) -> Scenario:
         return replace(self, **{k: v for k, v in changes.items() if v is not None})
@@ -79,7 +138,25 @@ class Scenario:
         return 1.0 / self.control_rate_hz
 
     def load_preset(self) -> Preset:
-        return load_checked_preset(self.preset)
+        """The preset with the scenario's ``overrides`` and ``drive.max_torque_nm``."""
+        overrides = {section: dict(values) for section, values in self.overrides.items()}
+        if "max_torque_nm" in self.drive:
+            overrides.setdefault("top_drive", {})["max_torque_nm"] = self.drive["max_torque_nm"]
+        if not overrides:
+            return load_checked_preset(self.preset)
+        path = preset_path(self.preset)
+        data = yaml.safe_load(path.read_text()) or {}
+        for section, values in overrides.items():
+            if not isinstance(data.get(section, {}), dict):
+                raise ParameterError(f"scenario: overrides.{section}: the preset's {section} "
+                                     "is not a mapping")
+            data[section] = {**(data.get(section) or {}), **values}
+        try:
+            check_preset_mapping(data)
+            return preset_from_dict(path.stem, data)
+        except (ParameterError, TypeError) as exc:
+            raise ParameterError(f"scenario: overrides of preset {self.preset!r}: {exc}"
+                                 ) from exc
 
     def setpoints(self, preset: Preset) -> Schedule:
         """The schedule, starting from the preset's rpm and WOB where it does not say."""
@@ -104,7 +181,25 @@ class Scenario:
                 "control_rate_hz": self.control_rate_hz, "mode": self.mode,
                 "controller": self.controller, "params": dict(self.params),
                 "enable_at_s": self.enable_at_s, "schedule": [dict(p) for p in self.schedule],
-                "sensors": dict(self.sensors)}
+                "sensors": dict(self.sensors), "description": self.description,
+                "overrides": {k: dict(v) for k, v in self.overrides.items()},
+                "drive": dict(self.drive), "formation": [dict(x) for x in self.formation],
+                "needs": list(self.needs)}
+
+
+def _check_drive(drive: Any) -> None:
+    if not isinstance(drive, dict):
+        raise ParameterError(f"scenario: 'drive' must be a mapping of {list(DRIVE_KEYS)}")
+    for key, value in drive.items():
+        if key not in DRIVE_KEYS:
+            raise ParameterError(f"scenario: drive.{key} is not one of {list(DRIVE_KEYS)}")
+        delay = key in ("command_delay_s", "motor_lag_s")
+        number = not isinstance(value, bool) and isinstance(value, (int, float)) and \
+            math.isfinite(value)
+        if not (number and (0.0 <= value <= 60.0 if delay else value > 0.0)):
+            allowed = "in [0, 60]" if delay else "> 0"
+            raise ParameterError(f"scenario: drive.{key} = {value!r} must be a number "
+                                 f"{allowed}")
 
 
 def scenario_from_dict(data: dict[str, Any]) -> Scenario:
@@ -114,7 +209,13 @@ def scenario_from_dict(data: dict[str, Any]) -> Scenario:
     unknown = sorted(set(data) - set(SCENARIO_KEYS))
     if unknown:
         raise ParameterError(f"scenario: unknown key(s) {unknown}; known: {list(SCENARIO_KEYS)}")
-    return Scenario(**check_scenario_mapping(data))
+    values = check_scenario_mapping(data)
+    for key in ("overrides", "drive"):
+        values[key] = dict(values.get(key) or {})
+    values["formation"] = tuple(values.get("formation") or ())
+    values["needs"] = tuple(values.get("needs") or ())
+    values["description"] = " ".join(str(values.get("description") or "").split())
+    return Scenario(**values)
 
 
 def load_scenario(path: str | Path) -> Scenario:
@@ -130,6 +231,28 @@ def load_scenario(path: str | Path) -> Scenario:
         return scenario_from_dict(data)
     except ParameterError as exc:
         raise ParameterError(f"{path}: {exc}") from exc
+
+
+def scenario_dir() -> Path:
+    """config/scenarios of the first config directory that has it."""
+    for base in config_dirs():
+        if (base / "scenarios").is_dir():
+            return base / "scenarios"
+    raise ParameterError("no config/scenarios directory found (set DRILL_SIM_CONFIG_DIR)")
+
+
+def scenario_path(name_or_path: str | Path) -> Path:
+    """A scenario by name (config/scenarios/<name>.yaml) or a YAML path; ParameterError
+    naming the known scenarios otherwise."""
+    path = Path(name_or_path)
+    if path.suffix in (".yaml", ".yml") and path.exists():
+        return path
+    path = scenario_dir() / f"{name_or_path}.yaml"
+    if not path.exists():
+        known = ", ".join(p.stem for p in sorted(scenario_dir().glob("*.yaml")))
+        raise ParameterError(f"scenario {str(name_or_path)!r}: no such file or scenario "
+                             f"(known: {known})")
+    return path
 
 
 def save_scenario(scenario: Scenario, path: str | Path) -> None:

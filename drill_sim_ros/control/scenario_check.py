@@ -100,6 +100,15 @@ def check_scenario_mapping(data: dict[str, Any]) -> dict[str, Any]:
     for key in _NUMBERS:
         if key in values:
             values[key] = check_number(key, values[key])
+    if not isinstance(values.get("description", ""), str):
+        raise ParameterError(f"scenario: 'description' = {values['description']!r} must be "
+                             "text")
+    for key in ("overrides", "drive"):
+        if not isinstance(values.get(key) or {}, dict):
+            raise ParameterError(f"scenario: '{key}' = {values[key]!r} must be a mapping")
+    for key in ("formation", "needs"):
+        if not isinstance(values.get(key) or [], list):
+            raise ParameterError(f"scenario: '{key}' = {values[key]!r} must be a list")
     values["params"] = check_params(values.get("params") or {})
     values["schedule"] = check_schedule(values.get("schedule") or [])
     values["sensors"] = check_sensors(values.get("sensors") or {})

@@ -26,7 +26,7 @@ class Change:
     ramp_s: float = 0.0
 
 
-def _level(start: float, changes: list[Change], t_s: float) -> float:
+def _level(start: float, changes: tuple[Change, ...], t_s: float) -> float:
     value = start
     for change in changes:
         if t_s < change.t_s:
@@ -47,10 +47,10 @@ class Schedule:
     wob_changes: tuple[Change, ...] = ()
 
     def rpm_at(self, t_s: float) -> float:
-        return _level(self.rpm0, list(self.rpm_changes), t_s)
+        return _level(self.rpm0, self.rpm_changes, t_s)
 
     def wob_at(self, t_s: float) -> float:
-        return _level(self.wob0_n, list(self.wob_changes), t_s)
+        return _level(self.wob0_n, self.wob_changes, t_s)
 
 
 def _number(point: dict[str, Any], key: str, low: float) -> float | None:

@@ -13,7 +13,11 @@ ROS-free; from telemetry rows (``TELEMETRY_FIELDS``, SI) of a run, after the swi
   <TOB omega_bit>/(A <ROP>), MPa);
 * peak and RMS string torque at the quill (N m), motor energy (the motor's work
   sum tau_m omega_drive P, MJ), saturation count (samples at the motor torque limit or with
-  the speed setpoint at 0 or at the rpm limit).
+  the speed setpoint at 0 or at the rpm limit);
+* status: ``stalled`` when the bit is stuck for good (stuck without a break for the last
+  ``STALL_S`` seconds or more of the run; ``stall_time_s`` is when that span began),
+  else ``stick-slip`` when the bit still sticks in the last 20 s, else ``ok``. (A run that
+  ends in a numerical fault has no rows to score: its runner reports ``fault``.)
 """
 
 from __future__ import annotations
@@ -32,9 +36,13 @@ from drill_sim_ros.model.telemetry import TELEMETRY_INDEX
 F = TELEMETRY_INDEX
 STUCK = 2
 WINDOW_S = 20.0
+STALL_S = 10.0            # stuck this long at the end of a run: stalled (a stick phase of
+                          # the field case's stick-slip lasts 2-4 s)
 SCORE_FIELDS = ("ssi_before_mean", "ssi_mean", "ssi_max", "ssi_last", "stick_fraction", "utr",
                 "time_to_suppress_s", "rop_m_h", "mse_mpa", "quill_torque_peak_nm",
-                "quill_torque_rms_nm", "motor_energy_mj", "saturation_count")
+                "quill_torque_rms_nm", "motor_energy_mj", "saturation_count", "status",
+                "stall_time_s")
+STATUSES = ("ok", "stick-slip", "stalled", "fault")
 
 
 def window_ssi(time_s: np.ndarray, bit_rpm: np.ndarray, start_s: float, end_s: float,
@@ -84,19 +92,36 @@ def score(rows: np.ndarray, enable_at_s: float, schedule: Schedule, rig: RigPhys
     setpoint = after[:, F["speed_setpoint_rpm"]]
     saturated = (np.abs(motor) >= rig.max_torque_nm * (1 - 1e-9)) | (setpoint <= 0.0) | \
         (setpoint >= rig.max_surface_rpm)
+    suppress_s = _time_to_suppress(ta, stuck, enable_at_s, end_s)
+    stall_s = stall_time_s(t, rows[:, F["mode"]] == STUCK)
+    status = "stalled" if stall_s is not None else "stick-slip" if suppress_s is None \
+        else "ok"
     return {
         "ssi_before_mean": _mean(before), "ssi_mean": _mean(ssi),
         "ssi_max": float(np.max(ssi)) if np.isfinite(ssi).all() else None,
         "ssi_last": float(ssi[-1]) if np.isfinite(ssi[-1]) else None,
         "stick_fraction": float(stuck.mean()), "utr": sev.utr,
-        "time_to_suppress_s": _time_to_suppress(ta, stuck, enable_at_s, end_s),
+        "time_to_suppress_s": suppress_s,
         "rop_m_h": float(rop.mean() * 3600.0),
         "mse_mpa": mse_pa * 1e-6 if math.isfinite(mse_pa) else None,
         "quill_torque_peak_nm": float(np.max(np.abs(quill))),
         "quill_torque_rms_nm": float(np.sqrt(np.mean(quill**2))),
         "motor_energy_mj": float(np.sum(motor * drive_rad_s) * period_s * 1e-6),
         "saturation_count": int(saturated.sum()),
+        "status": status, "stall_time_s": stall_s,
     }
+
+
+def stall_time_s(time_s: np.ndarray, stuck: np.ndarray, stall_s: float = STALL_S
+                 ) -> float | None:
+    """When the bit got stuck for good: the start of the stuck span that ends the run, if it
+    lasts ``stall_s`` or more; None otherwise."""
+    if not stuck.size or not stuck[-1]:
+        return None
+    moving = np.flatnonzero(~stuck)
+    first = int(moving[-1]) + 1 if moving.size else 0
+    start_s = float(time_s[first])
+    return start_s if float(time_s[-1]) - start_s >= stall_s else None
 
 
 def _time_to_suppress(t: np.ndarray, stuck: np.ndarray, enable_at_s: float,
@@ -105,3 +130,13 @@ def _time_to_suppress(t: np.ndarray, stuck: np.ndarray, enable_at_s: float,
         return 0.0
     last_s = float(t[stuck][-1])
     return None if last_s > end_s - WINDOW_S else last_s - enable_at_s
+
+
+def status_text(card: dict[str, Any]) -> str:
+    """``ok``, ``stick-slip``, ``stalled at 42.1 s``, ``fault at 3.20 s`` or as given."""
+    status = str(card.get("status", ""))
+    if status == "stalled":
+        return f"stalled at {card['stall_time_s']:.1f} s"
+    if status == "fault":
+        return f"fault at {card['fault_time_s']:.2f} s"
+    return status

@@ -1,37 +1,32 @@
-"""Compiled stepping of the RGD07 delay model (eqs. 25-33), in absolute variables.
+"""Compiled stepping of the RGD07 model (eqs. 25-33): a short loop over three seams.
 
 Richard, Germay & Detournay (2007), J. Sound Vib. 305, 432-456. Everything here is
 dimensionless (time unit t*, length unit L*, weight unit zeta*eps*a*L*, torque unit C).
 
-Absolute variables (so the surface inputs may change at any step):
+A step reads as three calls on one state:
 
-* ``U``  bit depth (down positive), ``V = dU/dtau`` (rate of penetration);
-* ``PHI`` bit angle, ``OMEGA = dPHI/dtau`` (never negative);
-* ``PHI_S`` top-drive angle, turning at ``OMEGA_S``; pipe torque = ``PHI_S - PHI``
-  (eq. 25 right: ``phi'' + phi = T0 - T`` with ``phi = PHI - PHI_0`` is
-  ``PHI'' = (PHI_S - PHI) - T``). The top drive (:mod:`drill_sim_ros.model.top_drive`)
-  either imposes ``OMEGA_S`` (kinematic, the paper's boundary condition) or is an inertia
-  ``j OMEGA_S' = m - (PHI_S - PHI)`` turned by a motor torque ``m`` (speed loop or torque
-  command), integrated with the bit by the same symplectic Euler step;
-* ``W_APP`` the applied weight (eq. 25 left: ``U'' = psi (W_APP - W)``).
+1. the bit-rock law (:mod:`drill_sim_ros.model.bit_rock`): the depth of cut from the delay
+   (eqs. 6-8, 26-28), then the forces and the bit's new velocities (eqs. 29-33), given the
+   string's bottom end in affine form;
+2. the top drive (:mod:`drill_sim_ros.model.top_drive`): its speed at the end of the step
+   against the string torque at the quill (kinematic, speed loop or torque mode);
+3. the string (:mod:`drill_sim_ros.model.string`): ``lumped`` is RGD07's spring C with the
+   BHA at the bit (eq. 25, symplectic Euler as eq. C.1 with the updated velocities);
+   ``distributed`` is a chain of wave-guide sections carrying torsional and axial waves,
+   moved on by one step between the drive's and the bit's new speeds.
 
-The depth of cut (eqs. 6-8, 26-28) is read from the bottom-hole profile: the height
-each angle of one blade sector (2 pi / n) was last cut to, stored on ``n_nodes`` nodes.
-A passing blade lowers the surface to the bit depth when the bit is deeper (max rule), so
-the rock is re-cut correctly after the bit has bounced off bottom. :func:`advance` with
-``exact=True`` is the reference path: it keeps the exact time history of (PHI, U) and
-solves eq. (7) for the delay by interpolation, as in RGD07 Appendix C.
+Absolute variables (so the surface inputs may change at any step): ``U`` bit depth (down
+positive), ``V = dU/dtau``; ``PHI`` bit angle, ``OMEGA = dPHI/dtau`` (never negative);
+``PHI_S`` top-drive angle turning at ``OMEGA_S``; ``W_APP`` the applied weight. In the lumped
+string the pipe torque is ``PHI_S - PHI`` (eq. 25 right, ``phi'' + phi = T0 - T`` with
+``phi = PHI - PHI_0`` is ``PHI'' = (PHI_S - PHI) - T``) and ``U'' = psi (W_APP - W)`` (eq. 25
+left). In the distributed string the hook holds the top axially, its speed set by a slow
+PI loop on the string force at the top (the applied-WOB estimate) so that W_APP sets the
+weight on bit in steady drilling.
 
-Integration is symplectic Euler (RGD07 eq. C.1 with the position update using the new
-velocity). The wearflat contact (eq. 31) is solved implicitly in the new axial velocity,
-which yields the set-valued force ``0 <= W_f <= lam`` at ``V = 0`` (eq. 31, last line)
-with no chattering. Stick (eq. 32) freezes the bit; the wearflat then carries what the
-cutting face does not, ``W_f = W_APP - delta_k`` bounded to ``[0, lam]`` (eq. 31 last line,
-eq. 25 left), so ``W = delta + W_f`` holds in every mode. Slip happens when the pipe torque
-reaches the cutting + friction torque (eqs. 14, 33), checked at every step so the
-top-drive speed may vary.
-
-Kernels never raise: they return a status code (``STATUS_*``).
+``advance`` with ``exact=True`` is the reference path of RGD07 Appendix C for the delay.
+Kernels never raise: they return a status code (``STATUS_*``); no loop in them is unbounded
+whatever the state (a step that would pass a whole blade sector is a runaway).
 """
 
 from __future__ import annotations
@@ -41,20 +36,21 @@ import math
 import numpy as np
 from numba import njit
 
-from drill_sim_ros.model.top_drive import (
-    TD_KINEMATIC,
-    TD_SPEED,
-    drive_acceleration,
-    kinematic_torque,
-    ramp,
-    speed_loop,
-    torque_command,
+from drill_sim_ros.model import bit_rock as br
+from drill_sim_ros.model import string as sg
+from drill_sim_ros.model.bit_rock import (  # noqa: F401  (the modes, re-exported)
+    MODE_CUTTING,
+    MODE_LOST_CONTACT,
+    MODE_NAMES,
+    MODE_OFF_BOTTOM,
+    MODE_STUCK,
 )
+from drill_sim_ros.model.top_drive import TD_KINEMATIC, drive_step, ramp
 
 # ---- parameter vector (float64) -------------------------------------------------------
 P_N = 0             # number of blades n
-P_BETA = 1          # beta = mu gamma zeta (eq. 10)
-P_LAM = 2           # bluntness lambda (eq. 24)
+P_BETA = 1          # beta = mu gamma zeta (eq. 10), of the rock being drilled
+P_LAM = 2           # bluntness lambda (eq. 24), of the rock being drilled
 P_PSI = 3           # system number psi (eq. 24)
 P_DT = 4            # time step dtau
 P_OMEGA_RATE = 5    # max |d OMEGA_S / dtau| (inf = instantaneous)
@@ -65,7 +61,18 @@ P_TD_INERTIA = 9    # drive inertia ratio j = J / I
 P_TD_KP = 10        # speed loop proportional gain, scaled kp_SI / (C t*)
 P_TD_KI = 11        # speed loop integral gain, scaled ki_SI / C
 P_TD_MAX_TORQUE = 12  # motor torque limit, scaled by C (inf: none)
-N_PARAMS = 13
+P_TD_LAG_ALPHA = 13  # motor torque lag per step, 1 - exp(-dtau / lag) (1: none)
+P_CUT = 14          # cutting-force factor eps / eps_ref of the rock being drilled (eq. 4)
+P_LAYER_U = 15      # bit depth U at which the next formation layer starts (inf: none)
+P_STRING = 16       # string model: string.STRING_LUMPED | STRING_DISTRIBUTED
+P_PARTS_T = 17      # distributed: parts of the torsional line (the axial ones follow)
+P_BIT_INERTIA = 18  # distributed: lumped inertia at the bit / I
+P_HOOK_KP = 19      # distributed: hook speed per unit force error (WOB loop, P)
+P_HOOK_KI = 20      # distributed: hook speed per unit force error x tau (WOB loop, I)
+P_OFF_BOTTOM = 21   # 1: the bit hangs free off bottom (T = W = 0), the hook fixed; 2: and
+                    # the torsional line ends without reflection (an anechoic bottom)
+P_BHA_PART = 22     # distributed: the part at whose top the BHA speed is read
+N_PARAMS = 23
 
 # ---- surface targets (float64) ----------------------------------------------------------
 I_OMEGA_S = 0       # commanded top-drive speed (kinematic and speed modes)
@@ -90,7 +97,9 @@ S_STEP = 12         # step counter
 S_OMEGA_REF = 13    # speed setpoint in force (the ramped I_OMEGA_S)
 S_TD_INTEGRAL = 14  # speed loop integral, torque units
 S_MOTOR_TORQUE = 15  # motor torque of the last step
-N_STATE = 16
+S_V_HOOK = 16       # distributed: hook speed (down positive)
+S_HOOK_INTEGRAL = 17  # distributed: the WOB loop's integral term (a speed)
+N_STATE = 18
 
 # ---- sample columns ---------------------------------------------------------------------
 C_TAU = 0
@@ -100,23 +109,18 @@ C_PHI = 3           # bit angle
 C_OMEGA = 4         # bit angular speed
 C_PHI_S = 5         # top-drive angle
 C_OMEGA_S = 6       # top-drive speed
-C_W_APP = 7         # applied weight
+C_W_APP = 7         # applied weight (the command, ramped)
 C_WOB = 8           # weight on bit W
 C_TOB = 9           # torque on bit T
 C_DOC = 10          # depth of cut delta (negative: clearance above the rock)
 C_WF = 11           # wearflat contact weight W_f
-C_T_PIPE = 12       # pipe (surface) torque PHI_S - PHI
+C_T_PIPE = 12       # string torque at the quill (lumped: PHI_S - PHI)
 C_MODE = 13
 C_MOTOR_TORQUE = 14  # top-drive motor torque over the step
 C_OMEGA_REF = 15    # top-drive speed setpoint in force
-N_COLS = 16
-
-# ---- interaction modes ------------------------------------------------------------------
-MODE_CUTTING = 0    # cutting with full wearflat contact
-MODE_LOST_CONTACT = 1  # cutting, wearflat contact partly or fully lost (V <= 0)
-MODE_STUCK = 2      # OMEGA = 0 (eq. 32)
-MODE_OFF_BOTTOM = 3  # delta < 0: bit above the rock, T = W = 0
-MODE_NAMES = ("cutting", "lost_contact", "stuck", "off_bottom")
+C_F_TOP = 16        # string force at the hook above its weight (applied WOB estimate)
+C_OMEGA_BHA = 17    # BHA speed (lumped: the bit's)
+N_COLS = 18
 
 # ---- statistics accumulators --------------------------------------------------------------
 A_COUNT = 0         # steps accumulated (tau >= P_TAU_AVG)
@@ -137,6 +141,8 @@ N_ACC = 13
 STATUS_OK = 0
 STATUS_NONFINITE = 1
 STATUS_HISTORY_FULL = 2
+STATUS_RUNAWAY = 3  # a step would pass a whole blade sector: the state ran away
+STATUS_LAYER = 4    # the bit reached P_LAYER_U: stopped after that step for the next layer
 
 
 def new_accumulators() -> np.ndarray:
@@ -149,67 +155,6 @@ def new_accumulators() -> np.ndarray:
     return acc
 
 
-@njit(cache=True, inline="always")
-def _wearflat_contact(v: float, w_app: float, doc: float, lam: float,
-                      kick: float) -> tuple[float, float]:
-    """Axial update with the contact law of eq. (31), implicit in the new velocity.
-
-    ``kick = psi * dtau``. Returns ``(v_new, w_f)`` with ``w_f = lam`` if ``v_new > 0``,
-    ``0`` if ``v_new < 0`` and ``v_new = 0, 0 <= w_f <= lam`` from the balance of linear
-    momentum otherwise (eq. 31, last line; eq. 25 left with W = delta + W_f, eq. 29).
-    """
-    v_free = v + kick * (w_app - doc)        # no wearflat force
-    if v_free < 0.0:
-        return v_free, 0.0                   # moving up: contact lost
-    v_full = v_free - kick * lam             # full wearflat force
-    if v_full > 0.0:
-        return v_full, lam                   # moving down: full contact
-    return 0.0, v_free / kick                # V = 0: set-valued contact force
-
-
-@njit(cache=True, inline="always")
-def _stuck_wearflat(w_app: float, doc: float, lam: float) -> float:
-    """Wearflat force while the bit sticks (eq. 31 last line, eq. 25 left with V = 0).
-
-    The bit is immobile, so the axial balance W = W_APP holds with W = delta_k + W_f
-    (eq. 29): the wearflat carries what the cutting face does not, within its contact law
-    ``0 <= W_f <= lam``.
-    """
-    return min(max(w_app - doc, 0.0), lam)
-
-
-@njit(cache=True, inline="always")
-def _bit_response(v: float, omega: float, t_pipe: float, w_app: float, doc: float,
-                  stuck: bool, beta: float, lam: float, kick: float,
-                  dt: float) -> tuple[float, float, float, float, float, int, bool]:
-    """Bit-rock forces and the new velocities (eqs. 25, 29-33).
-
-    Returns ``(v_new, omega_new, w_f, wob, tob, mode, stuck_new)``.
-    """
-    if stuck and doc >= 0.0 and t_pipe <= doc + beta * lam:
-        # Stick (eq. 32): the bit is immobile and the rock reacts the pipe torque and the
-        # applied weight, until the pipe torque exceeds the cutting + friction torque
-        # delta_k + beta lam (eqs. 14, 33 in the form valid for any top-drive speed).
-        # The wearflat is in full contact as the paper assumes and carries W_APP - delta_k
-        # (eq. 31, last line), so W = delta_k + W_f (eq. 29) and <U''> = 0 give eq. 44.
-        w_f = _stuck_wearflat(w_app, doc, lam)
-        return 0.0, 0.0, w_f, doc + w_f, t_pipe, MODE_STUCK, True
-    if doc >= 0.0:
-        v_new, w_f = _wearflat_contact(v, w_app, doc, lam, kick)
-        wob = doc + w_f                       # eq. (29): W = delta + W_f
-        tob = doc + beta * w_f                # eq. (30): T = delta + beta W_f
-        mode = MODE_CUTTING if w_f >= lam else MODE_LOST_CONTACT
-    else:
-        v_new = v + kick * w_app              # off bottom: T = W = 0, the bit falls
-        w_f, wob, tob, mode = 0.0, 0.0, 0.0, MODE_OFF_BOTTOM
-    omega_new = omega + (t_pipe - tob) * dt   # eq. (25) right, in absolute angles
-    if omega_new > 0.0:
-        return v_new, omega_new, w_f, wob, tob, mode, False
-    if doc >= 0.0:                            # eq. (32): the bit sticks on the rock
-        return 0.0, 0.0, w_f, wob, tob, mode, True
-    return v_new, 0.0, w_f, wob, tob, mode, False   # never backward rotation
-
-
 @njit(cache=True)
 def _first_countdown(step: int, every: int) -> int:
     """Steps until the next global step that is a multiple of ``every`` (-1: never)."""
@@ -218,214 +163,298 @@ def _first_countdown(step: int, every: int) -> int:
     return (every - step % every) % every
 
 
-@njit(cache=True)
-def _delayed_depth(hist_phi: np.ndarray, hist_u: np.ndarray, head: int, count: int,
-                   cursor: int, phi_target: float) -> tuple[float, int]:
-    """U at the latest time the bit angle was ``phi_target`` (eq. 7), by interpolation.
+@njit(cache=True, inline="always")
+def _accumulate(a: tuple, tau: float, tau_avg: float, mode: int, w_f: float, tob: float,
+                doc: float, wob: float, omega: float, t_pipe: float, v: float) -> tuple:
+    """The statistics (a tuple in ``A_*`` order) after one step: first stick and bounce
+    times always, the window sums for tau >= tau_avg."""
+    first_stick = tau if mode == MODE_STUCK and a[A_FIRST_STICK] != a[A_FIRST_STICK] \
+        else a[A_FIRST_STICK]
+    first_bounce = tau if mode == MODE_OFF_BOTTOM and a[A_FIRST_BOUNCE] != a[A_FIRST_BOUNCE] \
+        else a[A_FIRST_BOUNCE]
+    if tau < tau_avg:
+        return a[:A_FIRST_STICK] + (first_stick, first_bounce)  # noqa: RUF005 (numba)
+    return (a[A_COUNT] + 1.0, a[A_WF] + w_f, a[A_TOB] + tob, a[A_DOC] + doc,
+            a[A_WOB] + wob, a[A_OMEGA] + omega, a[A_T_PIPE] + t_pipe, a[A_V] + v,
+            min(a[A_OMEGA_MIN], omega), max(a[A_OMEGA_MAX], omega),
+            a[A_STUCK] + 1.0 if mode == MODE_STUCK else a[A_STUCK], first_stick, first_bounce)
 
-    History is a ring buffer (capacity = len(hist_phi)) of ``count`` samples ending at
-    ``head - 1``, with PHI increasing. ``cursor`` (an age-ordered index) only moves
-    forward because ``phi_target`` does. Returns ``(U, cursor)``.
-    """
-    cap = hist_phi.shape[0]
-    start = head - count
-    while cursor + 1 < count and hist_phi[(start + cursor + 1) % cap] <= phi_target:
-        cursor += 1
-    i0 = (start + cursor) % cap
-    if cursor + 1 >= count:
-        return hist_u[i0], cursor
-    i1 = (start + cursor + 1) % cap
-    w = (phi_target - hist_phi[i0]) / (hist_phi[i1] - hist_phi[i0])
-    return hist_u[i0] + w * (hist_u[i1] - hist_u[i0]), cursor
+
+@njit(cache=True, inline="always")
+def _lumped_ends(psi: float, dt: float, phi_s: float, phi: float, v: float, omega: float,
+                 w_app: float) -> tuple[float, ...]:
+    """What RGD07's lumped string (eq. 25) presents over this step: at the bit, the affine
+    forms of the bit law (bit_rock) ``v0, kick_v, f_ext, omega0, kick_w, t_ext``, with the
+    spring torque PHI_S - PHI and psi dtau on the applied weight; at the top, the string
+    torque at the quill and the force at the hook (the applied weight)."""
+    t_pipe = phi_s - phi                      # pipe torque C (PHI_S - PHI), scaled
+    return v, psi * dt, w_app, omega, dt, t_pipe, t_pipe, w_app
+
+
+@njit(cache=True, inline="always")
+def _distributed_ends(prm: np.ndarray, wave: np.ndarray, wave_i: np.ndarray,
+                      wave_f: np.ndarray, omega_s: float, v: float, omega: float,
+                      v_hook: float) -> tuple[float, ...]:
+    """The same for a distributed string (module string): the arriving waves and the end
+    impedances, with the bit's lumped inertia; at the top b + Z w with the drive's and the
+    hook's speeds."""
+    dt = prm[P_DT]
+    parts_t, parts = int(prm[P_PARTS_T]), wave_i.shape[1]
+    z = wave_f[sg.W_Z]
+    b_top_t, a_bot_t = sg.arriving(wave, wave_i, 0, parts_t)
+    b_top_a, a_bot_a = sg.arriving(wave, wave_i, parts_t, parts)
+    v0, kick_v, f_ext = sg.bottom_end(a_bot_a, z[parts - 1], 0.0, v, dt)
+    omega0, kick_w, t_ext = sg.bottom_end(a_bot_t, z[parts_t - 1], prm[P_BIT_INERTIA],
+                                          omega, dt)
+    return (v0, kick_v, f_ext, omega0, kick_w, t_ext, b_top_t + z[0] * omega_s,
+            b_top_a + z[parts_t] * v_hook)
+
+
+@njit(cache=True, inline="always")
+def _distributed_move(prm: np.ndarray, wave: np.ndarray, wave_i: np.ndarray,
+                      wave_f: np.ndarray, w_app: float, f_top: float, hook_int: float,
+                      omega_s_next: float, v_new: float, omega_new: float
+                      ) -> tuple[float, float]:
+    """The distributed string moves on by one step: both lines take what the drive, the
+    hook (its WOB loop on ``f_top``, :func:`_hook`) and the bit send into them
+    (a = b + 2 Z w at the top, b = a - 2 Z w at the bottom). Returns the hook's speed over
+    the step and its loop integral."""
+    v_hook, hook_int = _hook(prm, w_app, f_top, hook_int)
+    parts_t, parts = int(prm[P_PARTS_T]), wave_i.shape[1]
+    z = wave_f[sg.W_Z]
+    b_top_t, a_bot_t = sg.arriving(wave, wave_i, 0, parts_t)
+    b_top_a, a_bot_a = sg.arriving(wave, wave_i, parts_t, parts)
+    anechoic = prm[P_OFF_BOTTOM] == 2.0       # nothing comes back from below
+    sg.scatter(wave, wave_i, wave_f, 0, parts_t, b_top_t + 2.0 * z[0] * omega_s_next,
+               0.0 if anechoic else a_bot_t - 2.0 * z[parts_t - 1] * omega_new)
+    sg.scatter(wave, wave_i, wave_f, parts_t, parts, b_top_a + 2.0 * z[parts_t] * v_hook,
+               a_bot_a - 2.0 * z[parts - 1] * v_new)
+    return v_hook, hook_int
+
+
+@njit(cache=True, inline="always")
+def _hook(prm: np.ndarray, w_app: float, f_top: float, integral: float) -> tuple[float, float]:
+    """The hook's speed over the step: a PI loop on the applied-WOB error, so the string
+    force at the top (the applied WOB the rig infers from the hook load) follows W_APP;
+    zero (a fixed hook) off bottom. Returns ``(speed, integral)``."""
+    if prm[P_OFF_BOTTOM] != 0.0:
+        return 0.0, integral
+    err = w_app - f_top
+    integral += prm[P_HOOK_KI] * err * prm[P_DT]
+    return prm[P_HOOK_KP] * err + integral, integral
+
+
+@njit(cache=True, inline="always")
+def _cutting(cut_factor: float, off_bottom: bool, doc: float) -> float:
+    """The depth that sets the cutting forces (eq. 4): delta x eps / eps_ref of the rock
+    being drilled; negative (no contact) when the bit hangs off bottom."""
+    if off_bottom:
+        return -1.0
+    return doc if cut_factor == 1.0 else cut_factor * doc
+
+
+@njit(cache=True, inline="always")
+def _write_row(r: np.ndarray, tau: float, u: float, v: float, phi: float, omega: float,
+               phi_s: float, omega_s: float, w_app: float, wob: float, tob: float,
+               doc: float, w_f: float, t_top: float, mode: int, motor: float,
+               omega_ref: float, f_top: float, omega_bha: float) -> None:
+    """One sample row (columns C_*), the state at the start of the step."""
+    r[C_TAU], r[C_U], r[C_V], r[C_PHI], r[C_OMEGA] = tau, u, v, phi, omega
+    r[C_PHI_S], r[C_OMEGA_S], r[C_W_APP] = phi_s, omega_s, w_app
+    r[C_WOB], r[C_TOB], r[C_DOC], r[C_WF] = wob, tob, doc, w_f
+    r[C_T_PIPE], r[C_MODE] = t_top, mode
+    r[C_MOTOR_TORQUE], r[C_OMEGA_REF] = motor, omega_ref
+    r[C_F_TOP], r[C_OMEGA_BHA] = f_top, omega_bha
 
 
 @njit(cache=True)
 def advance(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarray,
             hist: np.ndarray, meta: np.ndarray, acc: np.ndarray, out: np.ndarray,
+            wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray,
             n_steps: int, every: int, exact: bool) -> tuple[int, int]:
-    """Advance ``n_steps``; state, statistics and bookkeeping live in locals.
-
-    Delay (eqs. 6-8, 26-28), two methods:
-
-    - ``exact=False``, the production path: ``profile`` (shape (n_nodes,)) holds the rock
-      height per node of one blade sector (2 pi / n). The bit reads the height left by the
-      previous blade (eq. 6: U(t - t_n) where eq. 7 holds) by linear interpolation in angle,
-      and re-cuts every node it passes to ``max(old, U_crossing)``. ``hist`` and ``meta``
-      are ignored (pass :data:`NO_HISTORY`, :data:`NO_META`).
-    - ``exact=True``, the reference path of RGD07 Appendix C: ``hist`` (shape (2,
-      capacity)) is a ring buffer of (PHI, U) samples and ``meta`` (int64, 3) its head,
-      count and cursor. Eq. (7) PHI(t) - PHI(t - t_n) = 2 pi / n is solved by interpolation
-      in that history and delta = n (U(t) - U(t - t_n)) (eq. 8). Samples are stored only when
-      the angle advances; those older than one sector are forgotten. ``profile`` is ignored.
-
-    out: shape (rows, N_COLS); a row is written when the global step % every == 0.
-    Returns ``(status, rows_written)``.
-    """
-    n, beta, lam, dt = prm[P_N], prm[P_BETA], prm[P_LAM], prm[P_DT]
-    kick = prm[P_PSI] * dt
-    omega_rate, w_rate, tau_avg = prm[P_OMEGA_RATE], prm[P_W_RATE], prm[P_TAU_AVG]
-    tgt_omega, tgt_w, tgt_torque = tgt[I_OMEGA_S], tgt[I_W_APP], tgt[I_MOTOR_TORQUE]
-    td_mode, td_j = int(prm[P_TD_MODE]), prm[P_TD_INERTIA]
-    td_kp, td_ki, td_max = prm[P_TD_KP], prm[P_TD_KI], prm[P_TD_MAX_TORQUE]
-    u, v, phi, omega = st[S_U], st[S_V], st[S_PHI], st[S_OMEGA]
-    phi_s, omega_s, w_app = st[S_PHI_S], st[S_OMEGA_S], st[S_W_APP]
-    omega_ref, integral, motor = st[S_OMEGA_REF], st[S_TD_INTEGRAL], st[S_MOTOR_TORQUE]
-    stuck = st[S_STUCK] != 0.0
-    step = int(st[S_STEP])
-    sector = 2.0 * math.pi / n
-    n_nodes = profile.shape[0]
-    inv_spacing = n_nodes / sector
-    node, frac, h_old = int(st[S_NODE]), st[S_FRAC], st[S_H_OLD]
-    cap = hist.shape[1]
+    """Up to ``n_steps`` of bit law, drive and string; delay from ``profile`` or ``hist``
+    (:func:`_surface`); ``wave*`` None: lumped; a row of ``out`` when step % every == 0;
+    stops after the step that reaches ``prm[P_LAYER_U]``. Returns (status, rows)."""
+    u, v, phi, omega, phi_s, omega_s, w_app, stuck, node, frac, h_old, step, omega_ref, \
+        integral, motor, v_hook, hook_int = _unpack(st)
+    dt, tau_avg, beta, lam, n_blades, psi, off_bottom, layer_u, cut_factor = _law_params(prm)
     head, count, cursor = meta[0], meta[1], meta[2]
-    a_count, a_wf, a_tob, a_doc = acc[A_COUNT], acc[A_WF], acc[A_TOB], acc[A_DOC]
-    a_wob, a_omega, a_tp, a_v = acc[A_WOB], acc[A_OMEGA], acc[A_T_PIPE], acc[A_V]
-    a_stuck = acc[A_STUCK]
-    om_min, om_max = acc[A_OMEGA_MIN], acc[A_OMEGA_MAX]
-    first_stick, first_bounce = acc[A_FIRST_STICK], acc[A_FIRST_BOUNCE]
-    countdown = _first_countdown(step, every)
-    n_rows = 0
-    status = STATUS_OK
-    probe = 0.0                               # NaN would vanish in the contact/stick logic
+    td_mode, tgt_omega, tgt_torque, omega_rate, td_j, td_kp, td_ki, td_max, td_lag, _ = \
+        _drive_params(prm, tgt)
+    stats, countdown, n_rows, status, probe = _stats(acc), _first_countdown(step, every), 0, \
+        STATUS_OK, 0.0                       # (a NaN probe survives the contact logic)
     for _ in range(n_steps):
-        tau = step * dt
-        # ---- depth of cut: delta = n (U(tau) - U(tau - tau_n)), eqs. (8), (26)-(28)
-        if exact:
-            surface, cursor = _delayed_depth(hist[0], hist[1], head, count, cursor,
-                                             phi - sector)
+        surface, cursor = _surface(exact, hist, profile, head, count, cursor, node, frac,
+                                   h_old, phi - 2.0 * math.pi / n_blades)
+        doc = n_blades * (u - surface)          # delta = n (U - U(tau - tau_n)), eq. 8
+        if wave is None:                      # the lumped string (compiled apart)
+            v0, kick_v, f_ext, omega0, kick_w, t_ext, t_top, f_top = _lumped_ends(
+                psi, dt, phi_s, phi, v, omega, w_app)
         else:
-            nxt = node + 1 if node + 1 < n_nodes else 0
-            surface = h_old + frac * (profile[nxt] - h_old)
-        doc = n * (u - surface)
-        t_pipe = phi_s - phi                  # pipe torque C (PHI_S - PHI), scaled
-        v_new, omega_new, w_f, wob, tob, mode, stuck = _bit_response(
-            v, omega, t_pipe, w_app, doc, stuck, beta, lam, kick, dt)
-        # ---- top drive (RGD07 eq. 12 extended): its speed at the end of the step
-        if td_mode == TD_KINEMATIC:           # the paper's imposed speed
-            omega_s_next = ramp(omega_s, tgt_omega, omega_rate, dt)
-            omega_ref = omega_s_next
-            motor = kinematic_torque(omega_s, omega_s_next, t_pipe, td_j, dt)
-        else:                                 # an inertia turned by the motor torque
-            omega_ref = ramp(omega_ref, tgt_omega, omega_rate, dt)
-            if td_mode == TD_SPEED:
-                motor, integral = speed_loop(omega_ref, omega_s, integral, td_kp, td_ki,
-                                             td_max, dt)
-            else:
-                motor = torque_command(tgt_torque, td_max)
-            omega_s_next = omega_s + drive_acceleration(motor, t_pipe, td_j) * dt
+            v0, kick_v, f_ext, omega0, kick_w, t_ext, t_top, f_top = _distributed_ends(
+                prm, wave, wave_i, wave_f, omega_s, v, omega, v_hook)
+        v_new, omega_new, w_f, wob, tob, mode, stuck = br.bit_response(
+            v0, kick_v, f_ext, omega0, kick_w, t_ext, _cutting(cut_factor, off_bottom, doc),
+            stuck, beta, lam)
+        omega_s_next, omega_ref, integral, motor = drive_step(
+            td_mode, omega_s, omega_ref, integral, motor, t_top, tgt_omega, tgt_torque,
+            omega_rate, td_j, td_kp, td_ki, td_max, td_lag, dt)
         probe += w_f + tob + motor
-        # ---- statistics
-        if mode == MODE_STUCK and first_stick != first_stick:
-            first_stick = tau
-        if mode == MODE_OFF_BOTTOM and first_bounce != first_bounce:
-            first_bounce = tau
-        if tau >= tau_avg:
-            a_count += 1.0
-            a_wf += w_f
-            a_tob += tob
-            a_doc += doc
-            a_wob += wob
-            a_omega += omega
-            a_tp += t_pipe
-            a_v += v
-            om_min = min(om_min, omega)
-            om_max = max(om_max, omega)
-            if mode == MODE_STUCK:
-                a_stuck += 1.0
-        # ---- sample at the start of the step
-        if countdown == 0:
-            if n_rows < out.shape[0]:
-                r = out[n_rows]
-                r[C_TAU], r[C_U], r[C_V], r[C_PHI], r[C_OMEGA] = tau, u, v, phi, omega
-                r[C_PHI_S], r[C_OMEGA_S], r[C_W_APP] = phi_s, omega_s, w_app
-                r[C_WOB], r[C_TOB], r[C_DOC], r[C_WF] = wob, tob, doc, w_f
-                r[C_T_PIPE], r[C_MODE] = t_pipe, mode
-                r[C_MOTOR_TORQUE], r[C_OMEGA_REF] = motor, omega_ref
-                n_rows += 1
-            countdown = every - 1
+        stats = _accumulate(stats, step * dt, tau_avg, mode, w_f, tob, doc, wob, omega, t_top, v)
+        if countdown == 0 and n_rows < out.shape[0]:
+            omega_bha = omega if wave is None else \
+                sg.speed_at_top_of(wave, wave_i, wave_f, int(prm[P_BHA_PART]))
+            _write_row(out[n_rows], step * dt, u, v, phi, omega, phi_s, omega_s, w_app, wob, tob,
+                       doc, w_f, t_top, mode, motor, omega_ref, f_top, omega_bha)
+            n_rows += 1
+        countdown = every - 1 if countdown == 0 else countdown - 1
+        if wave is None:    # kinematic: the angle moves at the step's starting speed
+            phi_s += (omega_s if td_mode == TD_KINEMATIC else omega_s_next) * dt
         else:
-            countdown -= 1
-        # ---- symplectic Euler (eq. C.1 with the updated velocities)
-        u_new = u + v_new * dt
-        phi_new = phi + omega_new * dt
-        if exact:
-            if phi_new > phi:                 # store (PHI, U) only when the bit turns
-                if count == cap:
-                    if cursor == 0:
-                        status = STATUS_HISTORY_FULL
-                        break
-                    count -= 1
-                    cursor -= 1
-                hist[0, head] = phi_new
-                hist[1, head] = u_new
-                head = head + 1 if head + 1 < cap else 0
-                count += 1
-            while cursor > 1:                 # forget what is older than one sector
-                count -= 1
-                cursor -= 1
-        else:
-            # nodes passed during the step are re-cut to the bit depth (max rule)
-            dfrac = (phi_new - phi) * inv_spacing
-            f_start = frac
-            frac += dfrac
-            while frac >= 1.0:
-                frac -= 1.0
-                node = node + 1 if node + 1 < n_nodes else 0
-                u_cross = u + (u_new - u) * (1.0 - f_start) / dfrac
-                f_start -= 1.0
-                h_old = profile[node]
-                if u_cross > h_old:
-                    profile[node] = u_cross
-        u, v, phi, omega = u_new, v_new, phi_new, omega_new
-        # kinematic: the angle advances at the speed the step started with (as before the
-        # drive had inertia, bit for bit); an inertial drive: symplectic Euler like the bit
-        phi_s += (omega_s if td_mode == TD_KINEMATIC else omega_s_next) * dt
+            v_hook, hook_int = _distributed_move(prm, wave, wave_i, wave_f, w_app, f_top,
+                                                 hook_int, omega_s_next, v_new, omega_new)
+            phi_s += omega_s_next * dt
         omega_s = omega_s_next
-        w_app = ramp(w_app, tgt_w, w_rate, dt)
+        u_new, phi_new = u + v_new * dt, phi + omega_new * dt     # symplectic Euler, eq. C.1
+        head, count, cursor, node, frac, h_old, ok = _remember(
+            exact, hist, profile, head, count, cursor, node, frac, h_old, u, u_new, phi,
+            phi_new, n_blades)
+        u, v, phi, omega = u_new, v_new, phi_new, omega_new
+        w_app = ramp(w_app, tgt[I_W_APP], prm[P_W_RATE], dt)
         step += 1
+        if not ok or u >= layer_u:
+            status = STATUS_LAYER if ok else (STATUS_HISTORY_FULL if exact else STATUS_RUNAWAY)
+            break
+    _pack(st, meta, u, v, phi, omega, phi_s, omega_s, w_app, stuck, node, frac, h_old, step,
+          omega_ref, integral, motor, v_hook, hook_int, dt, head, count, cursor)
+    return _finish(acc, stats, status, (u, v, phi, omega, omega_s, probe)), n_rows
+
+
+@njit(cache=True, inline="always")
+def _law_params(prm: np.ndarray) -> tuple:
+    """dtau, the statistics window start, beta, lambda, n, psi, off bottom, the next layer's
+    top and the cutting factor, for a run."""
+    return (prm[P_DT], prm[P_TAU_AVG], prm[P_BETA], prm[P_LAM], prm[P_N], prm[P_PSI],
+            prm[P_OFF_BOTTOM] != 0.0, prm[P_LAYER_U], prm[P_CUT])
+
+
+@njit(cache=True, inline="always")
+def _stats(acc: np.ndarray) -> tuple:
+    """The statistics as a tuple of locals (``A_*`` order)."""
+    return (acc[0], acc[1], acc[2], acc[3], acc[4], acc[5], acc[6], acc[7], acc[8], acc[9],
+            acc[10], acc[11], acc[12])
+
+
+@njit(cache=True, inline="always")
+def _surface(exact: bool, hist: np.ndarray, profile: np.ndarray, head: int, count: int,
+             cursor: int, node: int, frac: float, h_old: float,
+             phi_target: float) -> tuple[float, int]:
+    """The rock height the bit cuts down to now, U(tau - tau_n) (eqs. 6-7, 26-28): from the
+    bottom-hole profile, or from the exact history at the angle one sector back."""
+    if exact:
+        return br.delayed_depth(hist[0], hist[1], head, count, cursor, phi_target)
+    return br.profile_surface(profile, node, frac, h_old), cursor
+
+
+@njit(cache=True, inline="always")
+def _remember(exact: bool, hist: np.ndarray, profile: np.ndarray, head: int, count: int,
+              cursor: int, node: int, frac: float, h_old: float, u: float, u_new: float,
+              phi: float, phi_new: float, n_blades: float) -> tuple:
+    """The delay's memory after the bit moved: the history stores (PHI, U), or the profile
+    nodes passed are re-cut. Returns (head, count, cursor, node, frac, h_old, ok)."""
+    if exact:
+        head, count, cursor, ok = br.history_store(hist, head, count, cursor, phi, phi_new,
+                                                   u_new)
+        return head, count, cursor, node, frac, h_old, ok
+    inv_spacing = profile.shape[0] / (2.0 * math.pi / n_blades)
+    node, frac, h_old, ok = br.profile_recut(profile, node, frac, h_old, u, u_new,
+                                             (phi_new - phi) * inv_spacing)
+    return head, count, cursor, node, frac, h_old, ok
+
+
+@njit(cache=True, inline="always")
+def _finish(acc: np.ndarray, stats: tuple, status: int, values: tuple) -> int:
+    """The statistics back into ``acc``; a clean stop whose state is not finite becomes
+    STATUS_NONFINITE."""
+    for i in range(N_ACC):
+        acc[i] = stats[i]
+    if status in (STATUS_OK, STATUS_LAYER):
+        for x in values:
+            if not math.isfinite(x):
+                return STATUS_NONFINITE
+    return status
+
+
+@njit(cache=True, inline="always")
+def _drive_params(prm: np.ndarray, tgt: np.ndarray) -> tuple:
+    """The drive's parameters and commands for a run, read once (top_drive.drive_step)."""
+    return (int(prm[P_TD_MODE]), tgt[I_OMEGA_S], tgt[I_MOTOR_TORQUE], prm[P_OMEGA_RATE],
+            prm[P_TD_INERTIA], prm[P_TD_KP], prm[P_TD_KI], prm[P_TD_MAX_TORQUE],
+            prm[P_TD_LAG_ALPHA], prm[P_DT])
+
+
+@njit(cache=True, inline="always")
+def _unpack(st: np.ndarray) -> tuple:
+    """The state vector as the loop's locals."""
+    return (st[S_U], st[S_V], st[S_PHI], st[S_OMEGA], st[S_PHI_S], st[S_OMEGA_S],
+            st[S_W_APP], st[S_STUCK] != 0.0, int(st[S_NODE]), st[S_FRAC], st[S_H_OLD],
+            int(st[S_STEP]), st[S_OMEGA_REF], st[S_TD_INTEGRAL], st[S_MOTOR_TORQUE],
+            st[S_V_HOOK], st[S_HOOK_INTEGRAL])
+
+
+@njit(cache=True, inline="always")
+def _pack(st: np.ndarray, meta: np.ndarray, u: float, v: float, phi: float, omega: float,
+          phi_s: float, omega_s: float, w_app: float, stuck: bool, node: int, frac: float,
+          h_old: float, step: int, omega_ref: float, integral: float, motor: float,
+          v_hook: float, hook_int: float, dt: float, head: int, count: int,
+          cursor: int) -> None:
+    """The loop's locals back into the state vector and the history's bookkeeping."""
+    meta[0], meta[1], meta[2] = head, count, cursor
     st[S_U], st[S_V], st[S_PHI], st[S_OMEGA] = u, v, phi, omega
     st[S_PHI_S], st[S_OMEGA_S], st[S_W_APP] = phi_s, omega_s, w_app
-    st[S_OMEGA_REF], st[S_TD_INTEGRAL], st[S_MOTOR_TORQUE] = omega_ref, integral, motor
     st[S_STUCK] = 1.0 if stuck else 0.0
-    st[S_STEP] = step
-    st[S_TAU] = step * dt
     st[S_NODE], st[S_FRAC], st[S_H_OLD] = node, frac, h_old
-    meta[0], meta[1], meta[2] = head, count, cursor
-    acc[A_COUNT], acc[A_WF], acc[A_TOB], acc[A_DOC] = a_count, a_wf, a_tob, a_doc
-    acc[A_WOB], acc[A_OMEGA], acc[A_T_PIPE], acc[A_V] = a_wob, a_omega, a_tp, a_v
-    acc[A_STUCK] = a_stuck
-    acc[A_OMEGA_MIN], acc[A_OMEGA_MAX] = om_min, om_max
-    acc[A_FIRST_STICK], acc[A_FIRST_BOUNCE] = first_stick, first_bounce
-    if status == STATUS_OK and not (math.isfinite(u) and math.isfinite(v) and math.isfinite(phi)
-                                    and math.isfinite(omega) and math.isfinite(probe)):
-        status = STATUS_NONFINITE
-    return status, n_rows
+    st[S_STEP], st[S_TAU] = step, step * dt
+    st[S_OMEGA_REF], st[S_TD_INTEGRAL], st[S_MOTOR_TORQUE] = omega_ref, integral, motor
+    st[S_V_HOOK], st[S_HOOK_INTEGRAL] = v_hook, hook_int
 
 
 @njit(cache=True)
 def advance_and_sample(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarray,
                        hist: np.ndarray, meta: np.ndarray, acc: np.ndarray, out: np.ndarray,
+                       wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray,
                        n_steps: int, every: int, exact: bool) -> tuple[int, int]:
     """:func:`advance`, then the sample of the state it ended in, in the next row of ``out``.
 
     That sample is what the next step records at its start: it is read from one step taken
-    on copies of the state, the rock profile (or history) and the statistics, so the
-    simulation itself does not move. ``n_steps = 0`` gives the sample of the current state.
-    Returns ``(status, rows_written)`` with the end sample counted; on a failed status the
-    end sample is not taken.
+    on copies of the state, the rock profile (or history), the string and the statistics,
+    so the simulation itself does not move. ``n_steps = 0`` gives the sample of the current
+    state. Returns ``(status, rows_written)`` with the end sample counted; on a failed or
+    early-stopped status the end sample is not taken.
     """
     status, rows = STATUS_OK, 0
     if n_steps > 0:
-        status, rows = advance(st, prm, tgt, profile, hist, meta, acc, out, n_steps, every,
-                               exact)
+        status, rows = advance(st, prm, tgt, profile, hist, meta, acc, out, wave, wave_i,
+                               wave_f, n_steps, every, exact)
     if status != STATUS_OK or rows >= out.shape[0]:
         return status, rows
     one = np.int64(1)               # not the literal 1: that would compile advance twice
-    advance(st.copy(), prm, tgt, profile if exact else profile.copy(),
-            hist.copy() if exact else hist, meta.copy(), acc.copy(), out[rows:rows + 1], one,
-            one, exact)
+    if wave is None:
+        advance(st.copy(), prm, tgt, profile if exact else profile.copy(),
+                hist.copy() if exact else hist, meta.copy(), acc.copy(), out[rows:rows + 1],
+                wave, wave_i, wave_f, one, one, exact)
+    else:                           # one step undone: the slots it writes, the positions
+        slots = sg.step_slots(wave_i)
+        saved = wave[slots]
+        advance(st.copy(), prm, tgt, profile if exact else profile.copy(),
+                hist.copy() if exact else hist, meta.copy(), acc.copy(), out[rows:rows + 1],
+                wave, wave_i.copy(), wave_f, one, one, exact)
+        wave[slots] = saved
     return status, rows + 1
 
 
 NO_HISTORY = np.zeros((2, 1))             # what the profile path takes for hist and meta
 NO_META = np.zeros(3, dtype=np.int64)
+NO_WAVE = None                            # what the lumped string takes for the lines:
+NO_WAVE_I = None                          # None, so the lumped loop is compiled on its own
+NO_WAVE_F = None

@@ -1,10 +1,12 @@
 """What a rig measures at the surface: the drive's signals as its sensors give them.
 
 A rig has, at the surface, the drive's speed (encoder), its motor torque (the drive's own
-estimate from the motor current) and, where a torque sub is fitted, the string torque at the
-quill. The bit's speed, depth of cut, WOB and TOB are downhole truth that only the simulator
-knows. :class:`RigSensors` turns the true surface signals of each sample (SI, one column per
-signal of :data:`SIGNALS`) into measured ones, per signal and off by default:
+estimate from the motor current), where a torque sub is fitted, the string torque at the
+quill, and the hook load (the deadline load cell; the driller's applied-WOB estimate is the
+off-bottom hook load less the measured one, ``model.telemetry``). The bit's speed, depth of
+cut, WOB and TOB are downhole truth that only the simulator knows. :class:`RigSensors`
+turns the true surface signals of each sample (SI, one column per signal of
+:data:`SIGNALS`) into measured ones, per signal and off by default:
 
 * Gaussian noise of standard deviation ``noise_std`` (seeded: the same samples give the same
   measurements, run after run and whatever the blocks they come in);
@@ -22,7 +24,7 @@ import numpy as np
 
 from drill_sim_ros.model.errors import ParameterError
 
-SIGNALS = ("drive_speed_rad_s", "motor_torque_nm", "string_torque_nm")
+SIGNALS = ("drive_speed_rad_s", "motor_torque_nm", "string_torque_nm", "hook_load_n")
 MAX_DELAY_PERIODS = 10_000
 
 

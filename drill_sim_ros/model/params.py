@@ -18,6 +18,7 @@ from dataclasses import dataclass, fields, replace
 from typing import Any
 
 from drill_sim_ros.model.errors import ParameterError
+from drill_sim_ros.model.string import StringSpec, lumped_equivalent
 
 RPM_PER_RAD_S = 60.0 / (2.0 * math.pi)
 GROUPS = ("n", "psi", "beta", "lam", "w0", "omega0")   # the six groups, eqs. (23)-(24)
@@ -85,6 +86,7 @@ class PhysicalParams:
     bha_length_m: float = 200.0
     density_kg_m3: float = 7850.0
     shear_modulus_pa: float = 79.3e9
+    youngs_modulus_pa: float = 206.0e9
     bit_radius_m: float = 0.108
     n_blades: int = 6
     intrinsic_specific_energy_pa: float = 230e6
@@ -105,7 +107,7 @@ class PhysicalParams:
 def validate_physical(p: PhysicalParams) -> None:
     """Check every physical input; the error names the first bad one."""
     for name in ("pipe_outer_radius_m", "pipe_length_m", "bha_outer_radius_m", "bha_length_m",
-                 "density_kg_m3", "shear_modulus_pa", "bit_radius_m",
+                 "density_kg_m3", "shear_modulus_pa", "youngs_modulus_pa", "bit_radius_m",
                  "intrinsic_specific_energy_pa", "zeta", "mu_gamma"):
         _require(name, float(getattr(p, name)), 0.0, 1e15)
     _require("pipe_inner_radius_m", p.pipe_inner_radius_m, 0.0, 1e15, low_open=False)
@@ -181,8 +183,11 @@ class Scales:
 UNIT_SCALES = Scales(time_s=1.0, length_m=1.0, force_n=1.0, torque_nm=1.0)
 
 
-def structure(p: PhysicalParams) -> Structure:
-    """M, I, C of RGD07 eq. (1); I includes one third of the pipe inertia."""
+def structure(p: PhysicalParams, string: StringSpec | None = None) -> Structure:
+    """M, I, C of RGD07 eq. (1); I includes one third of the pipe inertia. With a
+    ``string`` of sections, its lumped equivalent (string.lumped_equivalent) instead."""
+    if string is not None and string.sections:
+        return Structure(*lumped_equivalent(string))
     j_pipe = 0.5 * math.pi * (p.pipe_outer_radius_m**4 - p.pipe_inner_radius_m**4)
     j_bha = 0.5 * math.pi * (p.bha_outer_radius_m**4 - p.bha_inner_radius_m**4)
     mass = p.density_kg_m3 * math.pi * (p.bha_outer_radius_m**2 - p.bha_inner_radius_m**2) \
@@ -192,19 +197,21 @@ def structure(p: PhysicalParams) -> Structure:
     return Structure(mass, inertia, stiffness)
 
 
-def scales(p: PhysicalParams) -> Scales:
+def scales(p: PhysicalParams, string: StringSpec | None = None) -> Scales:
     """t* and L* of RGD07 eq. (19), with the force and torque units of eq. (20)."""
-    s = structure(p)
+    s = structure(p, string)
     t_star = math.sqrt(s.inertia_kg_m2 / s.stiffness_nm_per_rad)
     l_star = 2.0 * s.stiffness_nm_per_rad / (p.intrinsic_specific_energy_pa * p.bit_radius_m**2)
     force = p.zeta * p.intrinsic_specific_energy_pa * p.bit_radius_m * l_star
     return Scales(t_star, l_star, force, s.stiffness_nm_per_rad)
 
 
-def scale(p: PhysicalParams) -> tuple[DimensionlessParams, Scales]:
-    """Physical description -> the six groups of RGD07 eqs. (23)-(24), plus the scales."""
-    s = structure(p)
-    sc = scales(p)
+def scale(p: PhysicalParams, string: StringSpec | None = None
+          ) -> tuple[DimensionlessParams, Scales]:
+    """Physical description -> the six groups of RGD07 eqs. (23)-(24), plus the scales
+    (of the lumped equivalent of ``string`` when it has sections)."""
+    s = structure(p, string)
+    sc = scales(p, string)
     eps, zeta, a = p.intrinsic_specific_energy_pa, p.zeta, p.bit_radius_m
     groups = DimensionlessParams(
         n=p.n_blades,

@@ -2,9 +2,12 @@
 
 A preset file holds ``description``, either ``dimensionless`` (RGD07 groups; the run is
 then in units of t* and L*) or ``physical`` (SI; see :class:`PhysicalParams`), optional
-``numerics`` (``dtau``, ``n_nodes``) and an optional ``top_drive`` (SI keys of
+``numerics`` (``dtau``, ``n_nodes``), an optional ``top_drive`` (SI keys of
 :class:`TopDrivePhysical` in a physical preset, scaled keys of :class:`TopDrive` in a
-dimensionless one; absent: the paper's kinematic drive).
+dimensionless one; absent: the paper's kinematic drive) and, in a physical preset, an
+optional ``string`` (:func:`string_from_dict`: ``lumped``, RGD07's spring, by default, or
+``distributed`` sections; without ``sections`` the ``pipe_*`` / ``bha_*`` keys are the
+two-section shorthand).
 """
 
 from __future__ import annotations
@@ -19,6 +22,7 @@ from typing import Any
 import yaml
 
 from drill_sim_ros.model.errors import ParameterError
+from drill_sim_ros.model.formation import Rock
 from drill_sim_ros.model.params import (
     UNIT_SCALES,
     DimensionlessParams,
@@ -28,6 +32,13 @@ from drill_sim_ros.model.params import (
     physical_from_dict,
     scale,
     structure,
+)
+from drill_sim_ros.model.string import (
+    STRING_MODELS,
+    KernelString,
+    Section,
+    StringSpec,
+    kernel_string,
 )
 from drill_sim_ros.model.top_drive import TopDrive, top_drive_from_dict
 
@@ -49,10 +60,29 @@ class Preset:
     dtau: float
     n_nodes: int | None
     top_drive: TopDrive = field(default_factory=TopDrive)
+    string: StringSpec = field(default_factory=StringSpec)
 
     @property
     def is_physical(self) -> bool:
         return self.physical is not None
+
+    @property
+    def rock(self) -> Rock:
+        """The reference rock and bit that formation layers are scaled against."""
+        phys = self.physical
+        if phys is None:
+            raise ParameterError(f"preset '{self.name}' is dimensionless; formation layers "
+                                 "are given in SI and need a physical preset")
+        return Rock(eps_pa=phys.intrinsic_specific_energy_pa, zeta=phys.zeta,
+                    mu_gamma=phys.mu_gamma,
+                    sigma_l_n_per_m=phys.contact_stress_times_wearflat_n_per_m,
+                    length_m=self.scales.length_m)
+
+    @property
+    def kernel_string(self) -> KernelString:
+        """The string in kernel units (what the simulator builds its delay lines from)."""
+        sc = self.scales
+        return kernel_string(self.string, sc.time_s, sc.torque_nm, sc.length_m, sc.force_n)
 
 
 def config_dirs() -> list[Path]:
@@ -98,11 +128,15 @@ def preset_from_dict(name: str, data: dict[str, Any]) -> Preset:
     if has_phys == has_dimless:
         raise ParameterError(f"preset '{name}' needs exactly one of 'physical' or "
                              "'dimensionless'")
-    physical = None
+    physical, string = None, StringSpec()
     if has_phys:
         physical = physical_from_dict(data["physical"])
-        params, scales = scale(physical)
+        string = string_from_dict(data.get("string") or {}, physical)
+        params, scales = scale(physical, string)
     else:
+        if "string" in data:
+            raise ParameterError(f"preset '{name}': 'string' needs a 'physical' preset (a "
+                                 "dimensionless one is RGD07's lumped string)")
         params, scales = dimensionless_from_dict(data["dimensionless"]), UNIT_SCALES
     n_nodes = numerics.get("n_nodes")
     drive = data.get("top_drive")
@@ -110,7 +144,100 @@ def preset_from_dict(name: str, data: dict[str, Any]) -> Preset:
     return Preset(name=name, description=str(data.get("description", "")).strip(),
                   params=params, scales=scales, physical=physical,
                   dtau=float(numerics.get("dtau", 1e-4)),
-                  n_nodes=None if n_nodes is None else int(n_nodes), top_drive=top_drive)
+                  n_nodes=None if n_nodes is None else int(n_nodes), top_drive=top_drive,
+                  string=string)
+
+
+SECTION_KEYS = ("outer_radius_m", "inner_radius_m", "length_m", "density_kg_m3",
+                "shear_modulus_pa", "youngs_modulus_pa", "torsional_damping_per_s",
+                "axial_damping_per_s")
+STRING_KEYS = ("model", "sections", "bit_inertia_kg_m2", "torsional_damping_per_s",
+               "axial_damping_per_s", "hook_wob_time_s", "damping_points")
+
+
+def _number(where: str, key: str, value: Any, low: float, high: float,
+            low_open: bool = False) -> float:
+    """A float in range, or ParameterError naming ``where.key``, the value and the range."""
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        x = math.nan
+    ok = math.isfinite(x) and (x > low if low_open else x >= low) and x <= high
+    if not ok:
+        bracket = "(" if low_open else "["
+        raise ParameterError(f"'{where}.{key}' = {value!r} must be a number in "
+                             f"{bracket}{low:g}, {high:g}]")
+    return x
+
+
+def _section(where: str, values: Any, defaults: dict[str, float]) -> Section:
+    """One section mapping (SI keys of :class:`Section`), checked."""
+    if not isinstance(values, dict):
+        raise ParameterError(f"'{where}' must be a mapping of {', '.join(SECTION_KEYS[:3])}")
+    unknown = sorted(set(values) - set(SECTION_KEYS))
+    if unknown:
+        raise ParameterError(f"unknown key(s) {unknown} in '{where}'; known: "
+                             f"{', '.join(SECTION_KEYS)}")
+    missing = [key for key in SECTION_KEYS[:3] if key not in values]
+    if missing:
+        raise ParameterError(f"'{where}' needs {', '.join(missing)}")
+    merged = {**defaults, **values}
+    ranges = {"outer_radius_m": (0.0, 10.0, True), "inner_radius_m": (0.0, 10.0, False),
+              "length_m": (0.0, 1e5, True), "density_kg_m3": (0.0, 1e5, True),
+              "shear_modulus_pa": (0.0, 1e13, True), "youngs_modulus_pa": (0.0, 1e13, True),
+              "torsional_damping_per_s": (0.0, 1e3, False),
+              "axial_damping_per_s": (0.0, 1e3, False)}
+    x = {key: _number(where, key, merged[key], *ranges[key]) for key in SECTION_KEYS}
+    if x["inner_radius_m"] >= x["outer_radius_m"]:
+        raise ParameterError(f"'{where}.inner_radius_m' = {x['inner_radius_m']!r} must be "
+                             f"smaller than outer_radius_m = {x['outer_radius_m']!r}")
+    return Section(**x)
+
+
+def string_from_dict(values: Any, phys: PhysicalParams) -> StringSpec:
+    """A physical preset's ``string`` mapping (see the module doc); the material defaults
+    are the ``physical`` ones, the damping defaults the string's own keys."""
+    if not isinstance(values, dict):
+        raise ParameterError("'string' must be a mapping (model, sections, ...)")
+    unknown = sorted(set(values) - set(STRING_KEYS))
+    if unknown:
+        raise ParameterError(f"unknown key(s) {unknown} in 'string'; known: "
+                             f"{', '.join(STRING_KEYS)}")
+    model = values.get("model", "lumped")
+    if model not in STRING_MODELS:
+        raise ParameterError(f"'string.model' = {model!r} must be one of {STRING_MODELS}")
+    defaults = {"density_kg_m3": phys.density_kg_m3, "shear_modulus_pa": phys.shear_modulus_pa,
+                "youngs_modulus_pa": phys.youngs_modulus_pa,
+                "torsional_damping_per_s": _number("string", "torsional_damping_per_s",
+                                                   values.get("torsional_damping_per_s", 0.0),
+                                                   0.0, 1e3),
+                "axial_damping_per_s": _number("string", "axial_damping_per_s",
+                                               values.get("axial_damping_per_s", 0.0),
+                                               0.0, 1e3)}
+    raw = values.get("sections")
+    if raw is None:                          # the two-section shorthand
+        raw = [{"outer_radius_m": phys.pipe_outer_radius_m,
+                "inner_radius_m": phys.pipe_inner_radius_m, "length_m": phys.pipe_length_m},
+               {"outer_radius_m": phys.bha_outer_radius_m,
+                "inner_radius_m": phys.bha_inner_radius_m, "length_m": phys.bha_length_m}]
+    elif not isinstance(raw, list) or len(raw) < 2:
+        raise ParameterError("'string.sections' must be a list of at least 2 sections, top "
+                             "to bottom (the bottom one is the BHA)")
+    sections = tuple(_section(f"string.sections[{i}]", sec, defaults)
+                     for i, sec in enumerate(raw))
+    points = _number("string", "damping_points", values.get("damping_points", 4), 1, 64)
+    if points != int(points):
+        raise ParameterError(f"'string.damping_points' = {points!r} must be an integer")
+    spec = StringSpec(model=model, sections=sections,
+                      bit_inertia_kg_m2=_number("string", "bit_inertia_kg_m2",
+                                                values.get("bit_inertia_kg_m2", 0.0), 0.0, 1e6),
+                      hook_wob_time_s=_number("string", "hook_wob_time_s",
+                                              values.get("hook_wob_time_s", 5.0), 0.0, 1e4,
+                                              low_open=True),
+                      damping_points=int(points))
+    if not spec.distributed and values.get("sections") is None:
+        return StringSpec()                  # RGD07's lumped string of pipe_* / bha_*
+    return spec
 
 
 def load_preset(name_or_path: str = DEFAULT_PRESET) -> Preset:
@@ -132,6 +259,9 @@ def submerged_string_weight_n(preset: Preset | None,
     if preset is None or preset.physical is None:
         return 0.0
     phys = preset.physical
+    if preset.string.sections:
+        return sum(s.mass_kg * GRAVITY_M_S2 * (1.0 - mud_density_kg_m3 / s.density_kg_m3)
+                   for s in preset.string.sections)
     pipe_m3 = math.pi * (phys.pipe_outer_radius_m**2 - phys.pipe_inner_radius_m**2) \
         * phys.pipe_length_m
     mass_kg = pipe_m3 * phys.density_kg_m3 + structure(phys).mass_kg

@@ -11,21 +11,24 @@ from __future__ import annotations
 
 import math
 from collections import deque
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
 from drill_sim_ros.model import kernel as k
 from drill_sim_ros.model.analysis import Severity, severity_of
+from drill_sim_ros.model.errors import ParameterError
+from drill_sim_ros.model.formation import layers_from_dicts
 from drill_sim_ros.model.measurement import RigSensors
 from drill_sim_ros.model.params import GROUPS
 from drill_sim_ros.model.presets import Preset
 from drill_sim_ros.model.simulator import SimConfig, Simulator
 from drill_sim_ros.model.telemetry import (
-    MEASURED,
     NO_COMMAND_S,
     NS_PER_S,
     field_scales,
+    set_measured,
     stamped_si_rows,
     surface_truth,
 )
@@ -51,6 +54,7 @@ class SessionConfig:
     submerged_weight_n: float = 0.0      # for the hook load
     top_drive: TopDrivePhysical | None = None   # None: the preset's drive
     sensors: RigSensors | None = None           # None: perfect surface sensors
+    command_delay_s: float = 0.0         # transport delay of the set_* inputs (0: none)
 
 
 @dataclass(slots=True)
@@ -92,7 +96,8 @@ def build_simulator(cfg: SessionConfig, period_tau: float, steps: int) -> Simula
     config = SimConfig(dtau=period_tau / steps, n_nodes=cfg.n_nodes, omega_rate=omega_rate,
                        w_rate=w_rate)
     drive = cfg.preset.top_drive if cfg.top_drive is None else cfg.top_drive.scaled(sc)
-    return Simulator(params, config, perturb_v=cfg.perturb_v, top_drive=drive, scales=sc)
+    return Simulator(params, config, perturb_v=cfg.perturb_v, top_drive=drive, scales=sc,
+                     string=cfg.preset.kernel_string)
 
 
 class SimSession:
@@ -123,6 +128,12 @@ class SimSession:
         self._bucket_samples = max(1, round(window / buckets))
         self._snapshots: deque[np.ndarray] = deque(maxlen=buckets + 1)
         self._bucket_end = self._bucket_samples
+        # inputs on their way to the drive: (due stamp ns, setter, value), in due order
+        self.command_delay_ns = round(cfg.command_delay_s * NS_PER_S)
+        if not (math.isfinite(cfg.command_delay_s) and self.command_delay_ns >= 0):
+            raise ParameterError(f"command delay {cfg.command_delay_s!r} s must be >= 0")
+        self._in_transit: deque[tuple[int, Callable[[float], None], float]] = deque()
+        self._part = np.empty((2, k.N_COLS))      # one part of a split period
 
     @property
     def dtau(self) -> float:
@@ -149,11 +160,42 @@ class SimSession:
         if periods + 1 > self._samples.shape[0]:
             self._samples = np.empty((periods + 1, k.N_COLS))
         first = self.next_index
-        # rows 0..periods-1: the state at the start of each period; row `periods`: the end
-        rows = self.sim.advance_into(self._samples, periods * self.steps, self.steps,
+        done = 0
+        while self._in_transit and done < periods:      # inputs arrive within a period
+            self._samples[done + 1] = self._split_period()
+            done += 1
+        if done < periods:
+            # rows 0..n-1: the state at the start of each period; row n: the end
+            rows = self.sim.advance_into(self._samples[done:], (periods - done) * self.steps,
+                                         self.steps, sample_end=True)
+            self._advanced(rows - 1)
+        return self._block(self._samples[1:periods + 1], first + 1)
+
+    def _split_period(self) -> np.ndarray:
+        """One period with the inputs due in it applied at their step (the step nearest
+        their due time); the kernel sample at its end."""
+        start_ns, done = self.sim_time_ns, 0
+        while self._in_transit:
+            due_ns, setter, value = self._in_transit[0]
+            at = max(0, round((due_ns - start_ns) * self.steps / self.period_ns))
+            if at >= self.steps:
+                break
+            if at > done:
+                self.sim.advance_into(self._part, at - done, self.steps)
+                done = at
+            self._in_transit.popleft()
+            setter(value)
+        rows = self.sim.advance_into(self._part, self.steps - done, self.steps,
                                      sample_end=True)
-        self._advanced(rows - 1)
-        return self._block(self._samples[1:rows], first + 1)
+        self._advanced(1)
+        return self._part[rows - 1]
+
+    def _input(self, setter: Callable[[float], None], value: float) -> None:
+        """``setter(value)`` now, or after the command delay (from the current stamp)."""
+        if self.command_delay_ns == 0:
+            setter(value)
+        else:
+            self._in_transit.append((self.sim_time_ns + self.command_delay_ns, setter, value))
 
     def _block(self, samples: np.ndarray, first_index: int) -> Block:
         """SI block of kernel rows, the first stamped ``first_index * period_ns``."""
@@ -164,7 +206,8 @@ class SimSession:
                                           first_index * self.period_ns, self.period_ns,
                                           float(self.submerged_weight_n), command_s)
         if not self._perfect_sensors:          # si_rows gives the truth, perfect sensors
-            rows[:, MEASURED] = self.sensors.measure(surface_truth(rows))
+            set_measured(rows, self.sensors.measure(surface_truth(rows)),
+                         float(self.submerged_weight_n))
         return Block(rows, stamps_ns, offsets)
 
     def _advanced(self, count: int) -> None:
@@ -207,23 +250,39 @@ class SimSession:
         }
 
     def set_surface_rpm(self, rpm: float) -> None:
-        self.sim.set_inputs(omega_s=self.scales.omega_from_rpm(rpm))
+        """The drive's speed setpoint, from now plus the command delay."""
+        self._input(self._set_rpm, rpm)
 
     def set_wob_n(self, wob_n: float) -> None:
-        self.sim.set_inputs(w_app=self.scales.w_from_newton(wob_n))
+        """The applied WOB setpoint, from now plus the command delay."""
+        self._input(self._set_wob, wob_n)
 
     def set_motor_torque_nm(self, torque_nm: float) -> None:
-        """The motor torque command of the torque mode (within the drive's limit)."""
-        self.sim.set_motor_torque_nm(torque_nm)
+        """The motor torque command of the torque mode (within the drive's limit), from now
+        plus the command delay."""
+        self._input(self.sim.set_motor_torque_nm, torque_nm)
+
+    def _set_rpm(self, rpm: float) -> None:
+        self.sim.set_inputs(omega_s=self.scales.omega_from_rpm(rpm))
+
+    def _set_wob(self, wob_n: float) -> None:
+        self.sim.set_inputs(w_app=self.scales.w_from_newton(wob_n))
 
     def set_top_drive(self, drive: TopDrivePhysical) -> None:
         """New drive gains, limit and mode (SI) from the next period, without a bump; the
         inertia is fixed for a session."""
         self.sim.set_top_drive(drive.scaled(self.scales))
 
+    def set_formation(self, layers: list[dict]) -> None:
+        """Rock layers by depth below the start (SI keys of model.formation.LAYER_KEYS), from
+        the next period; ``[]``: the preset's rock throughout."""
+        self.sim.set_formation(layers_from_dicts(layers, self.cfg.preset.rock) if layers
+                               else ())
+
     def reset(self) -> None:
         """Model back to its initial state and setpoints; the simulated clock runs on."""
         self.sim.reset()
         self.sensors.reset()
+        self._in_transit.clear()
         self._snapshots.clear()
         self._bucket_end = self.next_index + self._bucket_samples

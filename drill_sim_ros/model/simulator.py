@@ -15,9 +15,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from drill_sim_ros.model import kernel as k
+from drill_sim_ros.model import string as sg
 from drill_sim_ros.model import top_drive as td
 from drill_sim_ros.model.analysis import TrivialSolution, trivial_solution
 from drill_sim_ros.model.errors import HistoryOverflow, NumericalFault, ParameterError
+from drill_sim_ros.model.formation import Layer
 from drill_sim_ros.model.params import UNIT_SCALES, DimensionlessParams, Scales
 
 METHODS = ("profile", "exact")
@@ -70,6 +72,9 @@ class Snapshot:
     depth_offset: float
     angle_offset: float
     top_drive_mode: float = td.TD_KINEMATIC
+    wave: np.ndarray | None = None
+    wave_pos: np.ndarray | None = None
+    layer_index: int = -1
 
 
 @dataclass
@@ -101,22 +106,28 @@ def _check_input(name: str, value: float) -> float:
 
 
 class Simulator:
-    """The RGD07 bit on a torsional spring, stepped with bounded memory.
+    """The RGD07 bit at the bottom of a drill string, stepped with bounded memory.
 
     Starts on the trivial solution (eq. 34) of ``params``, with the history before tau = 0
     being the trivial motion, and the velocity perturbations ``perturb_v`` and
     ``perturb_omega`` added at tau = 0. ``top_drive`` (default: kinematic, the paper's
-    imposed speed) turns the top of the string; ``scales`` (default: unit scales) converts
-    the SI top-drive members.
+    imposed speed) turns the top of the string; ``string`` (default: RGD07's lumped spring)
+    is the string in kernel units (:func:`string.kernel_string`); ``scales`` (default: unit
+    scales) converts the SI top-drive members.
     """
 
     def __init__(self, params: DimensionlessParams, config: SimConfig | None = None,
                  perturb_v: float = 0.0, perturb_omega: float = 0.0,
-                 top_drive: td.TopDrive | None = None, scales: Scales = UNIT_SCALES) -> None:
+                 top_drive: td.TopDrive | None = None, scales: Scales = UNIT_SCALES,
+                 string: sg.KernelString = sg.LUMPED) -> None:
         self.params = params
         self.config = config or SimConfig()
         self.top_drive = top_drive or td.TopDrive()
         self.scales = scales
+        self.string = string
+        self._layers: tuple[Layer, ...] = ()
+        self._layer_index = -1
+        self._wave_layout()
         for name, value in (("perturb_v", perturb_v), ("perturb_omega", perturb_omega)):
             if not math.isfinite(value):
                 raise ParameterError(f"parameter '{name}' = {value!r} must be finite")
@@ -142,6 +153,49 @@ class Simulator:
         self._prm[k.P_TD_KP] = d.kp
         self._prm[k.P_TD_KI] = d.ki
         self._prm[k.P_TD_MAX_TORQUE] = d.max_torque
+        self._prm[k.P_TD_LAG_ALPHA] = d.lag_alpha(c.dtau)
+        self._prm[k.P_CUT] = 1.0
+        self._prm[k.P_LAYER_U] = math.inf
+        s = self.string
+        self._prm[k.P_STRING] = s.model
+        self._prm[k.P_PARTS_T] = self._parts[0] if self._parts else 0
+        self._prm[k.P_BIT_INERTIA] = s.bit_inertia
+        self._prm[k.P_HOOK_KP] = s.hook_kp
+        self._prm[k.P_HOOK_KI] = s.hook_ki
+        self._prm[k.P_BHA_PART] = s.bha_part
+
+    def _wave_layout(self) -> None:
+        """The delay lines of a distributed string at this step (none for the lumped one);
+        every part must span at least one step."""
+        if self.string.model != sg.STRING_DISTRIBUTED:
+            self._wave_i, self._wave_f, self._parts = k.NO_WAVE_I, k.NO_WAVE_F, ()
+            self._wave = k.NO_WAVE
+            return
+        self._wave_i, self._wave_f, self._wave, self._parts = sg.build_lines(
+            self.string.lines, self.config.dtau)
+        if self._wave_i[sg.W_LEN].min() < 1:
+            raise ParameterError(
+                f"a string section (or damping part) is shorter than one time step "
+                f"(dtau = {self.config.dtau:g}); lengthen it, merge it with its neighbour or "
+                "lower string.damping_points")
+
+    @property
+    def distributed(self) -> bool:
+        return self.string.model == sg.STRING_DISTRIBUTED
+
+    def _init_wave(self, triv: TrivialSolution) -> None:
+        """Steady drilling along the string: the trivial torque and speed everywhere, the
+        applied weight and the trivial rate of penetration axially; the hook feeds at it."""
+        if not self.distributed:
+            return
+        self._wave_i[sg.W_POS] = 0
+        parts_t = self._parts[0]
+        sg.fill_uniform(self._wave, self._wave_i, self._wave_f, 0, parts_t, triv.torque,
+                        self.params.omega0)
+        sg.fill_uniform(self._wave, self._wave_i, self._wave_f, parts_t,
+                        self._wave_i.shape[1], self.params.w0, triv.v)
+        self._state[k.S_V_HOOK] = triv.v
+        self._state[k.S_HOOK_INTEGRAL] = triv.v
 
     @property
     def trivial(self) -> TrivialSolution:
@@ -170,6 +224,8 @@ class Simulator:
         self._unchecked_steps = 0
         self._init_profile(triv)
         self._init_history(triv)
+        self._init_wave(triv)
+        self.set_formation(self._layers)
         self.fault: str | None = None
 
     def _init_profile(self, triv: TrivialSolution) -> None:
@@ -263,6 +319,7 @@ class Simulator:
         self._prm[k.P_TD_KP] = drive.kp
         self._prm[k.P_TD_KI] = drive.ki
         self._prm[k.P_TD_MAX_TORQUE] = drive.max_torque
+        self._prm[k.P_TD_LAG_ALPHA] = drive.lag_alpha(self.config.dtau)
         self.set_top_drive_mode(drive.mode)
 
     def set_speed_setpoint_rad_s(self, speed_rad_s: float) -> None:
@@ -331,9 +388,59 @@ class Simulator:
             raise ParameterError(f"n_steps = {n_steps!r} must be >= 0")
         self._open_run(n_steps)
         kernel = k.advance_and_sample if sample_end else k.advance
-        status, written = kernel(*self._kernel_arrays(), out, n_steps, every, self.exact)
+        written, left = 0, n_steps
+        while True:
+            start = self.steps
+            status, rows = kernel(*self._kernel_arrays(), out[written:], *self._wave_arrays(),
+                                  left, every, self.exact)
+            written += rows
+            left -= self.steps - start
+            if status != k.STATUS_LAYER:
+                break
+            self._next_layer()
+            if left == 0:
+                if sample_end:                 # the end sample is still due
+                    status, rows = kernel(*self._kernel_arrays(), out[written:],
+                                          *self._wave_arrays(), 0, every, self.exact)
+                    written += rows
+                else:
+                    status = k.STATUS_OK
+                break
         self._close_run(n_steps, status)
         return written
+
+    # ---- formation layers (model.formation) --------------------------------------------
+    def set_formation(self, layers: tuple[Layer, ...]) -> None:
+        """Rock layers by depth (kernel terms, tops in L* below the start); the layer the bit
+        is in now applies from the next step, the others where the bit reaches their top.
+        An empty tuple is the preset's rock throughout."""
+        self._layers = layers
+        self._layer_index = -1
+        depth = self._state[k.S_U] + self._depth_offset
+        while (self._layer_index + 1 < len(layers)
+               and layers[self._layer_index + 1].top <= depth):
+            self._layer_index += 1
+        self._apply_layer()
+
+    def _apply_layer(self) -> None:
+        """The bit law's rock parameters of the current layer and the next layer's top."""
+        layers, i, p = self._layers, self._layer_index, self.params
+        layer = layers[i] if i >= 0 else None
+        self._prm[k.P_CUT] = 1.0 if layer is None else layer.cut_factor
+        self._prm[k.P_BETA] = p.beta if layer is None else layer.beta
+        self._prm[k.P_LAM] = p.lam if layer is None else layer.lam
+        self._prm[k.P_LAYER_U] = (layers[i + 1].top - self._depth_offset
+                                  if i + 1 < len(layers) else math.inf)
+
+    @property
+    def layer_index(self) -> int:
+        """The formation layer the bit is in (-1: the preset's rock, above the first)."""
+        return self._layer_index
+
+    def _next_layer(self) -> None:
+        """The bit reached the next layer's top (kernel STATUS_LAYER)."""
+        self._layer_index += 1
+        self._apply_layer()
 
     def sample_into(self, out: np.ndarray) -> None:
         """The sample of the current state into ``out`` (one row of ``kernel.C_*`` columns,
@@ -341,8 +448,12 @@ class Simulator:
         read from one step of copies of the state, so the simulator itself does not move."""
         if self.fault is not None:
             raise NumericalFault(f"simulator faulted ({self.fault}); call reset()")
-        k.advance_and_sample(*self._kernel_arrays(), out.reshape(1, k.N_COLS), 0, 0,
-                             self.exact)
+        k.advance_and_sample(*self._kernel_arrays(), out.reshape(1, k.N_COLS),
+                             *self._wave_arrays(), 0, 0, self.exact)
+
+    def _wave_arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The arguments of ``kernel.advance`` after ``out``: the string's delay lines."""
+        return self._wave, self._wave_i, self._wave_f
 
     def _kernel_arrays(self) -> tuple[np.ndarray, ...]:
         """The arguments of ``kernel.advance`` before ``out``: state, parameters, targets,
@@ -384,6 +495,13 @@ class Simulator:
         if status == k.STATUS_HISTORY_FULL:
             self.fault = "exact-delay history full"
             raise HistoryOverflow(f"{self.fault}: raise SimConfig.history_capacity")
+        if status == k.STATUS_RUNAWAY:
+            st = self._state
+            self.fault = (f"runaway at tau = {self.tau:.6g}: bit speed {st[k.S_OMEGA]:.6g}, "
+                          f"drive speed {st[k.S_OMEGA_S]:.6g}, motor torque "
+                          f"{st[k.S_MOTOR_TORQUE]:.6g} (scaled): the bit would pass a whole "
+                          "blade sector in one step")
+            raise NumericalFault(self.fault)
 
     def _rebase(self) -> None:
         """Shift depth and angles by whole amounts so differences stay exact (U grows)."""
@@ -396,6 +514,7 @@ class Simulator:
             if self._hist is not None:
                 self._hist[1] -= shift
             self._depth_offset += shift
+            self._apply_layer()                # the next top, in the new depth frame
         if abs(st[k.S_PHI]) > REBASE_DEPTH:
             turns = 2.0 * math.pi * math.floor(st[k.S_PHI] / (2.0 * math.pi))
             st[k.S_PHI] -= turns
@@ -404,13 +523,76 @@ class Simulator:
                 self._hist[0] -= turns
             self._angle_offset += turns
 
+    # ---- the string along depth (distributed) -----------------------------------------
+    def string_profile(self, axial: bool = False
+                       ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The string now, top to bottom, one value per cell of its delay lines:
+        ``(depth_m, speed, force)`` with depth below the top in m, the speed (angular,
+        rad/s; axial, m/s) and the torque (N m) or axial force above the hanging weight (N),
+        in SI through :attr:`scales`. Empty arrays for the lumped string."""
+        if not self.distributed:
+            empty = np.zeros(0)
+            return empty, empty, empty
+        parts_t = self._parts[0]
+        lo, hi = (parts_t, self._wave_i.shape[1]) if axial else (0, parts_t)
+        force, speed, _ = sg.line_state(self._wave, self._wave_i, self._wave_f, lo, hi)
+        depth = sg.cell_depths_m(self.string.lines[1 if axial else 0], self._wave_i, lo)
+        sc = self.scales
+        if axial:
+            return depth, speed * sc.length_m / sc.time_s, force * sc.force_n
+        return depth, speed / sc.time_s, force * sc.torque_nm
+
+    def top_waves(self) -> tuple[float, float]:
+        """The torsional waves at the top of the string now, kernel units: (a, the one the
+        drive sent down last step; b, the one arriving from below)."""
+        wave, wave_i = self._wave, self._wave_i
+        off, n, pos = (int(wave_i[sg.W_OFF, 0]), int(wave_i[sg.W_LEN, 0]),
+                       int(wave_i[sg.W_POS, 0]))
+        return float(wave[off + (pos - 1) % n]), float(wave[off + n + pos])
+
+    def string_energy(self) -> float:
+        """Kinetic + strain energy of the distributed string now, in kernel units (torque
+        unit C x rad for the torsional line, force unit x L* for the axial one)."""
+        if not self.distributed:
+            return 0.0
+        parts_t, dtau = self._parts[0], self.config.dtau
+        return (sg.line_energy(self._wave, self._wave_i, self._wave_f, 0, parts_t, dtau)
+                + sg.line_energy(self._wave, self._wave_i, self._wave_f, parts_t,
+                                 self._wave_i.shape[1], dtau))
+
+    def hang_off_bottom(self, anechoic: bool = False) -> None:
+        """The bit hangs free off bottom (no bit-rock forces), the hook is fixed, and the
+        string is at rest: no twist, no torque, no axial motion, turning at the drive's
+        speed, as the string instruments start (``drill_sim modes``, ``reflection``).
+        ``anechoic``: the torsional line's bottom sends nothing back up (a matched end)."""
+        self._prm[k.P_OFF_BOTTOM] = 2.0 if anechoic else 1.0
+        st = self._state
+        if self.distributed:
+            parts_t = self._parts[0]
+            sg.fill_uniform(self._wave, self._wave_i, self._wave_f, 0, parts_t, 0.0,
+                            st[k.S_OMEGA_S])
+            sg.fill_uniform(self._wave, self._wave_i, self._wave_f, parts_t,
+                            self._wave_i.shape[1], 0.0, 0.0)
+        st[k.S_PHI_S] = st[k.S_PHI]
+        st[k.S_OMEGA] = st[k.S_OMEGA_S]
+        st[k.S_TD_INTEGRAL] = st[k.S_MOTOR_TORQUE] = 0.0
+        st[k.S_V] = st[k.S_V_HOOK] = st[k.S_HOOK_INTEGRAL] = 0.0
+        self._targets[k.I_MOTOR_TORQUE] = 0.0
+
+    def string_arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, tuple[int, ...]]:
+        """The delay lines as they are (wave, layout int, layout float, parts per line), for
+        instruments that send a pulse into the string; writes to ``wave`` are the state."""
+        return self._wave, self._wave_i, self._wave_f, self._parts
+
     # ---- state access -----------------------------------------------------------------
     def snapshot(self) -> Snapshot:
         """A deep copy of the whole state; :meth:`restore` resumes it bit-for-bit."""
         return Snapshot(self._state.copy(), self._targets.copy(), self._profile.copy(),
                         self._acc.copy(), None if self._hist is None else self._hist.copy(),
                         None if self._meta is None else self._meta.copy(),
-                        self._depth_offset, self._angle_offset, float(self._prm[k.P_TD_MODE]))
+                        self._depth_offset, self._angle_offset, float(self._prm[k.P_TD_MODE]),
+                        *((self._wave.copy(), self._wave_i[sg.W_POS].copy())
+                          if self.distributed else (None, None)), self._layer_index)
 
     def restore(self, snap: Snapshot) -> None:
         """Resume from a :meth:`snapshot` of a simulator with the same settings."""
@@ -425,6 +607,13 @@ class Simulator:
         self._depth_offset = snap.depth_offset
         self._angle_offset = snap.angle_offset
         self._prm[k.P_TD_MODE] = snap.top_drive_mode
+        self._layer_index = min(snap.layer_index, len(self._layers) - 1)
+        self._apply_layer()
+        if snap.wave is not None and self.distributed:
+            if snap.wave.shape != self._wave.shape:
+                raise ParameterError("snapshot string layout differs from this simulator's")
+            self._wave = snap.wave.copy()
+            self._wave_i[sg.W_POS] = snap.wave_pos
         self.fault = None
 
     @property

@@ -41,6 +41,8 @@ TELEMETRY_FIELDS = (
     "motor_torque_measured_nm",    # the drive's torque estimate
     "string_torque_measured_nm",   # torque sub at the quill
     "command_stamp_s",             # stamp of the drill/cmd/top_drive command in force (-1: none)
+    "hook_load_measured_n",        # deadline load cell (model.measurement)
+    "applied_wob_estimate_n",      # the driller's WOB: submerged weight - measured hook load
 )
 TELEMETRY_INDEX = {name: i for i, name in enumerate(TELEMETRY_FIELDS)}
 N_FIELDS = len(TELEMETRY_FIELDS)
@@ -58,7 +60,8 @@ _SOURCE_FIELDS = np.array([F[name] for name in SOURCE_COLUMNS], dtype=np.int64)
 _SOURCE_KERNEL_COLUMNS = np.array(list(SOURCE_COLUMNS.values()), dtype=np.int64)
 # The measured surface signals, in model.measurement.SIGNALS order, and their truth.
 MEASURED = [F["drive_speed_measured_rad_s"], F["motor_torque_measured_nm"],
-            F["string_torque_measured_nm"]]
+            F["string_torque_measured_nm"], F["hook_load_measured_n"]]
+_WOB_ESTIMATE = F["applied_wob_estimate_n"]
 _DEPTH = F["bit_depth_m"]
 _ANGLES = [F["bit_angle_rad"], F["surface_angle_rad"]]
 
@@ -124,6 +127,8 @@ def _fill_si(samples: np.ndarray, depth_offset: float, angle_offset: float,
         row[_MEASURED[0]] = row[_SURFACE_RPM] / RPM_PER_RAD_S
         row[_MEASURED[1]] = row[_MOTOR]
         row[_MEASURED[2]] = row[_STRING]
+        row[_MEASURED[3]] = row[_HOOK]
+        row[_WOB_ESTIMATE] = submerged_weight_n - row[_HOOK]
 
 
 @njit(cache=True)
@@ -148,7 +153,15 @@ def stamped_si_rows(samples: np.ndarray, depth_offset: float, angle_offset: floa
 
 
 def surface_truth(rows: np.ndarray) -> np.ndarray:
-    """The true surface signals of SI rows, shape (rows, 3): drive speed rad/s, motor torque
-    N m, string torque at the quill N m (``model.measurement.SIGNALS`` order)."""
+    """The true surface signals of SI rows, shape (rows, 4): drive speed rad/s, motor torque
+    N m, string torque at the quill N m, hook load N (``model.measurement.SIGNALS`` order)."""
     return np.column_stack([rows[:, F["surface_rpm"]] / RPM_PER_RAD_S,
-                            rows[:, F["motor_torque_nm"]], rows[:, F["surface_torque_nm"]]])
+                            rows[:, F["motor_torque_nm"]], rows[:, F["surface_torque_nm"]],
+                            rows[:, F["hook_load_n"]]])
+
+
+def set_measured(rows: np.ndarray, measured: np.ndarray, submerged_weight_n: float) -> None:
+    """Write the measured surface signals (shape (rows, 4), ``SIGNALS`` order) into SI
+    ``rows`` and the applied-WOB estimate from the measured hook load."""
+    rows[:, MEASURED] = measured
+    rows[:, _WOB_ESTIMATE] = submerged_weight_n - rows[:, F["hook_load_measured_n"]]

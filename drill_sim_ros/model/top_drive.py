@@ -96,13 +96,44 @@ def drive_acceleration(motor: float, t_string: float, inertia: float) -> float:
     return (motor - t_string) / inertia
 
 
+@njit(cache=True, inline="always")
+def motor_lag(previous: float, command: float, alpha: float) -> float:
+    """First-order motor torque lag (the drive's torque bandwidth): the torque moves by
+    ``alpha = 1 - exp(-dtau / lag)`` of the way to the command each step (1: no lag)."""
+    if alpha >= 1.0:
+        return command
+    return previous + alpha * (command - previous)
+
+
+@njit(cache=True, inline="always")
+def drive_step(mode: int, omega_s: float, omega_ref: float, integral: float, motor: float,
+               t_string: float, tgt_omega: float, tgt_torque: float, omega_rate: float,
+               inertia: float, kp: float, ki: float, max_torque: float, lag_alpha: float,
+               dt: float) -> tuple[float, float, float, float]:
+    """One step of the drive in its mode, against the string torque ``t_string`` at the
+    quill: ``(omega_s at the end of the step, omega_ref, integral, motor torque)``."""
+    if mode == TD_KINEMATIC:                  # the paper's imposed speed
+        omega_next = ramp(omega_s, tgt_omega, omega_rate, dt)
+        return omega_next, omega_next, integral, kinematic_torque(omega_s, omega_next,
+                                                                  t_string, inertia, dt)
+    omega_ref = ramp(omega_ref, tgt_omega, omega_rate, dt)   # an inertia turned by a motor
+    if mode == TD_SPEED:
+        command, integral = speed_loop(omega_ref, omega_s, integral, kp, ki, max_torque, dt)
+    else:
+        command = torque_command(tgt_torque, max_torque)
+    motor = motor_lag(motor, command, lag_alpha)
+    return (omega_s + drive_acceleration(motor, t_string, inertia) * dt, omega_ref, integral,
+            motor)
+
+
 # ---- parameters -------------------------------------------------------------------------
 @dataclass(frozen=True)
 class TopDrive:
     """The drive in the paper's scaling (see the module docstring).
 
     mode: 'kinematic' | 'speed' | 'torque'; inertia_ratio: J / I; kp: kp_SI / (C t*);
-    ki: ki_SI / C; max_torque: max_SI / C (inf: no limit).
+    ki: ki_SI / C; max_torque: max_SI / C (inf: no limit); motor_lag: time constant of the
+    first-order motor torque lag (the drive's torque bandwidth), in t* (0: none).
     The defaults are the field preset's drive (J = 2900 kg m^2 on I = 207 kg m^2).
     """
 
@@ -111,9 +142,13 @@ class TopDrive:
     kp: float = 83.0
     ki: float = 123.0
     max_torque: float = math.inf
+    motor_lag: float = 0.0
 
     def __post_init__(self) -> None:
         mode_index(self.mode)
+        if not (math.isfinite(self.motor_lag) and self.motor_lag >= 0.0):
+            raise ParameterError(f"parameter 'top_drive.motor_lag' = {self.motor_lag!r} must "
+                                 "be finite and >= 0")
         for name in ("inertia_ratio", "max_torque"):
             value = getattr(self, name)
             if math.isnan(value) or value <= 0.0:
@@ -135,7 +170,12 @@ class TopDrive:
         c, t_star = scales.torque_nm, scales.time_s
         return TopDrivePhysical(mode=self.mode, inertia_kg_m2=self.inertia_ratio * c * t_star**2,
                                 kp_nm_s=self.kp * c * t_star, ki_nm=self.ki * c,
-                                max_torque_nm=self.max_torque * c)
+                                max_torque_nm=self.max_torque * c,
+                                motor_lag_s=self.motor_lag * t_star)
+
+    def lag_alpha(self, dtau: float) -> float:
+        """The lag's share per step, 1 - exp(-dtau / lag) (1: no lag)."""
+        return 1.0 if self.motor_lag == 0.0 else -math.expm1(-dtau / self.motor_lag)
 
 
 @dataclass(frozen=True)
@@ -143,7 +183,8 @@ class TopDrivePhysical:
     """The drive in SI, referred to the quill.
 
     mode; inertia_kg_m2: J; kp_nm_s: proportional gain, N m per rad/s; ki_nm: integral gain,
-    N m per rad; max_torque_nm: motor torque limit, N m.
+    N m per rad; max_torque_nm: motor torque limit, N m; motor_lag_s: time constant of the
+    first-order lag of the motor torque behind its command (VFD torque bandwidth), s.
     """
 
     mode: str = "speed"
@@ -151,13 +192,15 @@ class TopDrivePhysical:
     kp_nm_s: float = 23_200.0
     ki_nm: float = 46_400.0
     max_torque_nm: float = 50_000.0
+    motor_lag_s: float = 0.0
 
     def scaled(self, scales: Scales) -> TopDrive:
         """The paper's scaling: I = C t*^2, so j = J / (C t*^2) (eqs. 19-20)."""
         c, t_star = scales.torque_nm, scales.time_s
         return TopDrive(mode=self.mode, inertia_ratio=self.inertia_kg_m2 / (c * t_star**2),
                         kp=self.kp_nm_s / (c * t_star), ki=self.ki_nm / c,
-                        max_torque=self.max_torque_nm / c)
+                        max_torque=self.max_torque_nm / c,
+                        motor_lag=self.motor_lag_s / t_star)
 
 
 def _from_dict(cls: type, values: dict[str, Any]) -> Any:

@@ -21,7 +21,8 @@ from drill_sim_ros.model.errors import ParameterError
 from drill_sim_ros.model.params import DimensionlessParams, PhysicalParams
 from drill_sim_ros.model.top_drive import MODES, TopDrive, TopDrivePhysical
 
-PRESET_SECTIONS = ("description", "physical", "dimensionless", "numerics", "top_drive")
+PRESET_SECTIONS = ("description", "physical", "dimensionless", "numerics", "top_drive",
+                   "string")      # 'string' is checked by model.presets (string_from_dict)
 INTEGER_KEYS = frozenset({"n", "n_blades", "n_nodes"})
 STRING_KEYS = frozenset({"mode"})
 NUMERICS_KEYS = ("dtau", "n_nodes")

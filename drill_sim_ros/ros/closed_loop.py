@@ -98,6 +98,10 @@ def run_over_dds(scenario: Scenario,
                  progress: Callable[[int, int], None] | None = None,
                  timeout_s: float | None = None) -> ClosedLoopRun:
     """Run ``scenario`` over DDS; the telemetry of the recording, t = 0 sample first."""
+    scenario.check_supported()
+    if scenario.overrides:
+        raise DrillSimError("over DDS, a scenario's 'overrides' do not reach sim_node: put "
+                            "them in a preset file and name it in 'preset'")
     preset = scenario.load_preset()
     periods = scenario.periods
     timeout_s = timeout_s or 120.0 + periods / 50.0

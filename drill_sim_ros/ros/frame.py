@@ -36,12 +36,15 @@ BIT_JOINT_VALUES = (("bit_angle_rad", False), ("bit_depth_m", False), ("bit_rpm"
                     ("rop_m_s", False), ("tob_nm", False), ("wob_n", False))
 SURFACE_JOINT_VALUES = (("surface_angle_rad", False), ("bit_depth_m", False),
                         ("surface_rpm", True), ("rop_m_s", False),
-                        ("surface_torque_nm", False), ("hook_load_n", False))
+                        ("surface_torque_nm", False), ("applied_wob_n", False))
 MEASURED_JOINT_VALUES = (("surface_angle_rad", False), ("surface_angle_rad", False),
+                         ("bit_depth_m", False), ("bit_depth_m", False),
                          ("drive_speed_measured_rad_s", False),
                          ("drive_speed_measured_rad_s", False),
+                         ("rop_m_s", False), ("rop_m_s", False),
                          ("motor_torque_measured_nm", False),
-                         ("string_torque_measured_nm", False))
+                         ("string_torque_measured_nm", False),
+                         ("hook_load_measured_n", False), ("applied_wob_estimate_n", False))
 SAMPLE_TOPICS = (*FLOAT64_TOPICS, topics.BIT_MODE, topics.BIT_JOINT_STATES,
                  topics.SURFACE_JOINT_STATES, topics.SURFACE_MEASURED, topics.TELEMETRY)
 TELEMETRY_LABEL = ",".join(TELEMETRY_FIELDS)

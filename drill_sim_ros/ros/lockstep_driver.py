@@ -21,6 +21,7 @@ from collections.abc import Callable
 from typing import Any
 
 import numpy as np
+from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
 from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.serialization import deserialize_message
@@ -60,13 +61,14 @@ def telemetry_sample(raw: bytes) -> tuple[np.ndarray, int]:
 
 
 def measured_sample(raw: bytes) -> tuple[SurfaceMeasurement, int]:
-    """A drill/surface/measured payload (joints top_drive, quill: MEASURED_JOINTS):
-    (measurement, stamp ns)."""
+    """A drill/surface/measured payload (joints top_drive, quill, hook, wob_estimate:
+    MEASURED_JOINTS): (measurement, stamp ns)."""
     msg = deserialize_message(raw, JointState)
     time_ns = stamp_ns(msg.header.stamp)
     return SurfaceMeasurement(time_s=time_ns / 1e9, drive_speed_rad_s=msg.velocity[0],
                               motor_torque_nm=msg.effort[0],
-                              string_torque_nm=msg.effort[1]), time_ns
+                              string_torque_nm=msg.effort[1], hook_load_n=msg.effort[2],
+                              applied_wob_estimate_n=msg.effort[3]), time_ns
 
 
 SAMPLE_DECODERS = {topics.TELEMETRY: telemetry_sample, topics.SURFACE_MEASURED: measured_sample}
@@ -95,7 +97,10 @@ class LockstepDriver(Node):
         msg_type = JointState if sample_topic == topics.SURFACE_MEASURED else Float64MultiArray
         self._sub = self.create_subscription(msg_type, topics.node_relative(sample_topic),
                                              self._on_sample, LOCKSTEP_QOS, raw=True)
-        self._start = self.create_timer(0.05, self._start_when_matched)
+        # steady: with use_sim_time the ROS clock stands still until the sim publishes,
+        # and the sim publishes only after this first command (command lockstep)
+        self._start = self.create_timer(0.05, self._start_when_matched,
+                                        clock=Clock(clock_type=ClockType.STEADY_TIME))
 
     @property
     def done(self) -> bool:

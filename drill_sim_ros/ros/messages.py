@@ -34,7 +34,8 @@ def stamp_ns(time: Time) -> int:
     return time.sec * NS_PER_S + time.nanosec
 
 
-def status(name: str, level: bytes, message: str, values: dict[str, str]) -> DiagnosticStatus:
+def status(name: str, level: bytes, message: str, values: dict[str, str],
+           hardware_id: str = HARDWARE_ID) -> DiagnosticStatus:
     """A DiagnosticStatus with ``values`` as key/value pairs."""
-    return DiagnosticStatus(level=level, name=name, message=message, hardware_id=HARDWARE_ID,
+    return DiagnosticStatus(level=level, name=name, message=message, hardware_id=hardware_id,
                             values=[KeyValue(key=k, value=v) for k, v in values.items()])

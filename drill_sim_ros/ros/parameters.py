@@ -89,7 +89,7 @@ def _sensor_specs() -> tuple[ParamSpec, ...]:
     """sensors.<signal>.noise_std / quantum / delay_periods for each surface signal."""
     out = []
     for signal in SIGNALS:
-        unit = "rad/s" if signal.endswith("rad_s") else "N m"
+        unit = {"drive_speed_rad_s": "rad/s", "hook_load_n": "N"}.get(signal, "N m")
         out += [
             ParamSpec(f"sensors.{signal}.noise_std", DOUBLE, 0.0,
                       f"Gaussian noise (standard deviation) of the measured {signal} [{unit}];"
@@ -129,22 +129,31 @@ SPECS: tuple[ParamSpec, ...] = (
               "Default: steel mass x g x (1 - 1200 kg/m3 mud / steel density); 0 for "
               "dimensionless presets.", 0.0, 1e10),
     ParamSpec("limits.max_surface_rpm", DOUBLE, 300.0,
-              "Surface-rpm commands above this [rev/min] are rejected.", 0.0, 1e4),
+              "Surface-rpm commands above this [rev/min] are clamped to it.", 0.0, 1e4),
     ParamSpec("limits.max_wob_n", DOUBLE, _max_wob_n,
-              "WOB commands above this [N] are rejected (default: 10 x the preset's WOB).",
+              "WOB commands above this [N] are clamped to it (default: 10 x the preset's WOB).",
               0.0, 1e9),
     ParamSpec("limits.top_drive_accel_rpm_s", DOUBLE, 0.0,
               "Top-drive acceleration limit [rev/min per s]; 0 = step changes.", 0.0, 1e6,
               read_only=True),
     ParamSpec("limits.wob_rate_n_s", DOUBLE, 0.0,
               "Applied-WOB rate limit [N/s]; 0 = step changes.", 0.0, 1e9, read_only=True),
+    ParamSpec("commands.delay_s", DOUBLE, 0.0,
+              "Transport delay of every setpoint command (drill/cmd/*) [s]: a command "
+              "received at sim time t takes effect at t + delay, at the integrator step "
+              "nearest it, also within a publish period; 0 = from the next step.", 0.0, 60.0,
+              read_only=True),
     ParamSpec("publish_rate_hz", DOUBLE, 100.0,
               "Samples published per second of SIMULATED time.", 1.0, 1000.0, read_only=True),
     ParamSpec("publish_clock", BOOL, True, "Publish /clock (rosgraph_msgs/Clock) in sim time."),
+    ParamSpec("clock_rate_hz", DOUBLE, 100.0,
+              "/clock messages per second of SIMULATED time, on the samples' stamps: at most "
+              "one per sample (at or above publish_rate_hz, every sample).", 1.0, 1000.0,
+              read_only=True),
     ParamSpec("real_time_factor", DOUBLE, 1.0,
               "Simulated seconds per wall second; 0 = as fast as possible.", 0.0, 1000.0),
     ParamSpec("lockstep", BOOL, False,
-              "Advance only on ~/step (one publish period per call); deterministic."),
+              "Advance one publish period per trigger (lockstep_trigger) only; deterministic."),
     ParamSpec("lockstep_trigger", STRING, "service",
               "What advances one period in lockstep: 'service' (a ~/step call) or 'command' "
               "(each message on drill/cmd/top_drive, applied first).",
@@ -184,6 +193,9 @@ SPECS: tuple[ParamSpec, ...] = (
     ParamSpec("diagnostics.window_s", DOUBLE, 20.0,
               "Simulated seconds of bit speed behind the stick-slip severity on /diagnostics.",
               0.1, 3600.0, read_only=True),
+    ParamSpec("diagnostics.command_timeout_s", DOUBLE, 1.0,
+              "Once a drill/cmd/top_drive command came, /diagnostics warns (controller "
+              "silent) when none follows for this many SIMULATED seconds; 0 = never.", 0.0, 1e6),
     ParamSpec("status_line", BOOL, True,
               "Show one live status line when stderr is a terminal."),
 )

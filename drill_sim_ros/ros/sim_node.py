@@ -45,13 +45,13 @@ from drill_sim_ros.model.measurement import SIGNALS, RigSensors, SignalSpec
 from drill_sim_ros.model.params import RPM_PER_RAD_S
 from drill_sim_ros.model.presets import load_preset
 from drill_sim_ros.model.session import Block, SessionConfig, SimSession
-from drill_sim_ros.model.telemetry import MODE_NAMES, TELEMETRY_INDEX
+from drill_sim_ros.model.telemetry import MODE_NAMES, NS_PER_S, TELEMETRY_INDEX
 from drill_sim_ros.model.top_drive import TopDrivePhysical
 from drill_sim_ros.realtime.pacing import Pacer, RateMeter
 from drill_sim_ros.realtime.ticker import HandoffLock, Ticker
-from drill_sim_ros.ros import messages
+from drill_sim_ros.ros import messages, typed
 from drill_sim_ros.ros.command_types import ForeignCommandTypes
-from drill_sim_ros.ros.diagnostics import Figures, diagnostics
+from drill_sim_ros.ros.diagnostics import Diagnostics, Figures, source_of
 from drill_sim_ros.ros.frame import SAMPLE_TOPICS
 from drill_sim_ros.ros.messages import RUN_INFO_QOS, stamp_ns
 from drill_sim_ros.ros.parameters import (
@@ -62,7 +62,7 @@ from drill_sim_ros.ros.parameters import (
     recording_options,
     validate,
 )
-from drill_sim_ros.ros.sinks import SampleSinks
+from drill_sim_ros.ros.sinks import SampleSinks, TypedTelemetry
 from drill_sim_ros.terminal import StatusLine, format_status
 
 RCLError = rclpy_implementation.RCLError
@@ -95,7 +95,8 @@ def session_config(values: dict[str, Any], preset: Any) -> SessionConfig:
         top_drive_accel_rpm_s=values["limits.top_drive_accel_rpm_s"],
         wob_rate_n_s=values["limits.wob_rate_n_s"], window_s=values["diagnostics.window_s"],
         submerged_weight_n=values["model.submerged_string_weight_n"],
-        top_drive=top_drive(values), sensors=rig_sensors(values))
+        top_drive=top_drive(values), sensors=rig_sensors(values),
+        command_delay_s=values["commands.delay_s"])
 
 
 def top_drive(values: dict[str, Any]) -> TopDrivePhysical:
@@ -119,6 +120,18 @@ def rig_sensors(values: dict[str, Any]) -> RigSensors:
 # (joint, interface) of drill/cmd/top_drive -> the Command field it sets
 COMMAND_INTERFACES = {("top_drive", "velocity"): "speed_rad_s",
                       ("top_drive", "effort"): "motor_torque_nm", ("hook", "effort"): "wob_n"}
+
+
+def malformed_joint_state(msg: JointState) -> str | None:
+    """Why a drill/cmd/top_drive message cannot be read joint by joint (None: it can): each
+    of position, velocity and effort must be empty or as long as ``name``."""
+    lengths = {"position": len(msg.position), "velocity": len(msg.velocity),
+               "effort": len(msg.effort)}
+    wrong = [f"{array} has {n}" for array, n in lengths.items() if n not in (0, len(msg.name))]
+    if not wrong:
+        return None
+    return (f"{len(msg.name)} names but {', '.join(wrong)} values (each array is empty or "
+            "one value per name)")
 
 
 def joint_commands(msg: JointState) -> dict[tuple[str, str], float]:
@@ -153,6 +166,9 @@ class SimNode(Node):
         self.recording_failed = False
         self.rejected_commands = 0
         self.saturated_commands = 0
+        self._last_command_ns: int | None = None     # sim time of the last top_drive command
+        self._diagnostics = Diagnostics(source_of(self.get_fully_qualified_name(),
+                                                  self.get_namespace()))
         self._last_row: np.ndarray | None = None     # SI, TELEMETRY_FIELDS; lock held
         self._pubs = {t: self.create_publisher(messages.type_of(t), topics.node_relative(t),
                                                self._qos(t), event_callbacks=QUIET_PUBLISHER)
@@ -168,6 +184,7 @@ class SimNode(Node):
             self._command_names[topic] = sub.topic_name
         self._foreign_commands = ForeignCommandTypes(
             {name: topics.MSG_TYPES[topic] for topic, name in self._command_names.items()})
+        self._typed_pubs = self._add_typed_topics()
         self.create_service(Trigger, "~/reset", self._on_reset)
         self.create_service(SetBool, "~/pause", self._on_pause)
         self.create_service(Trigger, "~/step", self._on_step)
@@ -183,6 +200,25 @@ class SimNode(Node):
         self.add_on_set_parameters_callback(self._validate_parameters)
         self.add_post_set_parameters_callback(self._apply_parameters)
 
+    def _add_typed_topics(self) -> dict[str, Any]:
+        """The drill_sim_msgs twins of the telemetry, run info and command, when that package
+        is installed; returns the typed publishers by topic."""
+        if not typed.AVAILABLE:
+            return {}
+        pubs = {topic: self.create_publisher(msg_type, topics.node_relative(topic), qos,
+                                             event_callbacks=QUIET_PUBLISHER)
+                for topic, msg_type, qos in (
+                    (topics.TYPED_TELEMETRY, typed.Telemetry, DATA_QOS),
+                    (topics.TYPED_RUN_INFO, typed.RunInfo, RUN_INFO_QOS))}
+        rig = self._diagnostics.source.hardware_id
+        self._sinks.typed = TypedTelemetry(pubs[topics.TYPED_TELEMETRY],
+                                           typed.TelemetryPacker(rig))
+        sub = self.create_subscription(typed.TopDriveCommand,
+                                       topics.node_relative(topics.TYPED_CMD_TOP_DRIVE),
+                                       self._on_typed_top_drive, COMMAND_QOS, raw=True)
+        self._command_names[topics.TYPED_CMD_TOP_DRIVE] = sub.topic_name
+        return pubs
+
     # ---- start -------------------------------------------------------------------------
     def start(self) -> None:
         """Build (compile, warm up) the session, open the recording, publish what runs; the
@@ -191,6 +227,7 @@ class SimNode(Node):
             session = SimSession(session_config(self._values, self._preset))
             self._session = session
             self._sinks.warm_up()
+            self._sinks.clock_period_ns = round(NS_PER_S / self._values["clock_rate_hz"])
             self._pacer = Pacer(self._wall_period_ns(self._rtf))
             self._sinks.recorder = self._open_recorder(self._values["record.path"])
             self._publish_run_info()
@@ -202,7 +239,7 @@ class SimNode(Node):
 
     @staticmethod
     def _qos(topic: str) -> QoSProfile:
-        if topic == topics.RUN_INFO:
+        if topic in (topics.RUN_INFO, topics.TYPED_RUN_INFO):
             return RUN_INFO_QOS
         return CLOCK_QOS if topic in (topics.CLOCK, topics.DIAGNOSTICS) else DATA_QOS
 
@@ -215,10 +252,11 @@ class SimNode(Node):
         recorder = InProcessRecorder(path, node_name=topics.NODE_NAME,
                                      metadata=self._run_metadata(),
                                      **recording_options(self._values))
-        for topic, publisher in self._pubs.items():
-            recorder.add_topic(publisher.topic_name, topics.MSG_TYPES[topic], self._qos(topic))
+        types = {**topics.MSG_TYPES, **topics.TYPED_MSG_TYPES}
+        for topic, publisher in {**self._pubs, **self._typed_pubs}.items():
+            recorder.add_topic(publisher.topic_name, types[topic], self._qos(topic))
         for topic, name in self._command_names.items():
-            recorder.add_topic(name, topics.MSG_TYPES[topic], COMMAND_QOS)
+            recorder.add_topic(name, types[topic], COMMAND_QOS)
         self.get_logger().info(f"recording to {path}")
         return recorder
 
@@ -233,6 +271,12 @@ class SimNode(Node):
         """/drill/run_info, latched: what this node runs, as JSON (lock held)."""
         payload = serialize_message(String(data=json.dumps(self._session.run_info())))
         self._sinks.emit_one(topics.RUN_INFO, payload, self._session.sim_time_ns)
+        if topics.TYPED_RUN_INFO in self._typed_pubs:
+            msg = typed.run_info_message(self._session.run_info(), self._values,
+                                         self._session.sim_time_ns,
+                                         self._diagnostics.source.hardware_id)
+            self._sinks.emit_one(topics.TYPED_RUN_INFO, serialize_message(msg),
+                                 self._session.sim_time_ns, self._typed_pubs)
 
     def _log_start(self) -> None:
         s = self._session
@@ -370,15 +414,31 @@ class SimNode(Node):
         advance exactly one period under it."""
         msg = deserialize_message(raw, JointState)
         topic = topics.CMD_TOP_DRIVE
+        if (problem := malformed_joint_state(msg)) is not None:
+            with self._lock.urgent():
+                self._reject(topic, problem)
+            return
         values = joint_commands(msg)
         for joint, interface in set(values) - set(COMMAND_INTERFACES):
             self._reject(topic, f"joint {joint!r} takes no {interface} command "
                                 "(top_drive: velocity, effort; hook: effort)")
         command = Command(**{name: values[key] for key, name in COMMAND_INTERFACES.items()
                              if key in values})
+        self._take_top_drive(topic, command, stamp_ns(msg.header.stamp), raw)
+
+    def _on_typed_top_drive(self, raw: bytes) -> None:
+        """drill/typed/cmd/top_drive: the same command as drill/cmd/top_drive, typed."""
+        msg = deserialize_message(raw, typed.TopDriveCommand)
+        self._take_top_drive(topics.TYPED_CMD_TOP_DRIVE, typed.command_of(msg),
+                             stamp_ns(msg.header.stamp), raw)
+
+    def _take_top_drive(self, topic: str, command: Command, reacts_to_ns: int,
+                        raw: bytes) -> None:
+        """Apply a top-drive command and, in command-triggered lockstep, advance one period."""
         with self._lock.urgent():
             self._apply(topic, command)
-            self._session.command_stamp_ns = stamp_ns(msg.header.stamp)
+            self._last_command_ns = self._session.sim_time_ns     # the controller is alive
+            self._session.command_stamp_ns = reacts_to_ns
             self._record_command(topic, raw)
             if self._command_steps():
                 self._advance(1)
@@ -469,7 +529,7 @@ class SimNode(Node):
         with self._lock.urgent():
             time_ns = self._session.sim_time_ns
             figures = self._figures(time_ns)
-        payload = serialize_message(diagnostics(figures, time_ns))
+        payload = serialize_message(self._diagnostics.message(figures, time_ns))
         self._sinks.emit_one(topics.DIAGNOSTICS, payload, time_ns)
 
     def _figures(self, time_ns: int) -> Figures:
@@ -487,7 +547,10 @@ class SimNode(Node):
             written=self._recorder_count("written"), severity=sev,
             stick_fraction=stick_fraction,
             mode="none" if row is None else MODE_NAMES[int(row[TELEMETRY_INDEX["mode"]])],
-            window_s=self._values["diagnostics.window_s"])
+            window_s=self._values["diagnostics.window_s"],
+            command_silence_s=None if self._last_command_ns is None else
+            (time_ns - self._last_command_ns) * 1e-9,
+            command_timeout_s=self._values["diagnostics.command_timeout_s"])
 
     def _recorder_count(self, name: str) -> int:
         recorder = self._sinks.recorder

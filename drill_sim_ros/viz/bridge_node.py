@@ -1,6 +1,7 @@
 """``rerun_bridge [--save FILE.rrd] [--connect URL] [--serve]``: the live drilling dashboard.
 
-A ROS 2 node that subscribes to ``/drill/telemetry`` (one atomic sample per message, SI) and
+A ROS 2 node that subscribes to ``drill/telemetry`` of its namespace (``-r __ns:=/rig1``:
+``/rig1/drill/telemetry``; one atomic sample per message, SI) and
 logs it on the ``sim_time`` timeline taken from the record's ``sim_time_s``. Queued samples
 are taken and sent with ``send_columns`` ``flush_hz`` times a second. ``--serve`` hosts a
 gRPC server bound to 127.0.0.1 only. ``--connect`` streams to a viewer through a
@@ -24,6 +25,7 @@ from typing import Any
 import numpy as np
 import rclpy
 import rerun as rr
+from rclpy.clock import Clock, ClockType
 from rclpy.context import Context
 from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
@@ -58,6 +60,8 @@ from drill_sim_ros.viz.viewer_link import Progress, ViewerLink
 
 NODE_NAME = "rerun_bridge"
 QUEUE_DEPTH = 1000          # 10 s of telemetry at the sim's default 100 Hz
+# The bridge's inner nodes, which nobody configures: no parameter services, no /rosout.
+HELPER_NODE = {"start_parameter_services": False, "enable_rosout": False}
 
 
 def telemetry_qos(best_effort: bool = False) -> QoSProfile:
@@ -75,9 +79,15 @@ class TelemetryQueue:
     """
 
     def __init__(self, context: Context | None = None, best_effort: bool = False) -> None:
-        self.node = Node(f"{NODE_NAME}_telemetry", context=context)
-        self._sub = self.node.create_subscription(Float64MultiArray, topics.TELEMETRY,
+        self.node = Node(f"{NODE_NAME}_telemetry", context=context, **HELPER_NODE)
+        self._sub = self.node.create_subscription(Float64MultiArray,
+                                                  topics.node_relative(topics.TELEMETRY),
                                                   lambda _msg: None, telemetry_qos(best_effort))
+
+    @property
+    def topic_name(self) -> str:
+        """The resolved telemetry topic (under the bridge's namespace)."""
+        return self._sub.topic_name
 
     def take_all(self, limit: int = 10 * QUEUE_DEPTH) -> list[Float64MultiArray]:
         """Every message queued so far (at most ``limit``), oldest first."""
@@ -109,11 +119,14 @@ class RerunBridge(Node):
         self._dashboard = dashboard
         self._viewer = viewer
         self._queue = TelemetryQueue(self.context, best_effort)
+        self.telemetry_topic = self._queue.topic_name
         self._order: np.ndarray | None = None
         self.dropped = 0
         self._status_period_s = status_period_s
         self._last_status = (time.monotonic(), 0)
-        self.create_timer(1.0 / flush_hz, self.flush)
+        # steady: the dashboard flushes while the sim's /clock (use_sim_time) stands still
+        self.create_timer(1.0 / flush_hz, self.flush,
+                          clock=Clock(clock_type=ClockType.STEADY_TIME))
 
     def _rows(self, messages: list[Float64MultiArray]) -> list[np.ndarray]:
         if self._order is None and messages:
@@ -193,9 +206,10 @@ def run_units(preset: str | None, timeout_s: float = RUN_INFO_WAIT_S) -> PaperUn
     for up to ``timeout_s``); else the default preset's, with a warning naming it."""
     if preset:
         return PaperUnits.load(preset)
-    node = Node("rerun_bridge_run_info")
+    node = Node(f"{NODE_NAME}_run_info", **HELPER_NODE)
     received: list[String] = []
-    node.create_subscription(String, topics.RUN_INFO, received.append, RUN_INFO_QOS)
+    node.create_subscription(String, topics.node_relative(topics.RUN_INFO), received.append,
+                             RUN_INFO_QOS)
     deadline = time.monotonic() + timeout_s
     try:
         while not received and time.monotonic() < deadline:
@@ -204,7 +218,7 @@ def run_units(preset: str | None, timeout_s: float = RUN_INFO_WAIT_S) -> PaperUn
         node.destroy_node()
     if received:
         return PaperUnits.from_run_info(json.loads(received[0].data))
-    node.get_logger().warning(
+    rclpy.logging.get_logger(NODE_NAME).warning(
         f"no {topics.RUN_INFO} within {timeout_s:g} s: the 2D views use the scales of preset "
         f"{DEFAULT_PRESET!r} (override with --preset)")
     return PaperUnits.load(DEFAULT_PRESET)
@@ -325,7 +339,7 @@ def main(argv: list[str] | None = None) -> int:
         outputs = open_outputs(args, logger)
         node = RerunBridge(outputs.dashboard, args.flush_hz, best_effort=args.best_effort,
                            viewer=outputs.viewer)
-        node.get_logger().info(f"ready: {topics.TELEMETRY} -> rerun "
+        node.get_logger().info(f"ready: {node.telemetry_topic} -> rerun "
                                f"(scales of {outputs.dashboard.units.preset or 'the run info'})")
         rclpy.spin(node)
     except (KeyboardInterrupt, ExternalShutdownException):

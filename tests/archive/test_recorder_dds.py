@@ -34,7 +34,7 @@ FLOAT_TOPICS = [f"/drill/test/f{i}" for i in range(9)]
 JOINTS = "/drill/test/joints"
 TOPICS = [*FLOAT_TOPICS, JOINTS]
 RATE_HZ = 100.0
-# The SIGKILL bound stated in docs/README_archive.md: at most 1 s of data lost.
+# The SIGKILL bound stated in docs/archive.md: at most 1 s of data lost.
 MAX_LOSS_S = 1.0
 
 

@@ -49,8 +49,8 @@ def _check(path, samples: int | None) -> None:
         assert {t: counts[t] for t in SAMPLE_TOPICS} == dict.fromkeys(SAMPLE_TOPICS, samples)
     assert counts[topics.RUN_INFO] == 1                 # latched: once, even for a late recorder
     info = recorded_run_info(path)
-    scales = load_preset("field_8p5in_shale").scales
-    assert info["preset"] == "field_8p5in_shale"
+    scales = load_preset("field_8p5in_shale_lumped").scales
+    assert info["preset"] == "field_8p5in_shale_lumped"
     assert (info["t_star_s"], info["l_star_m"], info["force_unit_n"], info["torque_unit_nm"]) \
         == (scales.time_s, scales.length_m, scales.force_n, scales.torque_nm)
 
@@ -63,7 +63,7 @@ def test_lockstep_in_process_recording_is_exact(tmp_path) -> None:
         assert stop(sim, signal.SIGINT) == 0, (tmp_path / "sim.log").read_text()
     _check(path, STEPS + 1)                     # the t = 0 sample, then one per step
     assert "0 dropped" in (tmp_path / "sim.log").read_text()
-    assert recorded_preset(path) == "field_8p5in_shale"     # the default preset
+    assert recorded_preset(path) == "field_8p5in_shale_lumped"     # the default preset
 
 
 def _recorder_ready(node) -> bool:

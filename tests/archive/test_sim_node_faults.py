@@ -130,7 +130,7 @@ def test_in_process_recording_splits_by_simulated_duration(tmp_path) -> None:
     for part in parts:
         counts = counts_mcap_ros2(part)
         assert ArchiveReader(part).summary() is not None
-        assert recorded_preset(part) == "field_8p5in_shale"     # every part stands alone
+        assert recorded_preset(part) == "field_8p5in_shale_lumped"     # every part stands alone
         assert max(counts[t] for t in SAMPLE_TOPICS) <= 10 + 1
         for topic in SAMPLE_TOPICS:
             totals[topic] += counts[topic]

@@ -26,7 +26,7 @@ def drill_sim(*args: str) -> subprocess.CompletedProcess[str]:
 
 def test_json_table_and_plot(tmp_path: Path) -> None:
     png = tmp_path / "cl.png"
-    result = drill_sim("--params", "field_8p5in_shale", "--controller", "z_torque",
+    result = drill_sim("--params", "field_8p5in_shale_lumped", "--controller", "z_torque",
                        "--mode", "torque", "--t-end", "60", "--enable-at", "20", "--json",
                        "--plot", str(png))
     assert result.returncode == 0, result.stderr

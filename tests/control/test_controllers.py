@@ -29,7 +29,7 @@ from drill_sim_ros.model.presets import load_preset
 from drill_sim_ros.model.telemetry import TELEMETRY_INDEX
 
 F = TELEMETRY_INDEX
-PRESET = load_preset("field_8p5in_shale")
+PRESET = load_preset("field_8p5in_shale_lumped")
 RIG = rig_physics(PRESET)
 RPM0 = PRESET.physical.surface_rpm
 ENABLE_S, END_S = 60.0, 180.0

@@ -19,7 +19,7 @@ from drill_sim_ros.model.presets import load_preset
 from drill_sim_ros.model.telemetry import N_FIELDS, TELEMETRY_INDEX
 
 F = TELEMETRY_INDEX
-PRESET = load_preset("field_8p5in_shale")
+PRESET = load_preset("field_8p5in_shale_lumped")
 RIG = rig_physics(PRESET)
 PERIOD_S = 0.01
 
@@ -82,3 +82,20 @@ def test_ssi_is_model_analysis_on_the_same_windows() -> None:
     assert card["ssi_mean"] == pytest.approx(np.mean(by_analysis), rel=1e-12)
     assert card["ssi_max"] == pytest.approx(np.max(by_analysis), rel=1e-12)
     assert card["ssi_last"] == pytest.approx(by_analysis[-1], rel=1e-12)
+
+
+def test_status_stalled_with_its_time_never_null() -> None:
+    rows = synthetic(100.0)
+    t = rows[:, F["sim_time_s"]]
+    end_stuck = t > 80.0                       # stuck from 80.01 s to the end: 20 s
+    rows[end_stuck, F["bit_rpm"]] = 0.0
+    rows[end_stuck, F["mode"]] = 2
+    card = score(rows, 20.0, Schedule(60.0, 60e3), RIG, PERIOD_S)
+    assert card["status"] == "stalled"
+    assert card["stall_time_s"] == pytest.approx(80.01)
+    short = synthetic(100.0)
+    short[t > 95.0, F["mode"]] = 2             # a 5 s stick at the end: a stick phase
+    card = score(short, 20.0, Schedule(60.0, 60e3), RIG, PERIOD_S)
+    assert card["status"] == "stick-slip" and card["stall_time_s"] is None
+    assert score(synthetic(100.0), 20.0, Schedule(60.0, 60e3), RIG,
+                 PERIOD_S)["status"] == "ok"                 # last stick at 45 s

@@ -1,4 +1,4 @@
-"""A user's controller for the bench (the README's example): ``module:Class``."""
+"""A user's controller for the bench (the example of docs/closed-loop.md): ``module:Class``."""
 
 from __future__ import annotations
 

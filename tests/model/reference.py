@@ -89,6 +89,7 @@ def run_reference(state: np.ndarray, profile: np.ndarray, n: float, beta: float,
             r[k.C_WOB], r[k.C_TOB], r[k.C_DOC], r[k.C_WF] = wob, tob, doc, w_f
             r[k.C_T_PIPE], r[k.C_MODE] = torque, mode
             r[k.C_MOTOR_TORQUE], r[k.C_OMEGA_REF] = torque, omega0   # no drive acceleration
+            r[k.C_F_TOP], r[k.C_OMEGA_BHA] = w0, omega     # lumped: the hook holds W0
         u_new, phi_new = u + v_new * dt, phi + omega_new * dt      # eq. (C.1)
         dfrac = (phi_new - phi) * (n_nodes / sector)
         f_start = frac

@@ -16,7 +16,8 @@ from drill_sim_ros.model.telemetry import field_scales, si_rows, surface_truth
 
 def _truth(rows: int = 20_000) -> np.ndarray:
     t = np.arange(rows) * 0.01
-    return np.column_stack([6.0 + np.sin(t), 3000.0 + 500.0 * np.cos(t), 2500.0 + 0.0 * t])
+    return np.column_stack([6.0 + np.sin(t), 3000.0 + 500.0 * np.cos(t), 2500.0 + 0.0 * t,
+                            9e5 - 1e3 * np.sin(t)])
 
 
 def test_perfect_sensors_by_default() -> None:
@@ -31,7 +32,7 @@ def test_noise_has_the_asked_size_and_repeats_with_the_seed() -> None:
     error = measured[:, 1] - truth[:, 1]
     assert error.std() == pytest.approx(50.0, rel=0.02)          # 1/sqrt(2N) = 0.2 %
     assert abs(error.mean()) < 4 * 50.0 / np.sqrt(error.size)
-    assert np.array_equal(measured[:, [0, 2]], truth[:, [0, 2]])  # the others untouched
+    assert np.array_equal(measured[:, [0, 2, 3]], truth[:, [0, 2, 3]])  # the others untouched
     assert np.array_equal(RigSensors(specs, seed=7).measure(truth), measured)
     assert not np.array_equal(RigSensors(specs, seed=8).measure(truth), measured)
 
@@ -63,7 +64,7 @@ def test_blocks_give_the_same_measurements_as_one_call() -> None:
 
 
 def test_surface_truth_of_the_field_preset_in_si() -> None:
-    preset = load_preset("field_8p5in_shale")
+    preset = load_preset("field_8p5in_shale_lumped")
     sim = Simulator(preset.params, SimConfig(dtau=preset.dtau), top_drive=preset.top_drive,
                     scales=preset.scales)
     rows = sim.advance(1000, every=100).data
@@ -79,5 +80,29 @@ def test_bad_sensor_settings_are_named() -> None:
         SignalSpec(noise_std=-1.0)
     with pytest.raises(ParameterError, match="delay_periods"):
         SignalSpec(delay_periods=-2)
-    with pytest.raises(ParameterError, match="hook_load"):
-        RigSensors({"hook_load": SignalSpec()})
+    with pytest.raises(ParameterError, match="bit_rpm"):
+        RigSensors({"bit_rpm": SignalSpec()})
+
+
+def test_hook_load_and_the_wob_estimate_of_a_session() -> None:
+    """The load cell reads the hook load (submerged weight - applied WOB); the driller's WOB
+    estimate is the submerged weight less the measured hook load, so its error is minus the
+    load cell's noise."""
+    from drill_sim_ros.model.session import SessionConfig, SimSession
+    from drill_sim_ros.model.telemetry import TELEMETRY_INDEX as F
+    preset = load_preset("field_8p5in_shale")
+    weight_n = 1.2e6
+    cfg = dict(preset=preset, dtau_max=preset.dtau, submerged_weight_n=weight_n)
+    perfect = SimSession(SessionConfig(**cfg)).run(200).rows
+    np.testing.assert_array_equal(perfect[:, F["hook_load_measured_n"]],
+                                  perfect[:, F["hook_load_n"]])
+    np.testing.assert_allclose(perfect[:, F["applied_wob_estimate_n"]],
+                               perfect[:, F["applied_wob_n"]], rtol=1e-12)
+    noisy = SimSession(SessionConfig(**cfg, sensors=RigSensors(
+        {"hook_load_n": SignalSpec(noise_std=500.0)}, seed=2))).run(5000).rows
+    error = noisy[:, F["hook_load_measured_n"]] - noisy[:, F["hook_load_n"]]
+    assert error.std() == pytest.approx(500.0, rel=0.05)         # 1/sqrt(2N) = 1 %
+    np.testing.assert_allclose(noisy[:, F["applied_wob_estimate_n"]],
+                               weight_n - noisy[:, F["hook_load_measured_n"]], rtol=1e-15)
+    np.testing.assert_array_equal(noisy[:, F["string_torque_measured_nm"]],
+                                  noisy[:, F["surface_torque_nm"]])      # the others perfect

@@ -98,7 +98,7 @@ def test_unknown_keys_are_named() -> None:
 def test_every_preset_loads_and_the_paper_cases_match_their_figures() -> None:
     names = available_presets()
     assert {"fig5_8a", "fig8b", "fig9", "fig10", "fig11", "fig12", "fig13", "fig14",
-            "field_8p5in_shale"} <= set(names)
+            "field_8p5in_shale_lumped"} <= set(names)
     for name in names:
         load_preset(name)
     fig8a = load_preset("fig5_8a").params
@@ -109,7 +109,7 @@ def test_every_preset_loads_and_the_paper_cases_match_their_figures() -> None:
 def test_field_preset_is_realistic() -> None:
     """Appendix A: 8.5-in bit, eps ~ 230 MPa, mu gamma ~ 0.48, beta ~ 0.35; psi of order
     1e2-1e3 (Sec. 3.1); t* ~ 1 s and L* ~ 1 mm."""
-    pr = load_preset("field_8p5in_shale")
+    pr = load_preset("field_8p5in_shale_lumped")
     assert pr.physical is not None
     assert pr.physical.bit_radius_m == pytest.approx(8.5 * 0.0254 / 2, rel=0.01)
     assert pr.params.beta == pytest.approx(0.35, abs=0.01)

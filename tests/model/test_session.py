@@ -16,7 +16,7 @@ BUCKET = 5                      # samples per part of the window
 
 @pytest.mark.parametrize("periods", [7, 1552])  # window not yet full / full, over a stick
 def test_severity_window_equals_the_statistics_of_every_step(periods):
-    cfg = SessionConfig(preset=load_preset("field_8p5in_shale"), publish_rate_hz=100.0,
+    cfg = SessionConfig(preset=load_preset("field_8p5in_shale_lumped"), publish_rate_hz=100.0,
                         window_s=WINDOW_BUCKETS * BUCKET * 0.01)
     session = SimSession(cfg)
     for _ in range(periods):
@@ -39,7 +39,7 @@ def test_severity_window_equals_the_statistics_of_every_step(periods):
 
 
 def test_reset_empties_the_window():
-    session = SimSession(SessionConfig(preset=load_preset("field_8p5in_shale")))
+    session = SimSession(SessionConfig(preset=load_preset("field_8p5in_shale_lumped")))
     session.run(50)
     session.reset()
     sev, stuck = session.severity()
@@ -52,7 +52,7 @@ def test_a_block_is_the_state_at_the_end_of_each_period_whatever_the_batching():
     end sample never moves the simulation, so 10 runs of 1 period equal one run of 10."""
     from drill_sim_ros.model.telemetry import NS_PER_S, field_scales, si_rows
 
-    cfg = SessionConfig(preset=load_preset("field_8p5in_shale"))
+    cfg = SessionConfig(preset=load_preset("field_8p5in_shale_lumped"))
     one_by_one = SimSession(cfg)
     start = one_by_one.current()
     singles = [one_by_one.run(1) for _ in range(10)]

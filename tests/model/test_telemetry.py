@@ -23,7 +23,7 @@ F = TELEMETRY_INDEX
 
 
 def test_si_rows_match_the_scales_field_by_field():
-    sc = load_preset("field_8p5in_shale").scales
+    sc = load_preset("field_8p5in_shale_lumped").scales
     rng = np.random.default_rng(7)
     data = rng.uniform(-50.0, 50.0, (5, k.N_COLS))
     data[:, k.C_MODE] = rng.integers(0, 4, 5)
@@ -55,7 +55,7 @@ def test_compiled_si_rows_equal_the_vectorised_reference_bit_for_bit():
     """The compiled conversion does the numpy formulation's operations in its order:
     (column + offset) * factor, then time, hook load, command stamp and the true surface
     signals; here that formulation, written out with whole-array numpy."""
-    sc = load_preset("field_8p5in_shale").scales
+    sc = load_preset("field_8p5in_shale_lumped").scales
     rng = np.random.default_rng(11)
     data = rng.uniform(-1e3, 1e3, (64, k.N_COLS))
     offsets, factors = (98765.4321, 2.0 * math.pi * 1234), field_scales(sc)
@@ -73,5 +73,7 @@ def test_compiled_si_rows_equal_the_vectorised_reference_bit_for_bit():
     ref[:, F["drive_speed_measured_rad_s"]] = ref[:, F["surface_rpm"]] / RPM_PER_RAD_S
     ref[:, F["motor_torque_measured_nm"]] = ref[:, F["motor_torque_nm"]]
     ref[:, F["string_torque_measured_nm"]] = ref[:, F["surface_torque_nm"]]
+    ref[:, F["hook_load_measured_n"]] = ref[:, F["hook_load_n"]]
+    ref[:, F["applied_wob_estimate_n"]] = weight_n - ref[:, F["hook_load_measured_n"]]
     rows = si_rows(data, offsets, factors, times_s, weight_n, stamp_s)
     assert rows.tobytes() == ref.tobytes()

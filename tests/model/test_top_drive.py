@@ -177,7 +177,7 @@ def test_switching_modes_mid_run_leaves_no_jump(sequence: tuple[str, ...]) -> No
 
 
 def test_si_commands_and_readings_use_the_scales_of_the_field_preset() -> None:
-    preset = load_preset("field_8p5in_shale")
+    preset = load_preset("field_8p5in_shale_lumped")
     sc = preset.scales
     sim = Simulator(preset.params, SimConfig(dtau=preset.dtau), top_drive=preset.top_drive,
                     scales=sc)
@@ -212,7 +212,7 @@ def test_preset_top_drive_sections_are_validated_and_scaled() -> None:
 
 
 def test_the_drive_scales_both_ways() -> None:
-    preset = load_preset("field_8p5in_shale")
+    preset = load_preset("field_8p5in_shale_lumped")
     si = preset.top_drive.physical(preset.scales)
     assert si.inertia_kg_m2 == pytest.approx(2900.0)
     assert (si.kp_nm_s, si.ki_nm, si.max_torque_nm) == pytest.approx((23200.0, 46400.0, 5e4))

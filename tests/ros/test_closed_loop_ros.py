@@ -20,12 +20,19 @@ SENSORS = {"seed": 7, "string_torque_nm": {"noise_std": 25.0, "quantum": 1.0},
            "motor_torque_nm": {"noise_std": 40.0}}
 
 
-@pytest.mark.parametrize(("controller", "mode"), [("z_torque", "speed"),
-                                                  ("soft_torque", "torque")])
-def test_in_process_and_over_dds_give_the_same_telemetry(controller: str, mode: str) -> None:
+# the drive's limits and a command delay within a period, as sim_node parameters
+DRIVE = {"accel_rpm_s": 20.0, "wob_rate_n_s": 3000.0, "max_torque_nm": 20e3,
+         "command_delay_s": 0.0042}
+
+
+@pytest.mark.parametrize(("controller", "mode", "drive"), [
+    ("z_torque", "speed", {}), ("soft_torque", "torque", {}), ("z_torque", "speed", DRIVE)])
+def test_in_process_and_over_dds_give_the_same_telemetry(controller: str, mode: str,
+                                                         drive: dict) -> None:
+    sensors = {**SENSORS, "hook_load_n": {"noise_std": 500.0}} if drive else SENSORS
     scenario = Scenario(controller=controller, mode=mode, duration_s=30.0, enable_at_s=10.0,
-                        sensors=SENSORS, schedule=({"t_s": 20.0, "rpm": 70.0, "ramp_s": 5.0},
-                                                   {"t_s": 22.0, "wob_n": 65e3}))
+                        sensors=sensors, schedule=({"t_s": 20.0, "rpm": 70.0, "ramp_s": 5.0},
+                                                   {"t_s": 22.0, "wob_n": 65e3}), drive=drive)
     local = run_in_process(scenario).rows
     remote = run_over_dds(scenario, timeout_s=240.0).rows
     assert local.shape == remote.shape == (3001, len(topics.TELEMETRY_FIELDS))

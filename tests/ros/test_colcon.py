@@ -20,7 +20,8 @@ from tests.ros.harness import Probe, ros_context
 pytestmark = pytest.mark.ros
 REPO = Path(__file__).resolve().parents[2]
 PACKAGE = "drill_sim_ros"
-PACKAGE_FILES = ("setup.py", "setup.cfg", "package.xml", "resource", "config", PACKAGE)
+PACKAGE_FILES = ("setup.py", "setup.cfg", "package.xml", "resource", "config", "launch",
+                 PACKAGE)
 VENV_BIN = Path(sys.executable).parent
 
 
@@ -88,7 +89,10 @@ def test_colcon_install_tree_runs_like_ros2_run(tmp_path):
     executable = prefix / "lib" / PACKAGE / "sim_node"
     assert executable.is_file() and os.access(executable, os.X_OK)
     assert (prefix / "share" / "ament_index" / "resource_index" / "packages" / PACKAGE).is_file()
-    assert (prefix / "share" / PACKAGE / "config" / "sim.yaml").is_file()
+    share = prefix / "share" / PACKAGE
+    for installed in ("config/sim.yaml", "config/fastdds_localhost.xml",
+                      "launch/drill_sim.launch.py"):
+        assert (share / installed).is_file(), installed
     env = installed_env(prefix)
     found_prefix, module = resolve_like_ros2_run(env, tmp_path)
     assert found_prefix == prefix

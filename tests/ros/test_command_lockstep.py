@@ -31,7 +31,7 @@ from tests.ros.harness import ros_context
 pytestmark = pytest.mark.ros
 F = topics.TELEMETRY_INDEX
 PERIOD_S = 0.01
-PRESET = load_preset("field_8p5in_shale")
+PRESET = load_preset("field_8p5in_shale_lumped")
 RPM0 = PRESET.physical.surface_rpm
 WOB0 = PRESET.physical.applied_wob_n
 

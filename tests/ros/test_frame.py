@@ -32,8 +32,9 @@ def random_rows(rows: int, seed: int = 3) -> np.ndarray:
 
 def joint_state(names: tuple[str, ...], sec: int, nanosec: int, values: list[float]
                 ) -> JointState:
-    msg = JointState(name=list(names), position=values[0:2], velocity=values[2:4],
-                     effort=values[4:6])
+    n = len(names)
+    msg = JointState(name=list(names), position=values[0:n], velocity=values[n:2 * n],
+                     effort=values[2 * n:3 * n])
     msg.header.stamp.sec, msg.header.stamp.nanosec = sec, nanosec
     return msg
 
@@ -59,11 +60,13 @@ def expected_messages(v: np.ndarray, time_ns: int) -> dict[str, object]:
         topics.SURFACE_JOINT_STATES: joint_state(topics.SURFACE_JOINTS, sec, nanosec, [
             v[F["surface_angle_rad"]], v[F["bit_depth_m"]],
             v[F["surface_rpm"]] / RPM_PER_RAD_S, v[F["rop_m_s"]], v[F["surface_torque_nm"]],
-            v[F["hook_load_n"]]]),
+            v[F["applied_wob_n"]]]),
         topics.SURFACE_MEASURED: joint_state(topics.MEASURED_JOINTS, sec, nanosec, [
-            v[F["surface_angle_rad"]], v[F["surface_angle_rad"]],
-            v[F["drive_speed_measured_rad_s"]], v[F["drive_speed_measured_rad_s"]],
-            v[F["motor_torque_measured_nm"]], v[F["string_torque_measured_nm"]]]),
+            v[F["surface_angle_rad"]], v[F["surface_angle_rad"]], v[F["bit_depth_m"]],
+            v[F["bit_depth_m"]], v[F["drive_speed_measured_rad_s"]],
+            v[F["drive_speed_measured_rad_s"]], v[F["rop_m_s"]], v[F["rop_m_s"]],
+            v[F["motor_torque_measured_nm"]], v[F["string_torque_measured_nm"]],
+            v[F["hook_load_measured_n"]], v[F["applied_wob_estimate_n"]]]),
         topics.TELEMETRY: telemetry,
         topics.CLOCK: clock,
     }

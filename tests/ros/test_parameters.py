@@ -45,13 +45,13 @@ def test_submerged_weight_of_the_field_string_by_hand():
     # 7850 kg/m3 in 1200 kg/m3 mud.
     steel_m3 = math.pi * ((0.0635**2 - 0.0543**2) * 2500.0 + (0.0857**2 - 0.0357**2) * 200.0)
     expected = steel_m3 * 7850.0 * 9.80665 * (1.0 - 1200.0 / 7850.0)
-    preset = load_preset("field_8p5in_shale")
+    preset = load_preset("field_8p5in_shale_lumped")
     assert submerged_string_weight_n(preset) == pytest.approx(expected, rel=1e-12)
     assert submerged_string_weight_n(load_preset("fig5_8a")) == 0.0
 
 
 def test_physical_defaults_come_from_the_preset():
-    preset = load_preset("field_8p5in_shale")
+    preset = load_preset("field_8p5in_shale_lumped")
     defaults = yaml_defaults(preset)
     assert defaults["model.applied_wob_n"] == pytest.approx(preset.physical.applied_wob_n)
     assert defaults["model.surface_rpm"] == pytest.approx(preset.physical.surface_rpm)

@@ -28,7 +28,7 @@ from tests.ros.harness import Probe, Ros, overrides, ros_context
 
 pytestmark = pytest.mark.ros
 F = topics.TELEMETRY_INDEX
-FIELD = "field_8p5in_shale"
+FIELD = "field_8p5in_shale_lumped"
 PERIOD_S = 0.01          # publish_rate_hz 100 (the default)
 NODE = f"/{topics.NODE_NAME}"
 FAST = 10.0             # a real-time factor the probe keeps up with, even on a busy machine
@@ -130,7 +130,7 @@ def test_every_topic_published_with_its_type_and_one_stamp_per_sample(ros):
     np.testing.assert_allclose(surf_arr[:, 0], rows[:, F["surface_angle_rad"]])
     np.testing.assert_allclose(surf_arr[:, 2] * RPM_PER_RAD_S, rows[:, F["surface_rpm"]])
     np.testing.assert_allclose(surf_arr[:, 4], rows[:, F["surface_torque_nm"]])
-    np.testing.assert_allclose(surf_arr[:, 5], rows[:, F["hook_load_n"]])
+    np.testing.assert_allclose(surf_arr[:, 5], rows[:, F["applied_wob_n"]])   # hook: WOB
 
     # Plausible values for the field preset (60 rpm, 60 kN, 2500 m of 5-in pipe + 200 m BHA).
     preset = load_preset(FIELD)

@@ -42,13 +42,14 @@ def test_controller_needs_a_physical_preset(tmp_path: Path) -> None:
 
 
 def test_controller_refuses_dimensionless_axes(tmp_path: Path) -> None:
-    _one_line_error(drill_sim("map", "--params", "field_8p5in_shale", "--vary", "psi=50:60:2",
+    _one_line_error(drill_sim("map", "--params", "field_8p5in_shale_lumped", "--vary",
+                              "psi=50:60:2",
                               "--controller", "soft_torque", "--out", str(tmp_path / "m.nc")),
                     "--controller", "psi", "surface_rpm")
 
 
 def test_controller_unknown_name(tmp_path: Path) -> None:
-    _one_line_error(drill_sim("map", "--params", "field_8p5in_shale", "--vary",
+    _one_line_error(drill_sim("map", "--params", "field_8p5in_shale_lumped", "--vary",
                               "surface_rpm=40:80:2", "--controller", "softer",
                               "--out", str(tmp_path / "m.nc")), "softer", "soft_torque")
 

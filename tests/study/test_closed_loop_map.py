@@ -23,7 +23,7 @@ from drill_sim_ros.study.grid import Axis, Control, MapSpec, Numerics
 from drill_sim_ros.study.point import COLUMN, evaluate_point
 from tests.study.helpers import drill_sim
 
-FIELD = load_preset("field_8p5in_shale")
+FIELD = load_preset("field_8p5in_shale_lumped")
 T_STAR_S = FIELD.scales.time_s
 # map variable -> `drill_sim closed-loop --json` score key
 SAME_AS_CLOSED_LOOP = {"ssi": "ssi_mean", "utr": "utr", "stick_fraction": "stick_fraction",

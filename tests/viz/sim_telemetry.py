@@ -61,11 +61,13 @@ def telemetry_rows(preset: Preset, seconds: float, rate_hz: float = 100.0) -> np
         "motor_torque_measured_nm": sc.tob_nm(col(k.C_MOTOR_TORQUE)),
         "string_torque_measured_nm": sc.tob_nm(col(k.C_T_PIPE)),
         "command_stamp_s": np.full(len(samples), -1.0),
+        "hook_load_measured_n": -sc.wob_n(col(k.C_W_APP)),
+        "applied_wob_estimate_n": sc.wob_n(col(k.C_W_APP)),
     }
     return np.column_stack([fields[name] for name in topics.TELEMETRY_FIELDS])
 
 
-def default_rows(seconds: float = 30.0, preset: str = "field_8p5in_shale") -> np.ndarray:
+def default_rows(seconds: float = 30.0, preset: str = "field_8p5in_shale_lumped") -> np.ndarray:
     return telemetry_rows(load_preset(preset), seconds)
 
 

@@ -59,7 +59,7 @@ def test_bad_options_are_usage_errors(args, tmp_path) -> None:
 @pytest.mark.parametrize("signum", [signal.SIGHUP, signal.SIGTERM])
 def test_no_viewer_beside_save_warns_and_the_signal_finishes_the_rrd(tmp_path, signum) -> None:
 
-    rows = telemetry_rows(load_preset("field_8p5in_shale"), 2.0)
+    rows = telemetry_rows(load_preset("field_8p5in_shale_lumped"), 2.0)
     rrd = tmp_path / "live.rrd"
     bridge, code = bridge_logs(rows, "--save", str(rrd), "--connect", _nowhere(),
                                signum=signum)

@@ -14,7 +14,7 @@ from tests.viz.sim_telemetry import telemetry_rows
 
 pytestmark = pytest.mark.ros
 F = topics.TELEMETRY_INDEX
-PRESET = "field_8p5in_shale"
+PRESET = "field_8p5in_shale_lumped"
 
 
 @pytest.fixture(scope="module")

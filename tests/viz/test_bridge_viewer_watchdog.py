@@ -85,7 +85,7 @@ def live_run(tmp_path: Path, sim_seconds: float, **stop: Any) -> Iterator[LiveRu
     """Start a :class:`LiveRun` of ``sim_seconds`` of the field preset's telemetry; at the
     end close the publisher, stop the bridge (``stop``: BridgeProcess.stop's arguments) and
     kill the viewer."""
-    rows = telemetry_rows(load_preset("field_8p5in_shale"), sim_seconds)
+    rows = telemetry_rows(load_preset("field_8p5in_shale_lumped"), sim_seconds)
     viewer = ViewerStandIn(free_port())
     viewer.start()
     topic = private_topic()
@@ -137,7 +137,7 @@ def test_a_viewer_gone_mid_run_is_cut_then_reconnected(tmp_path: Path) -> None:
 
 
 def test_a_viewer_started_after_the_bridge_is_connected(tmp_path: Path) -> None:
-    rows = telemetry_rows(load_preset("field_8p5in_shale"), 12.0)
+    rows = telemetry_rows(load_preset("field_8p5in_shale_lumped"), 12.0)
     viewer = ViewerStandIn(free_port())
     topic = private_topic()
     bridge = BridgeProcess("--save", str(tmp_path / "live.rrd"), "--connect", viewer.url,

@@ -49,7 +49,7 @@ def test_the_polar_frame_holds_the_radius_with_equal_scales(r_max: float) -> Non
 
 
 def test_es_frame_keeps_the_reference_points_and_the_data_but_not_outliers() -> None:
-    units = PaperUnits.load("field_8p5in_shale")
+    units = PaperUnits.load("field_8p5in_shale_lumped")
     extents = Extents()
     extents.add(np.array([1.0]), np.array([1.0]), np.array([1.0]),
                 s=np.array([1.4, 2.2, np.nan, 1e6]), e=np.array([1.1, 1.4, np.nan, 1e6]))

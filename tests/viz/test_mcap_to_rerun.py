@@ -23,7 +23,7 @@ from tests.viz.rrd_read import (
 )
 from tests.viz.sim_telemetry import telemetry_rows, write_mcap
 
-PRESET = "field_8p5in_shale"
+PRESET = "field_8p5in_shale_lumped"
 SECONDS = 40.0
 F = topics.TELEMETRY_INDEX
 
@@ -227,4 +227,5 @@ def test_the_scales_come_from_the_recorded_run_info(tmp_path, capsys):
     fallback = recorded_units(without, None)
     assert fallback.preset == DEFAULT_PRESET
     assert f"no {topics.RUN_INFO} and names no preset" in capsys.readouterr().err
-    assert recorded_units(with_info, "field_8p5in_shale").preset == "field_8p5in_shale"
+    lumped = "field_8p5in_shale_lumped"
+    assert recorded_units(with_info, lumped).preset == lumped

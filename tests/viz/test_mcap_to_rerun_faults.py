@@ -34,7 +34,7 @@ def recording(tmp_path_factory) -> tuple[Path, np.ndarray]:
     path = tmp_path_factory.mktemp("faults") / "run.mcap"
     label = ",".join(topics.TELEMETRY_FIELDS)
     with Ros2McapWriter(str(path)) as writer:
-        writer.add_metadata("drill_sim", {"preset": "field_8p5in_shale"})   # as sim_node's
+        writer.add_metadata("drill_sim", {"preset": "field_8p5in_shale_lumped"})   # as sim_node's
         channel = writer.add_channel(topics.TELEMETRY, "std_msgs/msg/Float64MultiArray")
         for row in rows:
             msg = Float64MultiArray(data=[float(v) for v in row])

@@ -13,7 +13,7 @@ from drill_sim_ros.viz.paper_units import PaperUnits
 
 def test_es_scaling_equals_eq_48_in_si() -> None:
     """E = <T>/<delta> = 2 T/(eps a^2 d) and S = <W>/<delta> = W/(zeta eps a d)."""
-    preset = load_preset("field_8p5in_shale")
+    preset = load_preset("field_8p5in_shale_lumped")
     units, phys = PaperUnits.from_preset(preset), preset.physical
     torque, weight, doc = 3.0e3, 4.0e4, 2.0e-3
     eps, a = phys.intrinsic_specific_energy_pa, phys.bit_radius_m
@@ -31,6 +31,6 @@ def test_trivial_state_lies_on_the_friction_line() -> None:
 
 
 def test_omega_scaling() -> None:
-    units = PaperUnits.load("field_8p5in_shale")
+    units = PaperUnits.load("field_8p5in_shale_lumped")
     rpm = 60.0
     assert units.omega(rpm) == pytest.approx(rpm * 2 * math.pi / 60 * units.scales.time_s)

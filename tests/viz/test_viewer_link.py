@@ -35,7 +35,7 @@ def test_a_detached_stream_misses_what_follows_and_the_other_keeps_everything(tm
     half = len(rows) // 2
     kept, cut = _file_stream(tmp_path / "kept.rrd"), _file_stream(tmp_path / "cut.rrd")
     recordings = Recordings(kept, cut)
-    dashboard = Dashboard(recordings, PaperUnits.load("field_8p5in_shale"))
+    dashboard = Dashboard(recordings, PaperUnits.load("field_8p5in_shale_lumped"))
     dashboard.log_batch(TelemetryBatch.from_rows(rows[:half]))
     recordings.detach(cut)
     close_recording(cut)

@@ -1,0 +1,418 @@
+"""The drill string between the top drive and the bit: lumped (RGD07) or a wave guide.
+
+* ``lumped``: RGD07 eq. (1) and (25), a torsional spring C with the BHA inertia I and mass M
+  at the bit (the paper's model, bit for bit).
+* ``distributed``: a chain of uniform hollow sections (drill pipe, heavy-weight pipe,
+  collars, ...), each carrying torsional waves at c_t = sqrt(G / rho) and axial waves at
+  c_a = sqrt(E / rho), with impedances Z_t = J_p sqrt(G rho) and Z_a = A sqrt(E rho).
+
+The distributed string is solved by the method of characteristics. In a uniform lossless
+section the Riemann invariants ``a = T + Z w`` (travelling down) and ``b = T - Z w``
+(travelling up), with T the torque the upper part applies to the lower and w the angular
+speed, are carried unchanged at the wave speed: a section whose travel time is a whole
+number of steps is a pair of delay lines, exact, with no numerical dispersion or diffusion.
+Section boundaries are rounded to whole steps on the cumulative travel time (each within
+half a step). At a junction, speed is continuous and the torques balance; with a point
+damper D there (torque D w), w = (a_in - b_in) / (Z_up + Z_down + D), and the outgoing waves
+follow. Distributed viscous damping (force per length proportional to the local speed,
+rate ``gamma`` = damping per unit mass, 1/s) is lumped into ``damping_points`` point dampers
+per section, each at the middle of an equal part. Axial waves use the same machinery with
+force and velocity.
+
+Everything compiled here works in the kernel's units (time t*, torque C, force unit
+zeta eps a L*, length L*; RGD07 eqs. 19-20).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
+
+STRING_LUMPED = 0
+STRING_DISTRIBUTED = 1
+STRING_MODELS = ("lumped", "distributed")
+
+STEEL_DENSITY_KG_M3 = 7850.0
+STEEL_SHEAR_MODULUS_PA = 79.3e9
+STEEL_YOUNGS_MODULUS_PA = 206.0e9
+
+# rows of the integer and float layout arrays of the delay lines
+W_LEN, W_OFF, W_POS = 0, 1, 2          # int64 (3, segments): steps, buffer offset, slot
+W_Z, W_D = 0, 1                         # float64 (2, segments): impedance, damper below
+
+
+# ---- sections (SI) ------------------------------------------------------------------------
+@dataclass(frozen=True)
+class Section:
+    """One uniform hollow section of the string, SI.
+
+    Radii and length in m; density kg/m^3; moduli Pa; damping rates in 1/s: the viscous
+    force per unit length is ``rate x (mass or inertia per unit length) x local speed``, so
+    a section moving rigidly would lose speed as exp(-rate t) and mode k of a uniform string
+    has the damping ratio rate / (2 omega_k).
+    """
+
+    outer_radius_m: float
+    inner_radius_m: float
+    length_m: float
+    density_kg_m3: float = STEEL_DENSITY_KG_M3
+    shear_modulus_pa: float = STEEL_SHEAR_MODULUS_PA
+    youngs_modulus_pa: float = STEEL_YOUNGS_MODULUS_PA
+    torsional_damping_per_s: float = 0.0
+    axial_damping_per_s: float = 0.0
+
+    @property
+    def polar_moment_m4(self) -> float:
+        """J = pi/2 (ro^4 - ri^4) (RGD07, after eq. 1)."""
+        return 0.5 * math.pi * (self.outer_radius_m**4 - self.inner_radius_m**4)
+
+    @property
+    def area_m2(self) -> float:
+        return math.pi * (self.outer_radius_m**2 - self.inner_radius_m**2)
+
+    @property
+    def torsional_speed_m_s(self) -> float:
+        return math.sqrt(self.shear_modulus_pa / self.density_kg_m3)
+
+    @property
+    def axial_speed_m_s(self) -> float:
+        return math.sqrt(self.youngs_modulus_pa / self.density_kg_m3)
+
+    @property
+    def torsional_impedance_nm_s(self) -> float:
+        """Z = J sqrt(G rho), N m per rad/s."""
+        return self.polar_moment_m4 * math.sqrt(self.shear_modulus_pa * self.density_kg_m3)
+
+    @property
+    def axial_impedance_n_s_per_m(self) -> float:
+        """Z = A sqrt(E rho), N per m/s."""
+        return self.area_m2 * math.sqrt(self.youngs_modulus_pa * self.density_kg_m3)
+
+    @property
+    def torsional_stiffness_nm(self) -> float:
+        """G J (N m^2 per rad): torque = G J x twist per metre."""
+        return self.shear_modulus_pa * self.polar_moment_m4
+
+    @property
+    def axial_stiffness_n(self) -> float:
+        """E A (N): force = E A x strain."""
+        return self.youngs_modulus_pa * self.area_m2
+
+    @property
+    def mass_kg(self) -> float:
+        return self.density_kg_m3 * self.area_m2 * self.length_m
+
+    @property
+    def inertia_kg_m2(self) -> float:
+        return self.density_kg_m3 * self.polar_moment_m4 * self.length_m
+
+
+@dataclass(frozen=True)
+class StringSpec:
+    """The string as a preset describes it (SI). ``sections`` top to bottom; the bottom one
+    is the BHA for the lumped equivalent. ``bit_inertia_kg_m2``: lumped inertia at the bit
+    beyond the sections. ``hook_wob_time_s``: time constant of the hook's WOB loop (the
+    driller's brake / autodriller holding the top so that the weight on bit follows the
+    applied-WOB command). ``damping_points``: point dampers per section."""
+
+    model: str = "lumped"
+    sections: tuple[Section, ...] = ()
+    bit_inertia_kg_m2: float = 0.0
+    hook_wob_time_s: float = 5.0
+    damping_points: int = 4
+
+    @property
+    def distributed(self) -> bool:
+        return self.model == "distributed"
+
+    @property
+    def length_m(self) -> float:
+        return sum(s.length_m for s in self.sections)
+
+    @property
+    def torsional_travel_s(self) -> float:
+        """One-way torsional travel time, top to bit."""
+        return sum(s.length_m / s.torsional_speed_m_s for s in self.sections)
+
+
+def lumped_equivalent(spec: StringSpec) -> tuple[float, float, float]:
+    """(M, I, C) of RGD07 eq. (1) generalised to sections: the bottom section is the BHA
+    (M = its mass, I = its inertia + a third of the others'), C = the others in series."""
+    bha, pipes = spec.sections[-1], spec.sections[:-1]
+    compliance = sum(s.length_m / s.torsional_stiffness_nm for s in pipes)
+    inertia = bha.inertia_kg_m2 + sum(s.inertia_kg_m2 for s in pipes) / 3.0
+    return bha.mass_kg, inertia + spec.bit_inertia_kg_m2, 1.0 / compliance
+
+
+def axial_compliance_m_per_n(spec: StringSpec) -> float:
+    """Static axial compliance of the string, hook to bit: sum of L / (E A)."""
+    return sum(s.length_m / s.axial_stiffness_n for s in spec.sections)
+
+
+# ---- analytic modes (transfer matrices, fixed top, free or inertia-loaded bit) -------------
+def _mode_residual(omega_rad_s: float, spec: StringSpec, axial: bool) -> float:
+    """End condition of the fixed-top string at ``omega``: the torque (force) at the bit
+    minus what the bit inertia needs, for unit slope at the top; zero at a natural
+    frequency. Transfer of (displacement, force) along each uniform section."""
+    disp, force = 0.0, 1.0                     # fixed top: no displacement, unit force
+    for s in spec.sections:
+        c = s.axial_speed_m_s if axial else s.torsional_speed_m_s
+        stiff = s.axial_stiffness_n if axial else s.torsional_stiffness_nm
+        k = omega_rad_s / c
+        kl = k * s.length_m
+        disp, force = (disp * math.cos(kl) + force * math.sin(kl) / (stiff * k),
+                       -disp * stiff * k * math.sin(kl) + force * math.cos(kl))
+    inertia = 0.0 if axial else spec.bit_inertia_kg_m2
+    return force - inertia * omega_rad_s**2 * disp
+
+
+def analytic_modes_hz(spec: StringSpec, count: int = 3, axial: bool = False,
+                      f_max_hz: float = 50.0) -> list[float]:
+    """The first ``count`` natural frequencies of the string, fixed at the top and free at
+    the bit (with its lumped inertia), by bracketing and bisection of the transfer-matrix
+    end condition (for two sections of one material: tan(k L1) tan(k L2) = S1 / S2)."""
+    found: list[float] = []
+    step = 2.0 * math.pi * 1e-3
+    w, prev = step, _mode_residual(step, spec, axial)
+    while len(found) < count and w < 2.0 * math.pi * f_max_hz:
+        w_next = w + step
+        cur = _mode_residual(w_next, spec, axial)
+        if prev == 0.0 or prev * cur < 0.0:
+            lo, hi = w, w_next
+            for _ in range(80):
+                mid = 0.5 * (lo + hi)
+                if _mode_residual(lo, spec, axial) * _mode_residual(mid, spec, axial) <= 0.0:
+                    hi = mid
+                else:
+                    lo = mid
+            found.append(0.5 * (lo + hi) / (2.0 * math.pi))
+        w, prev = w_next, cur
+    return found
+
+
+# ---- the delay lines in kernel units --------------------------------------------------------
+@dataclass(frozen=True)
+class WaveLine:
+    """One kind of wave (torsional or axial) along the string, in kernel units: per part
+    (top to bottom) its travel time in tau, impedance, and the point damper below it."""
+
+    travel_tau: tuple[float, ...]
+    impedance: tuple[float, ...]
+    damper_below: tuple[float, ...]
+    length_m: tuple[float, ...] = ()
+
+
+def wave_line(spec: StringSpec, axial: bool, time_s: float, z_unit: float,
+              mass_unit: float) -> WaveLine:
+    """Parts of ``spec`` for one kind of wave. ``z_unit`` converts an SI impedance to
+    kernel units, ``mass_unit`` an SI damper (N m s/rad or N s/m) likewise (same factor).
+
+    With damping, each section is cut into ``damping_points`` equal parts; each part is two
+    halves around a point damper that carries the part's damping (rate x inertia)."""
+    travel, z, damper, length = [], [], [], []
+    for s in spec.sections:
+        c = s.axial_speed_m_s if axial else s.torsional_speed_m_s
+        zi = (s.axial_impedance_n_s_per_m if axial else s.torsional_impedance_nm_s) / z_unit
+        rate = s.axial_damping_per_s if axial else s.torsional_damping_per_s
+        per_length = (s.density_kg_m3 * (s.area_m2 if axial else s.polar_moment_m4))
+        t_tau = s.length_m / c / time_s
+        if rate <= 0.0:
+            travel.append(t_tau)
+            z.append(zi)
+            damper.append(0.0)
+            length.append(s.length_m)
+            continue
+        parts = spec.damping_points
+        d_part = rate * per_length * s.length_m / parts / mass_unit
+        for _ in range(parts):
+            travel += [0.5 * t_tau / parts, 0.5 * t_tau / parts]
+            z += [zi, zi]
+            damper += [d_part, 0.0]
+            length += [0.5 * s.length_m / parts, 0.5 * s.length_m / parts]
+    return WaveLine(tuple(travel), tuple(z), tuple(damper), tuple(length))
+
+
+def line_steps(line: WaveLine, dtau: float) -> np.ndarray:
+    """Whole steps per part: boundaries rounded on the cumulative travel time, so each one
+    lies within half a step of its true place. ParameterError-free: the caller checks >= 1."""
+    edges = np.rint(np.cumsum(line.travel_tau) / dtau).astype(np.int64)
+    return np.diff(np.concatenate(([0], edges)))
+
+
+def build_lines(lines: tuple[WaveLine, ...], dtau: float
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray, tuple[int, ...]]:
+    """The layout of the delay lines of ``lines`` (torsional first): ``(wave_i, wave_f,
+    counts)`` with ``wave_i`` int64 (3, parts) rows W_LEN, W_OFF, W_POS, ``wave_f``
+    float64 (2, parts) rows W_Z, W_D, and the parts per line; plus an empty buffer."""
+    lens = np.concatenate([line_steps(line, dtau) for line in lines])
+    wave_i = np.zeros((3, lens.size), dtype=np.int64)
+    wave_i[W_LEN] = lens
+    wave_i[W_OFF] = np.concatenate(([0], np.cumsum(2 * lens)[:-1]))
+    wave_f = np.zeros((2, lens.size))
+    wave_f[W_Z] = np.concatenate([line.impedance for line in lines])
+    wave_f[W_D] = np.concatenate([line.damper_below for line in lines])
+    return wave_i, wave_f, np.zeros(int(2 * lens.sum())), tuple(len(x.travel_tau)
+                                                                 for x in lines)
+
+
+def fill_uniform(wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray, lo: int, hi: int,
+                 force: float, speed: float) -> None:
+    """Every part of parts ``lo..hi-1`` carries ``force`` and ``speed`` (steady state)."""
+    for j in range(lo, hi):
+        n, off, z = wave_i[W_LEN, j], wave_i[W_OFF, j], wave_f[W_Z, j]
+        wave[off:off + n] = force + z * speed
+        wave[off + n:off + 2 * n] = force - z * speed
+
+
+@dataclass(frozen=True)
+class KernelString:
+    """A string in kernel units, what the simulator builds its arrays from.
+
+    ``model``: STRING_LUMPED or STRING_DISTRIBUTED; ``lines``: (torsional, axial);
+    ``bit_inertia``: J_bit / I; ``hook_kp``, ``hook_ki``: the WOB loop's gains (hook speed
+    per unit force error, and per unit force error and tau); ``bha_part``: the torsional
+    part at whose top the BHA speed is read; ``spec``: the SI description."""
+
+    model: int
+    lines: tuple[WaveLine, ...] = ()
+    bit_inertia: float = 0.0
+    hook_kp: float = 0.0
+    hook_ki: float = 0.0
+    bha_part: int = 0
+    spec: StringSpec | None = None
+
+
+LUMPED = KernelString(STRING_LUMPED)
+
+
+def kernel_string(spec: StringSpec, time_s: float, torque_nm: float, length_m: float,
+                  force_n: float) -> KernelString:
+    """``spec`` in kernel units: time t*, torque C, length L*, force zeta eps a L*
+    (RGD07 eqs. 19-20). The hook loop is critically damped with time constant
+    ``hook_wob_time_s`` on the string's static axial stiffness."""
+    if not spec.distributed:
+        return KernelString(STRING_LUMPED, spec=spec)
+    z_torsion = torque_nm * time_s                     # N m s/rad per kernel unit
+    z_axial = force_n * time_s / length_m               # N s/m per kernel unit
+    torsion = wave_line(spec, False, time_s, z_torsion, z_torsion)
+    axial = wave_line(spec, True, time_s, z_axial, z_axial)
+    stiffness = length_m / force_n / axial_compliance_m_per_n(spec)
+    t_w = spec.hook_wob_time_s / time_s
+    bha_part = len(torsion.travel_tau) - _parts_of(spec, spec.sections[-1], False)
+    return KernelString(STRING_DISTRIBUTED, (torsion, axial),
+                        spec.bit_inertia_kg_m2 / (torque_nm * time_s**2),
+                        2.0 / (t_w * stiffness), 1.0 / (t_w**2 * stiffness), bha_part, spec)
+
+
+def _parts_of(spec: StringSpec, section: Section, axial: bool) -> int:
+    rate = section.axial_damping_per_s if axial else section.torsional_damping_per_s
+    return 2 * spec.damping_points if rate > 0.0 else 1
+
+
+# ---- compiled: one step of a line -------------------------------------------------------
+@njit(cache=True, inline="always")
+def arriving(wave: np.ndarray, wave_i: np.ndarray, lo: int, hi: int) -> tuple[float, float]:
+    """The waves arriving now at the two ends of a line: (b at the top, a at the bottom)."""
+    b_top = wave[wave_i[W_OFF, lo] + wave_i[W_LEN, lo] + wave_i[W_POS, lo]]
+    a_bottom = wave[wave_i[W_OFF, hi - 1] + wave_i[W_POS, hi - 1]]
+    return b_top, a_bottom
+
+
+@njit(cache=True, inline="always")
+def scatter(wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray, lo: int, hi: int,
+            a_top: float, b_bottom: float) -> None:
+    """One step of a line: ``a_top`` enters at the top, ``b_bottom`` at the bottom, every
+    inner junction scatters what arrives (continuous speed, torques balanced with its point
+    damper), and the delay lines move on by one step. Reads each slot before writing it."""
+    off, n, pos = wave_i[W_OFF], wave_i[W_LEN], wave_i[W_POS]
+    z, d = wave_f[W_Z], wave_f[W_D]
+    a_slot = off[lo] + pos[lo]
+    a_in = wave[a_slot]                      # arriving at the bottom of part lo
+    wave[a_slot] = a_top
+    for j in range(lo, hi - 1):
+        b_slot = off[j + 1] + n[j + 1] + pos[j + 1]
+        b_in = wave[b_slot]                  # arriving at the top of part j + 1
+        w = (a_in - b_in) / (z[j] + z[j + 1] + d[j])
+        wave[off[j] + n[j] + pos[j]] = a_in - 2.0 * z[j] * w
+        a_slot = off[j + 1] + pos[j + 1]
+        a_next = wave[a_slot]
+        wave[a_slot] = b_in + 2.0 * z[j + 1] * w
+        a_in = a_next
+    wave[off[hi - 1] + n[hi - 1] + pos[hi - 1]] = b_bottom
+    for j in range(lo, hi):
+        pos[j] = pos[j] + 1 if pos[j] + 1 < n[j] else 0
+
+
+@njit(cache=True)
+def step_slots(wave_i: np.ndarray) -> np.ndarray:
+    """The buffer slots the next step writes (a and b of every part): saving and restoring
+    them undoes a step (with the positions), without copying the whole buffer."""
+    parts = wave_i.shape[1]
+    slots = np.empty(2 * parts, dtype=np.int64)
+    for j in range(parts):
+        slots[2 * j] = wave_i[W_OFF, j] + wave_i[W_POS, j]
+        slots[2 * j + 1] = wave_i[W_OFF, j] + wave_i[W_LEN, j] + wave_i[W_POS, j]
+    return slots
+
+
+@njit(cache=True, inline="always")
+def speed_at_top_of(wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray,
+                    j: int) -> float:
+    """Speed at the top of part ``j`` now: (a entering last step - b arriving) / 2 Z."""
+    off, n, pos = wave_i[W_OFF, j], wave_i[W_LEN, j], wave_i[W_POS, j]
+    last = pos - 1 if pos > 0 else n - 1
+    return (wave[off + last] - wave[off + n + pos]) / (2.0 * wave_f[W_Z, j])
+
+
+@njit(cache=True, inline="always")
+def bottom_end(a_in: float, z: float, mass: float, v: float,
+               dt: float) -> tuple[float, float, float]:
+    """The bit end of a line in the bit law's affine form (see :mod:`bit_rock`):
+    ``(v0, kick, f_ext)`` with a lumped ``mass`` (inertia) at the bit moving at ``v``;
+    implicit in the string's impedance, exact for ``mass = 0`` (the end moves at
+    (a - F) / Z)."""
+    denom = mass + dt * z
+    return mass * v / denom, dt / denom, a_in
+
+
+# ---- Python-side readings ------------------------------------------------------------------
+def line_state(wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray, lo: int,
+               hi: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(force, speed, impedance) of every cell of parts lo..hi-1, top to bottom, now."""
+    forces, speeds, zs = [], [], []
+    for j in range(lo, hi):
+        n, off, pos, z = (int(wave_i[W_LEN, j]), int(wave_i[W_OFF, j]),
+                          int(wave_i[W_POS, j]), float(wave_f[W_Z, j]))
+        # slot pos - 1 - k holds the a that entered k steps ago (k cells below the top);
+        # b at k cells below the top entered n - 1 - k steps ago at the bottom
+        k = np.arange(n)
+        a = wave[off + (pos - 1 - k) % n]
+        b = wave[off + n + (pos - n + k) % n]
+        forces.append(0.5 * (a + b))
+        speeds.append((a - b) / (2.0 * z))
+        zs.append(np.full(n, z))
+    return np.concatenate(forces), np.concatenate(speeds), np.concatenate(zs)
+
+
+def cell_depths_m(line: WaveLine, wave_i: np.ndarray, lo: int) -> np.ndarray:
+    """Depth below the top of the middle of every cell of a line (its parts start at
+    column ``lo`` of ``wave_i``), m."""
+    depths, top = [], 0.0
+    for j, length in enumerate(line.length_m):
+        n = int(wave_i[W_LEN, lo + j])
+        depths.append(top + (np.arange(n) + 0.5) * (length / n))
+        top += length
+    return np.concatenate(depths)
+
+
+def line_energy(wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray, lo: int, hi: int,
+                dtau: float) -> float:
+    """Kinetic + strain energy of a line, sum of (a^2 + b^2) dtau / (4 Z) over its cells."""
+    total = 0.0
+    for j in range(lo, hi):
+        n, off, z = int(wave_i[W_LEN, j]), int(wave_i[W_OFF, j]), float(wave_f[W_Z, j])
+        total += float(np.sum(wave[off:off + 2 * n] ** 2)) * dtau / (4.0 * z)
+    return total

@@ -1,0 +1,262 @@
+"""Instruments a controller engineer uses on a distributed string, in the time domain.
+
+ROS-free. Both run the simulator as it runs the string (the same kernel, the same delay
+lines), off bottom with the hook fixed, after a short pulse sent up from the bit:
+
+* :func:`identify_modes`: the ring-down of the bit's angular and axial speed under a
+  kinematic top drive with no damping; the first natural frequencies are the spectral
+  peaks (Hann window, zero padding, parabolic interpolation on the log magnitude), shown
+  beside the transfer-matrix ones (:func:`string.analytic_modes_hz`).
+* :func:`measure_reflection`: the waves meeting the top drive, separated exactly by the
+  method of characteristics (b arriving, a = b + 2 Z w leaving), and the drive's
+  reflection r(f) = A(f) / B(f) as the ratio of their spectra over a ring-down long enough
+  to decay; beside the analytic |Z - Z_TD(i w)| / |Z + Z_TD(i w)| with
+  Z_TD(s) = J s + kp + ki / s for the drive's own speed loop.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from drill_sim_ros.model import kernel as k
+from drill_sim_ros.model import string as sg
+from drill_sim_ros.model.errors import ParameterError
+from drill_sim_ros.model.presets import Preset
+from drill_sim_ros.model.simulator import SimConfig, Simulator
+from drill_sim_ros.model.top_drive import TopDrive
+
+PULSE_WIDTH_S = 0.05       # standard deviation of the Gaussian pulse sent from the bit
+SAMPLE_HZ = 200.0          # the ring-down is recorded at this rate (modes < 20 Hz)
+
+
+@dataclass(frozen=True)
+class Modes:
+    """Natural frequencies, Hz: identified from the ring-down and analytic."""
+
+    torsional_identified_hz: list[float]
+    torsional_analytic_hz: list[float]
+    axial_identified_hz: list[float]
+    axial_analytic_hz: list[float]
+
+    def as_dict(self) -> dict[str, dict[str, list[float]]]:
+        return {"torsional": {"identified_hz": self.torsional_identified_hz,
+                              "analytic_hz": self.torsional_analytic_hz},
+                "axial": {"identified_hz": self.axial_identified_hz,
+                          "analytic_hz": self.axial_analytic_hz}}
+
+
+def require_distributed(preset: Preset) -> None:
+    if not preset.string.distributed:
+        raise ParameterError(f"preset '{preset.name}' has a lumped string; the string "
+                             "instruments need 'string: {model: distributed}'")
+
+
+def reflection_preset(preset: Preset) -> Preset:
+    """``preset`` with its string replaced by its top section twice over, undamped: a
+    uniform line in which a pulse from the bit meets only the top drive (the bottom is
+    made anechoic by :meth:`Simulator.hang_off_bottom`), so the waves that come back down
+    are the drive's reflection and nothing else. Scales, rock and drive are unchanged."""
+    require_distributed(preset)
+    top = replace(preset.string.sections[0], torsional_damping_per_s=0.0,
+                  axial_damping_per_s=0.0)
+    return replace(preset, string=replace(preset.string, sections=(top, top),
+                                          bit_inertia_kg_m2=0.0))
+
+
+def off_bottom_simulator(preset: Preset, drive: TopDrive, dtau: float | None = None,
+                         undamped: bool = False, anechoic: bool = False) -> Simulator:
+    """A simulator of ``preset`` with the bit hanging free off bottom, the hook fixed, the
+    string untwisted and turning at the preset's speed (no torque, no axial motion)."""
+    require_distributed(preset)
+    spec = preset.string
+    if undamped:
+        sections = tuple(replace(s, torsional_damping_per_s=0.0, axial_damping_per_s=0.0)
+                         for s in spec.sections)
+        spec = replace(spec, sections=sections)
+    sc = preset.scales
+    string = sg.kernel_string(spec, sc.time_s, sc.torque_nm, sc.length_m, sc.force_n)
+    sim = Simulator(preset.params, SimConfig(dtau=dtau or preset.dtau, n_nodes=64),
+                    top_drive=drive, scales=sc, string=string)
+    sim.hang_off_bottom(anechoic)
+    return sim
+
+
+def send_pulse_from_bit(sim: Simulator, axial: bool, amplitude: float,
+                        width_steps: float) -> None:
+    """An up-going Gaussian pulse centred at the bit at this instant: its upper half in the
+    up-going wave above the bit and its lower half as a down-going image that the free bit
+    end reflects into the rest (b = -a). ``amplitude`` in the line's force units."""
+    wave, wave_i, _, parts = sim.string_arrays()
+    j = wave_i.shape[1] - 1 if axial else parts[0] - 1
+    n, off, pos = (int(wave_i[sg.W_LEN, j]), int(wave_i[sg.W_OFF, j]),
+                   int(wave_i[sg.W_POS, j]))
+    cells = np.arange(min(n, int(8 * width_steps) + 1))
+    # b in the cell k above the bit left it k + 1 steps ago; a in the cell k above it
+    # reaches it in k steps and leaves again as b = -a: the centre is at the bit now
+    wave[off + n + (pos - 1 - cells) % n] += amplitude * np.exp(
+        -0.5 * ((cells + 1) / width_steps) ** 2)
+    wave[off + (pos + cells) % n] -= amplitude * np.exp(-0.5 * (cells / width_steps) ** 2)
+
+
+def _peaks_hz(signal: np.ndarray, sample_hz: float, count: int, f_min_hz: float) -> list[float]:
+    """The ``count`` lowest spectral peaks above ``f_min_hz``: maxima of a zero-padded Hann
+    spectrum that stand above 1 % of the largest and are the largest within +-10 % of
+    their frequency (so no window sidelobe counts), each refined by a parabola through
+    the log magnitudes."""
+    x = signal - signal.mean()
+    n_fft = 1 << (math.ceil(math.log2(x.size)) + 3)
+    mag = np.abs(np.fft.rfft(x * np.hanning(x.size), n_fft))
+    logm = np.log(mag + 1e-300)
+    df = sample_hz / n_fft
+    floor = mag.max() * 1e-2
+    found: list[float] = []
+    for i in range(max(1, int(f_min_hz / df)), mag.size - 1):
+        if mag[i] <= floor or mag[i] < mag[i - 1] or mag[i] <= mag[i + 1]:
+            continue
+        half = max(2, int(0.1 * i))
+        if mag[i] < mag[max(0, i - half):i + half + 1].max():
+            continue
+        a, b, c = logm[i - 1], logm[i], logm[i + 1]
+        found.append((i + 0.5 * (a - c) / (a - 2.0 * b + c)) * df)
+        if len(found) == count:
+            break
+    return found
+
+
+def _ring_down(sim: Simulator, seconds: float, columns: tuple[int, ...]
+               ) -> tuple[np.ndarray, float]:
+    """Kernel sample columns over ``seconds`` of simulated time at about SAMPLE_HZ, and the
+    sampling rate in Hz."""
+    every = max(1, round(1.0 / (SAMPLE_HZ * sim.scales.time_s * sim.config.dtau)))
+    steps = sim.steps_for(seconds / sim.scales.time_s)
+    rows = sim.advance(steps, every=every).data
+    return rows[:, list(columns)], 1.0 / (every * sim.config.dtau * sim.scales.time_s)
+
+
+def identify_modes(preset: Preset, count: int = 3, seconds: float = 400.0) -> Modes:
+    """The first ``count`` torsional and axial natural frequencies of ``preset``'s string,
+    identified from a simulated ring-down (off bottom, kinematic top, no damping, a pulse
+    from the bit), with the analytic ones (fixed top, free bit)."""
+    drive = TopDrive(mode="kinematic", inertia_ratio=preset.top_drive.inertia_ratio)
+    sim = off_bottom_simulator(preset, drive, undamped=True)
+    width = PULSE_WIDTH_S / (preset.scales.time_s * sim.config.dtau)
+    send_pulse_from_bit(sim, False, 0.05 * preset.params.omega0 * sim.string_arrays()[2][
+        sg.W_Z, 0], width)
+    send_pulse_from_bit(sim, True, 1.0, width)
+    data, sample_hz = _ring_down(sim, seconds, (k.C_OMEGA, k.C_V))
+    spec = preset.string
+    return Modes(_peaks_hz(data[:, 0], sample_hz, count, 0.02),
+                 sg.analytic_modes_hz(spec, count, axial=False),
+                 _peaks_hz(data[:, 1], sample_hz, count, 0.02),
+                 sg.analytic_modes_hz(spec, count, axial=True))
+
+
+@dataclass(frozen=True)
+class Reflection:
+    """|r| of the top drive against frequency: measured and, for the native loop, analytic."""
+
+    f_hz: list[float]
+    r_measured: list[float]
+    r_analytic: list[float] | None
+
+
+def reflection_frequencies(count: int = 12, f_lo_hz: float = 0.05,
+                           f_hi_hz: float = 2.0) -> np.ndarray:
+    """Log-spaced frequencies between ``f_lo_hz`` and ``f_hi_hz``."""
+    return np.geomspace(f_lo_hz, f_hi_hz, count)
+
+
+def analytic_reflection(z_string: float, inertia: float, kp: float, ki: float,
+                        f_hz: np.ndarray) -> np.ndarray:
+    """|Z - Z_TD(i w)| / |Z + Z_TD(i w)| with Z_TD(s) = J s + kp + ki / s (SI)."""
+    s = 2j * np.pi * f_hz
+    z_td = inertia * s + kp + ki / s
+    return np.abs(z_string - z_td) / np.abs(z_string + z_td)
+
+
+def top_waves(rows: np.ndarray, z_top: float) -> tuple[np.ndarray, np.ndarray]:
+    """From kernel rows (every step): the wave arriving at the top, b = T - Z w_s, and the
+    wave leaving it, a = b + 2 Z w_s(next step) (module string), over all rows but the
+    last."""
+    b = rows[:-1, k.C_T_PIPE] - z_top * rows[:-1, k.C_OMEGA_S]
+    a = b + 2.0 * z_top * rows[1:, k.C_OMEGA_S]
+    return a, b
+
+
+def spectral_ratio(a: np.ndarray, b: np.ndarray, sample_hz: float,
+                   f_hz: np.ndarray) -> np.ndarray:
+    """|A(f) / B(f)| at ``f_hz`` by direct Fourier sums of the whole records (both decay to
+    nothing at the end, so no window is needed)."""
+    t = np.arange(a.size) / sample_hz
+    out = []
+    for f in f_hz:
+        e = np.exp(-2j * np.pi * f * t)
+        out.append(abs(np.dot(a, e)) / abs(np.dot(b, e)))
+    return np.array(out)
+
+
+def _top_records(sim: Simulator, z_top: float, seconds: float, block: int = 32
+                 ) -> tuple[np.ndarray, np.ndarray, float]:
+    """The waves at the top over ``seconds``, from every step, block-averaged by ``block``
+    steps (a linear filter on both, which their ratio does not see); and their rate, Hz."""
+    steps = sim.steps_for(seconds / sim.scales.time_s) // block * block
+    a_parts, b_parts, last = [], [], None
+    while steps > 0:
+        n = min(block << 14, steps)
+        rows = sim.advance(n, every=1).data
+        rows = rows if last is None else np.vstack((last, rows))
+        a, b = top_waves(rows, z_top)
+        m = a.size // block * block
+        a_parts.append(a[:m].reshape(-1, block).mean(axis=1))
+        b_parts.append(b[:m].reshape(-1, block).mean(axis=1))
+        last = rows[m:]
+        steps -= n
+    return (np.concatenate(a_parts), np.concatenate(b_parts),
+            1.0 / (block * sim.config.dtau * sim.scales.time_s))
+
+
+def reflection_of(run: Callable[[bool], tuple[np.ndarray, np.ndarray]], sample_hz: float,
+                  f_hz: np.ndarray) -> np.ndarray:
+    """|r(f)| from two identical runs ``run(pulse)`` -> (a, b), with and without the pulse
+    from the bit: their difference is the pulse's own waves at the top (the loop is linear
+    off bottom), so a drive or controller that is not at rest when the pulse comes does not
+    count."""
+    a1, b1 = run(True)
+    a0, b0 = run(False)
+    return spectral_ratio(a1 - a0, b1 - b0, sample_hz, f_hz)
+
+
+def measure_reflection(preset: Preset, seconds: float = 120.0,
+                       f_hz: np.ndarray | None = None) -> Reflection:
+    """The reflection of torsional waves by ``preset``'s own drive (its speed loop),
+    measured in the time domain on :func:`reflection_preset` (one pulse up, its reflection
+    down, nothing else), with the analytic curve."""
+    f_hz = reflection_frequencies() if f_hz is None else f_hz
+    drive = preset.top_drive.with_(mode="speed")
+    line = reflection_preset(preset)
+
+    def run(pulse: bool) -> tuple[np.ndarray, np.ndarray]:
+        sim = off_bottom_simulator(line, drive, anechoic=True)
+        if pulse:
+            z_top = float(sim.string_arrays()[2][sg.W_Z, 0])
+            width = PULSE_WIDTH_S / (line.scales.time_s * sim.config.dtau)
+            send_pulse_from_bit(sim, False, 0.05 * line.params.omega0 * z_top, width)
+        a, b, _ = _top_records(sim, z_top_of(sim), seconds)
+        return a, b
+
+    sample_hz = 1.0 / (32 * line.dtau * line.scales.time_s)
+    ratio = reflection_of(run, sample_hz, f_hz)
+    phys = drive.physical(preset.scales)
+    z_si = preset.string.sections[0].torsional_impedance_nm_s
+    analytic = analytic_reflection(z_si, phys.inertia_kg_m2, phys.kp_nm_s, phys.ki_nm, f_hz)
+    return Reflection([float(f) for f in f_hz], [float(r) for r in ratio],
+                      [float(r) for r in analytic])
+
+
+def z_top_of(sim: Simulator) -> float:
+    """The impedance of the string's top part, kernel units."""
+    return float(sim.string_arrays()[2][sg.W_Z, 0])

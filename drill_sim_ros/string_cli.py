@@ -1,0 +1,120 @@
+"""``drill_sim modes`` and ``drill_sim reflection``: the string instruments on the command line.
+
+Both simulate in the time domain (model/string_instruments.py) and print a table, then, as
+the last line of stdout, one JSON object (``--json``: only that line).
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+from typing import Any
+
+from drill_sim_ros.control.reflection import measure_reflection_with
+from drill_sim_ros.model import string_instruments as si
+from drill_sim_ros.model.errors import ParameterError
+from drill_sim_ros.model.presets import DEFAULT_PRESET, load_preset
+
+
+def add_parsers(sub: Any) -> None:
+    modes = sub.add_parser("modes", help="natural frequencies of the string from a simulated "
+                           "ring-down, beside the analytic ones")
+    modes.add_argument("--params", default=DEFAULT_PRESET, help="preset name or YAML path")
+    modes.add_argument("--count", type=int, default=3, help="modes of each kind (1-6)")
+    modes.add_argument("--json", action="store_true", help="print only the JSON line")
+    refl = sub.add_parser("reflection", help="the top drive's reflection of torsional waves "
+                          "|r| against frequency, measured in the time domain")
+    refl.add_argument("--params", default=DEFAULT_PRESET, help="preset name or YAML path")
+    refl.add_argument("--controller", action="append", default=[],
+                      help="measure with this controller in the loop through the closed-loop "
+                      "bench (a built-in or path/file.py:Class); repeat for several; "
+                      "without: the drive's own speed loop, beside the formula")
+    refl.add_argument("--mode", choices=("speed", "torque"), default="speed",
+                      help="the drive's mode under --controller (default speed)")
+    refl.add_argument("--seconds", type=float, default=120.0,
+                      help="length of the record after the pulse, s of simulated time "
+                      "(20-3600)")
+    refl.add_argument("--json", action="store_true", help="print only the JSON line")
+    refl.add_argument("--plot", type=Path, help="write a PNG of |r| against frequency")
+
+
+def cmd_modes(args: Any) -> int:
+    if not 1 <= args.count <= 6:
+        raise ParameterError(f"--count = {args.count} must be in [1, 6]")
+    modes = si.identify_modes(load_preset(args.params), count=args.count).as_dict()
+    out = {kind: {key: [round(float(f), 6) for f in values] for key, values in d.items()}
+           for kind, d in modes.items()}
+    if not args.json:
+        print("mode  kind        identified Hz  analytic Hz  error")
+        for kind in ("torsional", "axial"):
+            for i, (a, b) in enumerate(zip(out[kind]["identified_hz"],
+                                           out[kind]["analytic_hz"], strict=False)):
+                print(f"{i + 1:4d}  {kind:10s}  {a:12.4f}  {b:11.4f}  {(a - b) / b:+.2%}")
+    print(json.dumps(out))
+    return 0
+
+
+def cmd_reflection(args: Any) -> int:
+    if not 20.0 <= args.seconds <= 3600.0:
+        raise ParameterError(f"--seconds = {args.seconds!r} must be in [20, 3600]")
+    if args.plot is not None:
+        _check_plot_path(args.plot)
+    preset = load_preset(args.params)
+    si.require_distributed(preset)
+    curves: dict[str, list[float]] = {}
+    if args.controller:
+        for name in args.controller:
+            result = measure_reflection_with(args.params, name, args.mode, args.seconds)
+            curves[name] = [round(r, 5) for r in result.r_measured]
+        analytic = None
+    else:
+        result = si.measure_reflection(preset, seconds=args.seconds)
+        curves["speed loop"] = [round(r, 5) for r in result.r_measured]
+        analytic = [round(r, 5) for r in result.r_analytic]
+    out: dict[str, Any] = {"f_hz": [round(f, 6) for f in result.f_hz],
+                           "r_measured": next(iter(curves.values())), "r_analytic": analytic}
+    if len(curves) > 1:
+        out["controllers"] = curves
+    if not args.json:
+        print("f Hz    " + "".join(f"{name:>14s}" for name in curves)
+              + ("    analytic" if analytic else ""))
+        for i, f in enumerate(out["f_hz"]):
+            print(f"{f:6.3f}  " + "".join(f"{c[i]:14.4f}" for c in curves.values())
+                  + (f"  {analytic[i]:10.4f}" if analytic else ""))
+    if args.plot is not None:
+        _plot(args.plot, preset.name, out["f_hz"], curves, analytic)
+    print(json.dumps(out))
+    return 0
+
+
+def _check_plot_path(path: Path) -> None:
+    if path.suffix.lower() != ".png":
+        raise ParameterError(f"--plot {path}: the picture is a .png")
+    if path.is_dir() or path.exists():
+        raise ParameterError(f"--plot {path} exists; choose a new file")
+    if not path.parent.is_dir():
+        raise ParameterError(f"--plot {path}: directory {path.parent} does not exist")
+
+
+def _plot(path: Path, name: str, f_hz: list[float], curves: dict[str, list[float]],
+          analytic: list[float] | None) -> None:
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(7, 4))
+    for label, values in curves.items():
+        ax.semilogx(f_hz, values, "o-", label=f"{label} (measured in the time domain)")
+    if analytic is not None:
+        ax.semilogx(f_hz, analytic, "k--", label="|Z - Z_TD| / |Z + Z_TD|")
+    ax.axhline(1.0, color="0.5", lw=0.8)
+    ax.set_xlabel("frequency, Hz")
+    ax.set_ylabel("|r| of torsional waves at the top drive")
+    ax.set_title(f"{name}: reflection at the top drive (> 1: the drive feeds the wave)")
+    ax.set_ylim(0.0, max(1.05, 1.05 * max(max(v) for v in curves.values())))
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    print(f"wrote {path}", file=sys.stderr)

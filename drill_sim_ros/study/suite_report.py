@@ -1,0 +1,187 @@
+"""The league table of a suite: printed, and as DIR/suite.json, DIR/suite.nc (xarray) and
+DIR/report.md with one picture per scenario (DIR/<scenario>.png, one column per controller).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Sequence
+from datetime import UTC, datetime
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import xarray as xr
+
+from drill_sim_ros import __version__
+from drill_sim_ros.control.scorecard import status_text
+from drill_sim_ros.study.suite import Entry, EntryResult
+
+# (card key, column head, format) of the table
+COLUMNS = (("ssi_mean", "SSI after", ".3f"), ("stick_fraction", "stick frac", ".3f"),
+           ("rop_m_h", "ROP m/h", ".2f"), ("mse_mpa", "MSE MPa", ".0f"),
+           ("time_to_suppress_s", "suppress s", ".1f"),
+           ("saturation_fraction", "saturated", ".1%"))
+NUMERIC = ("ssi_mean", "ssi_max", "ssi_last", "stick_fraction", "utr", "time_to_suppress_s",
+           "rop_m_h", "mse_mpa", "quill_torque_peak_nm", "quill_torque_rms_nm",
+           "motor_energy_mj", "saturation_fraction", "stall_time_s", "wall_s")
+UNITS = {"rop_m_h": "m/h", "mse_mpa": "MPa", "time_to_suppress_s": "s", "stall_time_s": "s",
+         "quill_torque_peak_nm": "N m", "quill_torque_rms_nm": "N m", "motor_energy_mj": "MJ",
+         "wall_s": "s"}
+
+
+def _cell(value: Any, fmt: str) -> str:
+    if value is None or (isinstance(value, float) and not math.isfinite(value)):
+        return "-"
+    return format(value, fmt)
+
+
+def table_rows(entries: Sequence[Entry], results: dict[str, EntryResult]) -> list[list[str]]:
+    """One row per entry: scenario, controller, the COLUMNS, status."""
+    out = []
+    for entry in entries:
+        result = results.get(entry.key)
+        card = result.card if result else {"status": "not run"}
+        out.append([entry.scenario_name, _label(entry),
+                    *(_cell(card.get(key), fmt) for key, _, fmt in COLUMNS),
+                    status_text(card)])
+    return out
+
+
+def _label(entry: Entry) -> str:
+    name = entry.controller.split(":")[-1]
+    return name if entry.controller == "none" else f"{name} ({entry.scenario.mode})"
+
+
+HEADS = ("scenario", "controller", *(head for _, head, _ in COLUMNS), "status")
+
+
+def format_table(entries: Sequence[Entry], results: dict[str, EntryResult]) -> str:
+    """The table as aligned text, a blank line between scenarios."""
+    rows = table_rows(entries, results)
+    widths = [max(len(h), *(len(r[i]) for r in rows)) for i, h in enumerate(HEADS)]
+    def line(cells: Sequence[str]) -> str:
+        return "  ".join(c.ljust(w) if i < 2 or i == len(cells) - 1 else c.rjust(w)
+                         for i, (c, w) in enumerate(zip(cells, widths, strict=True))).rstrip()
+    out, last = [line(HEADS)], None
+    for row in rows:
+        if last is not None and row[0] != last:
+            out.append("")
+        out.append(line(row))
+        last = row[0]
+    return "\n".join(out)
+
+
+def markdown_table(entries: Sequence[Entry], results: dict[str, EntryResult]) -> str:
+    rows = table_rows(entries, results)
+    lines = ["| " + " | ".join(HEADS[1:]) + " |", "|" + "---|" * (len(HEADS) - 1)]
+    lines += ["| " + " | ".join(row[1:]) + " |" for row in rows]
+    return "\n".join(lines)
+
+
+def suite_json(entries: Sequence[Entry], results: dict[str, EntryResult],
+               wall_s: float) -> dict[str, Any]:
+    return {"package_version": __version__, "wall_s": wall_s,
+            "created_utc": datetime.now(UTC).isoformat(timespec="seconds"),
+            "entries": [{"scenario": e.scenario_name, "controller": e.controller,
+                         "mode": e.scenario.mode,
+                         "status": status_text(results[e.key].card) if e.key in results
+                         else "not run",
+                         "score": _clean(results[e.key].card) if e.key in results else None,
+                         "wall_s": results[e.key].wall_s if e.key in results else None}
+                        for e in entries]}
+
+
+def _clean(value: Any) -> Any:
+    if isinstance(value, dict):
+        return {k: _clean(v) for k, v in value.items()}
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return value
+
+
+def suite_dataset(entries: Sequence[Entry], results: dict[str, EntryResult]) -> xr.Dataset:
+    """The table over (scenario, controller): each figure, and the status as text."""
+    scenarios = list(dict.fromkeys(e.scenario_name for e in entries))
+    controllers = list(dict.fromkeys(_label(e) for e in entries))
+    shape = (len(scenarios), len(controllers))
+    data = {name: np.full(shape, np.nan) for name in NUMERIC}
+    status = np.full(shape, "not run", dtype=object)
+    for e in entries:
+        i, j = scenarios.index(e.scenario_name), controllers.index(_label(e))
+        result = results.get(e.key)
+        if result is None:
+            continue
+        status[i, j] = status_text(result.card)
+        for name in NUMERIC:
+            value = result.wall_s if name == "wall_s" else result.card.get(name)
+            if isinstance(value, (int, float)) and value is not None:
+                data[name][i, j] = float(value)
+    dims = ("scenario", "controller")
+    variables = {name: (dims, values, {"units": UNITS.get(name, "1")})
+                 for name, values in data.items()}
+    variables["status"] = (dims, status.astype(str))
+    return xr.Dataset(variables, coords={"scenario": scenarios, "controller": controllers},
+                      attrs={"title": "drill_sim suite: controllers x scenarios",
+                             "package_version": __version__})
+
+
+def write_outputs(out: Path, entries: Sequence[Entry], results: dict[str, EntryResult],
+                  wall_s: float, pictures: bool = True) -> list[Path]:
+    """suite.json, suite.nc, the pictures and report.md in ``out``; the files written."""
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "suite.json").write_text(json.dumps(suite_json(entries, results, wall_s), indent=1))
+    suite_dataset(entries, results).to_netcdf(out / "suite.nc", engine="h5netcdf")
+    written = [out / "suite.json", out / "suite.nc"]
+    images = draw_pictures(out, entries, results) if pictures else {}
+    (out / "report.md").write_text(report_markdown(entries, results, images, wall_s))
+    return [*written, *images.values(), out / "report.md"]
+
+
+def _by_scenario(entries: Sequence[Entry]) -> dict[str, list[Entry]]:
+    groups: dict[str, list[Entry]] = {}
+    for e in entries:
+        groups.setdefault(e.scenario_name, []).append(e)
+    return groups
+
+
+def draw_pictures(out: Path, entries: Sequence[Entry],
+                  results: dict[str, EntryResult]) -> dict[str, Path]:
+    """One PNG per scenario that ran: one column per controller."""
+    from drill_sim_ros.control.plot import PlotContext, PlotRun, plot_runs, schedule_events
+    from drill_sim_ros.control.rig import rig_physics
+    images = {}
+    for name, group in _by_scenario(entries).items():
+        runs = [(e, results[e.key]) for e in group
+                if e.key in results and len(results[e.key].trace)]
+        if not runs:
+            continue
+        scenario = group[0].scenario
+        preset = scenario.load_preset()
+        rig, schedule = rig_physics(preset), scenario.setpoints(preset)
+        ctx = PlotContext(f"{name}: {scenario.description}"[:150], schedule,
+                          scenario.enable_at_s, rig.max_torque_nm, rig.max_surface_rpm,
+                          schedule_events(schedule))
+        path = out / f"{name}.png"
+        plot_runs(path, [PlotRun(_label(e), r.rows(), e.scenario.mode == "speed",
+                                 status_text(r.card)) for e, r in runs], ctx)
+        images[name] = path
+    return images
+
+
+def report_markdown(entries: Sequence[Entry], results: dict[str, EntryResult],
+                    images: dict[str, Path], wall_s: float) -> str:
+    lines = ["# drill_sim suite", "",
+             f"{len(entries)} runs (controller x scenario), {wall_s:.0f} s of wall time for "
+             "those computed by the last call. Columns: SSI after the switch-on (mean of "
+             "whole 20 s windows), stick fraction after it, mean ROP, MSE at the bit, time "
+             "from the switch-on to the last stick (- while it still sticks in the last "
+             "20 s), share of samples with the drive saturated, status.", ""]
+    for name, group in _by_scenario(entries).items():
+        scenario = group[0].scenario
+        lines += [f"## {name}", "", scenario.description or "", "",
+                  markdown_table(group, results), ""]
+        if name in images:
+            lines += [f"![{name}]({images[name].name})", ""]
+    return "\n".join(lines)

@@ -1,0 +1,284 @@
+"""The distributed string: waves, modes, reflection, energy, and the lumped model unchanged.
+
+Expected values come from physics: the travel time L / c, the transfer-matrix and closed-form
+mode conditions, the reflection formula of an impedance Z_TD against the pipe's Z, the
+energy balance, the lumped limit of RGD07 eq. (1); and, for the lumped kernel, from the
+kernel as it was before the string existed (hashes of its output at commit 855bfb7).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from drill_sim_ros.model import kernel as k
+from drill_sim_ros.model import string as sg
+from drill_sim_ros.model import string_instruments as si
+from drill_sim_ros.model.presets import load_preset, preset_from_dict
+from drill_sim_ros.model.simulator import SimConfig, Simulator
+from drill_sim_ros.model.top_drive import TopDrive
+
+FIELD_PHYSICAL = {
+    "density_kg_m3": 7850.0, "shear_modulus_pa": 79.3e9, "youngs_modulus_pa": 206e9,
+    "bit_radius_m": 0.108, "n_blades": 6, "intrinsic_specific_energy_pa": 230e6,
+    "zeta": 0.729, "mu_gamma": 0.48, "contact_stress_times_wearflat_n_per_m": 3.0e5,
+    "applied_wob_n": 60e3, "surface_rpm": 60.0}
+PIPE = {"outer_radius_m": 0.0635, "inner_radius_m": 0.0543}
+COLLAR = {"outer_radius_m": 0.0857, "inner_radius_m": 0.0357}
+
+
+def string_preset(sections: list[dict], **string_keys: object):
+    return preset_from_dict("test", {
+        "physical": FIELD_PHYSICAL, "numerics": {"dtau": 5e-5},
+        "string": {"model": "distributed", "sections": sections, **string_keys},
+        "top_drive": {"mode": "speed", "inertia_kg_m2": 2900.0, "kp_nm_s": 23200.0,
+                      "ki_nm": 46400.0, "max_torque_nm": 50000.0}})
+
+
+# ---- the lumped model, bit for bit --------------------------------------------------------
+def lumped_hash(name: str, mode: str, method: str) -> str:
+    """The output of a fixed run, hashed (the columns and state entries that existed
+    before the string)."""
+    p = load_preset(name)
+    sim = Simulator(p.params, SimConfig(dtau=p.dtau, method=method, n_nodes=p.n_nodes or 2048),
+                    perturb_v=1e-3, top_drive=p.top_drive.with_(mode=mode), scales=p.scales)
+    s = sim.advance(200_000 if method == "profile" else 50_000, every=97)
+    if mode == "torque":
+        sim.set_inputs(motor_torque=float(sim.state[k.S_MOTOR_TORQUE]) * 1.01)
+    s2 = sim.advance(20_000, every=13)
+    return hashlib.sha256(np.ascontiguousarray(s.data[:, :16]).tobytes()
+                          + np.ascontiguousarray(s2.data[:, :16]).tobytes()
+                          + sim.state[:16].tobytes() + sim.profile.tobytes()
+                          + sim.accumulators.tobytes()).hexdigest()
+
+
+HASHES = json.loads((Path(__file__).parent / "data" / "lumped_hashes_855bfb7.json").read_text())
+
+
+@pytest.mark.parametrize("case", sorted(key for key in HASHES if not key.startswith("_")))
+def test_paper_presets_unchanged_bit_for_bit(case: str) -> None:
+    name, mode, method = case.split("/")
+    assert lumped_hash(name, mode, method) == HASHES[case]
+
+
+# ---- waves ----------------------------------------------------------------------------------
+def test_pulse_arrives_after_l_over_c_and_returns_whole() -> None:
+    """A pulse sent up from the bit on a uniform lossless string under a kinematic top: its
+    peak reaches the top after L / c (within a step), and after the round trip top -> bit
+    -> top (a fixed top keeps the torque's sign, the free bit flips it) it is back at the
+    top after 3 L / c with its peak within 1 %."""
+    preset = string_preset([{**PIPE, "length_m": 1500.0}, {**PIPE, "length_m": 1200.0}])
+    sim = si.off_bottom_simulator(preset, TopDrive(mode="kinematic", inertia_ratio=14.0))
+    dt_s = sim.config.dtau * preset.scales.time_s
+    travel_s = preset.string.torsional_travel_s
+    assert travel_s == pytest.approx(2700.0 / math.sqrt(79.3e9 / 7850.0), rel=1e-12)
+    amplitude = 0.02 * preset.params.omega0 * float(sim.string_arrays()[2][sg.W_Z, 0])
+    si.send_pulse_from_bit(sim, False, amplitude, width_steps=40.0)
+    rows = sim.advance(sim.steps_for(3.3 * travel_s / preset.scales.time_s), every=1).data
+    torque = rows[:, k.C_T_PIPE] - rows[0, k.C_T_PIPE]
+    t_s = np.arange(len(torque)) * dt_s
+
+    def peak(lo_s: float, hi_s: float, sign: float) -> tuple[float, float]:
+        window = np.flatnonzero((t_s > lo_s) & (t_s < hi_s))
+        i = window[np.argmax(sign * torque[window])]
+        a, b, c = torque[i - 1], torque[i], torque[i + 1]
+        shift = 0.5 * (a - c) / (a - 2.0 * b + c)
+        return (i + shift) * dt_s, b - 0.25 * (a - c) * shift
+
+    t1, p1 = peak(0.5 * travel_s, 1.5 * travel_s, 1.0)
+    t3, p3 = peak(2.5 * travel_s, 3.2 * travel_s, -1.0)
+    assert abs(t1 - travel_s) <= dt_s
+    assert abs(t3 - 3.0 * travel_s) <= dt_s
+    assert p1 == pytest.approx(amplitude, rel=0.01)   # the top doubles nothing: T = b + Z w
+    assert -p3 == pytest.approx(p1, rel=0.01)
+
+
+def test_junction_transmits_as_the_impedances_say() -> None:
+    """Pipe on collars: the pulse from the bit reaches the top with the transmission
+    coefficient of a torque wave from Z_collar into Z_pipe, 2 Z_pipe / (Z_pipe + Z_collar)."""
+    preset = string_preset([{**PIPE, "length_m": 2500.0}, {**COLLAR, "length_m": 200.0}])
+    sim = si.off_bottom_simulator(preset, TopDrive(mode="kinematic", inertia_ratio=14.0))
+    z_pipe, z_collar = (s.torsional_impedance_nm_s for s in preset.string.sections)
+    amplitude = 1e-3
+    si.send_pulse_from_bit(sim, False, amplitude, width_steps=40.0)
+    travel_s = preset.string.torsional_travel_s
+    rows = sim.advance(sim.steps_for(1.1 * travel_s / preset.scales.time_s), every=1).data
+    arrived = np.max(rows[:, k.C_T_PIPE] - rows[0, k.C_T_PIPE])
+    assert arrived == pytest.approx(amplitude * 2 * z_pipe / (z_pipe + z_collar), rel=0.01)
+
+
+# ---- modes --------------------------------------------------------------------------------
+def closed_form_two_section_hz(preset, axial: bool, count: int = 3) -> list[float]:
+    """Roots of tan(k L1) tan(k L2) = S1 / S2 (one material, fixed top, free bit), written
+    as S1 cos cos - S2 sin sin = 0 and bracketed on a fine grid."""
+    top, bottom = preset.string.sections
+    c = top.axial_speed_m_s if axial else top.torsional_speed_m_s
+    s1, s2 = ((top.axial_stiffness_n, bottom.axial_stiffness_n) if axial else
+              (top.torsional_stiffness_nm, bottom.torsional_stiffness_nm))
+    w = np.linspace(1e-4, 2 * math.pi * 5.0, 2_000_001)
+    g = s1 * np.cos(w * top.length_m / c) * np.cos(w * bottom.length_m / c) \
+        - s2 * np.sin(w * top.length_m / c) * np.sin(w * bottom.length_m / c)
+    i = np.flatnonzero(np.sign(g[:-1]) != np.sign(g[1:]))[:count]
+    roots = w[i] - g[i] * (w[i + 1] - w[i]) / (g[i + 1] - g[i])
+    return list(roots / (2 * math.pi))
+
+
+def test_field_modes_identified_from_the_ring_down() -> None:
+    preset = load_preset("field_8p5in_shale")
+    modes = si.identify_modes(preset)
+    for axial, identified, analytic in ((False, modes.torsional_identified_hz,
+                                         modes.torsional_analytic_hz),
+                                        (True, modes.axial_identified_hz,
+                                         modes.axial_analytic_hz)):
+        closed = closed_form_two_section_hz(preset, axial)
+        assert analytic == pytest.approx(closed, rel=1e-5)
+        assert len(identified) == 3
+        assert identified == pytest.approx(analytic, rel=0.005)
+    # the issue's figures for this string (fixed top, free bit, E = 206 GPa)
+    assert modes.torsional_analytic_hz == pytest.approx([0.2115, 0.7276, 1.3211], abs=1e-4)
+    assert modes.axial_analytic_hz == pytest.approx([0.3616, 1.1983, 2.1463], abs=1e-4)
+
+
+def test_modes_of_a_three_section_string_with_a_bit_inertia() -> None:
+    """Drill pipe, heavy-weight pipe, collars and a lumped bit inertia: the ring-down finds
+    the transfer-matrix modes (which include the bit inertia)."""
+    hwdp = {"outer_radius_m": 0.0635, "inner_radius_m": 0.0381, "length_m": 150.0}
+    preset = string_preset([{**PIPE, "length_m": 1800.0}, hwdp,
+                            {**COLLAR, "length_m": 120.0}], bit_inertia_kg_m2=40.0)
+    modes = si.identify_modes(preset)
+    assert modes.torsional_identified_hz == pytest.approx(modes.torsional_analytic_hz,
+                                                          rel=0.005)
+    assert modes.axial_identified_hz == pytest.approx(modes.axial_analytic_hz, rel=0.005)
+
+
+def test_light_pipe_on_a_heavy_bha_approaches_the_lumped_model() -> None:
+    """A pipe much lighter than its BHA: mode 1 tends to sqrt(C / I) / 2 pi of RGD07 eq. (1),
+    both in the formula and in the simulated ring-down."""
+    thin = {**PIPE, "length_m": 2000.0}                       # 186 kg m^2
+    heavy = {"outer_radius_m": 0.2, "inner_radius_m": 0.05, "length_m": 100.0}  # 1963
+    preset = string_preset([thin, heavy])
+    _mass, inertia, stiffness = sg.lumped_equivalent(preset.string)
+    lumped_hz = math.sqrt(stiffness / inertia) / (2 * math.pi)
+    modes = si.identify_modes(preset, count=1)
+    assert modes.torsional_analytic_hz[0] == pytest.approx(lumped_hz, rel=0.01)
+    assert modes.torsional_identified_hz[0] == pytest.approx(lumped_hz, rel=0.01)
+
+
+# ---- reflection ------------------------------------------------------------------------
+def test_reflection_of_the_speed_loop_matches_the_formula() -> None:
+    preset = load_preset("field_8p5in_shale")
+    result = si.measure_reflection(preset, seconds=60.0)
+    assert len(result.f_hz) >= 8 and min(result.f_hz) <= 0.05 and max(result.f_hz) >= 2.0
+    assert np.max(np.abs(np.array(result.r_measured) - result.r_analytic)) < 0.03
+
+
+def test_reflection_through_the_bench() -> None:
+    """The drive's own loop through the closed-loop bench (sampled at 100 Hz) gives the
+    formula too; a damper-like law (soft_torque, c close to Z) absorbs most of a wave
+    where the stiff loop reflects nearly all of it."""
+    from drill_sim_ros.control.reflection import measure_reflection_with
+    preset = load_preset("field_8p5in_shale")
+    native = measure_reflection_with("field_8p5in_shale", "none", seconds=60.0)
+    drive = preset.top_drive.physical(preset.scales)
+    z = preset.string.sections[0].torsional_impedance_nm_s
+    formula = si.analytic_reflection(z, drive.inertia_kg_m2, drive.kp_nm_s, drive.ki_nm,
+                                     np.array(native.f_hz))
+    assert np.max(np.abs(np.array(native.r_measured) - formula)) < 0.03
+    soft = measure_reflection_with("field_8p5in_shale", "soft_torque", seconds=60.0)
+    band = (np.array(soft.f_hz) > 0.1) & (np.array(soft.f_hz) < 0.5)
+    assert np.all(np.array(soft.r_measured)[band] < 0.5)
+    assert np.all(np.array(native.r_measured)[band] > 0.95)
+
+
+def test_an_impedance_matched_drive_reflects_nothing() -> None:
+    """A drive whose loop is a pure damper equal to the pipe's Z (kp = Z, ki = 0, a tiny
+    inertia): |r| = |Z - kp - i w J| / |Z + kp + i w J| -> nearly 0 at low frequency."""
+    preset = load_preset("field_8p5in_shale")
+    z = preset.string.sections[0].torsional_impedance_nm_s
+    f = np.array([0.1, 0.3, 1.0])
+    r = si.analytic_reflection(z, 1.0, z, 0.0, f)
+    assert np.all(r < 0.02)
+
+
+# ---- energy ------------------------------------------------------------------------------
+def energy_residual(dtau: float) -> float:
+    """Motor work minus (drive kinetic energy + string energy changes + bit-rock
+    dissipation) in the torsional line, relative to the motor work, over a speed step."""
+    preset = string_preset([{**PIPE, "length_m": 2500.0}, {**COLLAR, "length_m": 200.0}])
+    sim = Simulator(preset.params, SimConfig(dtau=dtau), perturb_v=1e-3,
+                    top_drive=preset.top_drive, scales=preset.scales,
+                    string=preset.kernel_string)
+    wave, wave_i, wave_f, parts = sim.string_arrays()
+    j = preset.top_drive.inertia_ratio
+
+    def stored() -> float:
+        omega_s = float(sim.state[k.S_OMEGA_S])
+        return (sg.line_energy(wave, wave_i, wave_f, 0, parts[0], dtau)
+                + 0.5 * j * omega_s**2)
+
+    e0 = stored()
+    sim.set_inputs(omega_s=1.3 * preset.params.omega0)
+    rows = sim.advance(sim.steps_for(8.0), every=1).data
+    omega_s_next = np.append(rows[1:, k.C_OMEGA_S], sim.state[k.S_OMEGA_S])
+    omega_bit_next = np.append(rows[1:, k.C_OMEGA], sim.state[k.S_OMEGA])
+    work = float(np.sum(rows[:, k.C_MOTOR_TORQUE] * omega_s_next) * dtau)
+    dissipated = float(np.sum(rows[:, k.C_TOB] * omega_bit_next) * dtau)
+    return abs(work - (stored() - e0) - dissipated) / abs(work)
+
+
+def test_energy_balances_with_no_damping_to_a_tolerance_that_shrinks_with_the_step() -> None:
+    coarse, fine = energy_residual(1e-4), energy_residual(2.5e-5)
+    assert coarse < 1e-2
+    assert fine < 0.5 * coarse
+
+
+def test_damping_rate_sets_the_mode_damping_ratio() -> None:
+    """Mass-proportional damping rate gamma gives every mode the damping ratio
+    gamma / (2 omega_k): the ring-down of mode 1 decays per cycle by exp(-2 pi zeta)."""
+    gamma = 0.05
+    thin = {**PIPE, "length_m": 2500.0}
+    preset = string_preset([thin, {**COLLAR, "length_m": 200.0}],
+                           torsional_damping_per_s=gamma)
+    sim = si.off_bottom_simulator(preset, TopDrive(mode="kinematic", inertia_ratio=14.0))
+    z0 = float(sim.string_arrays()[2][sg.W_Z, 0])
+    si.send_pulse_from_bit(sim, False, 0.02 * preset.params.omega0 * z0, width_steps=2000.0)
+    data, hz = si._ring_down(sim, 120.0, (k.C_OMEGA,))
+    omega1 = 2 * math.pi * si.identify_modes(preset, count=1).torsional_analytic_hz[0]
+    # envelope of mode 1: the signal low-passed well below mode 2, amplitude per cycle
+    x = data[:, 0] - data[:, 0].mean()
+    spectrum = np.fft.rfft(x)
+    f = np.fft.rfftfreq(x.size, 1 / hz)
+    spectrum[f > 0.45] = 0.0
+    mode1 = np.fft.irfft(spectrum, x.size)
+    t = np.arange(x.size) / hz
+    late = (t > 20) & (t < 100)
+    envelope = np.abs(mode1[late])
+    peaks_t = t[late][1:-1][(envelope[1:-1] > envelope[:-2]) & (envelope[1:-1] >= envelope[2:])]
+    peaks_a = envelope[1:-1][(envelope[1:-1] > envelope[:-2]) & (envelope[1:-1] >= envelope[2:])]
+    rate = -np.polyfit(peaks_t, np.log(peaks_a), 1)[0]
+    assert rate == pytest.approx(gamma / 2, rel=0.1)          # zeta omega1 = gamma / 2
+    assert omega1 > 0
+
+
+def test_the_end_sample_leaves_the_distributed_string_untouched() -> None:
+    """advance_into with sample_end takes one step on the side and undoes it: the run goes
+    on exactly as one that never sampled."""
+    preset = load_preset("field_8p5in_shale")
+    sims = [Simulator(preset.params, SimConfig(dtau=1e-4), perturb_v=1e-3,
+                      top_drive=preset.top_drive, scales=preset.scales,
+                      string=preset.kernel_string) for _ in range(2)]
+    out = np.empty((400, k.N_COLS))
+    for _ in range(20):
+        sims[0].advance_into(out, 136, 136, sample_end=True)
+        sims[1].advance(136)
+    assert np.array_equal(sims[0].state, sims[1].state)
+    assert np.array_equal(sims[0].string_arrays()[0], sims[1].string_arrays()[0])
+    assert np.array_equal(sims[0].string_arrays()[1], sims[1].string_arrays()[1])
+    end = out[1]                                  # the end sample of the last run
+    step = sims[1].advance(1, every=1).data[0]    # what the next step records at its start
+    assert np.array_equal(end, step)

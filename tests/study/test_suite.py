@@ -1,0 +1,102 @@
+"""drill_sim suite on a two-scenario subset, on a real Dask LocalCluster on 127.0.0.1: the
+table, its files read back by independent readers, and resuming (a finished run is never
+computed twice; a changed scenario is)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+import xarray as xr
+import yaml
+
+from drill_sim_ros.control.bench import run_in_process
+from drill_sim_ros.control.rig import rig_physics
+from drill_sim_ros.control.scenario import load_scenario
+from drill_sim_ros.control.scorecard import score
+from tests.study.helpers import drill_sim
+
+# 40 s of the field case: stick-slip from about 15 s, control on at 20 s
+FIELD = {"description": "field stick-slip, short", "duration_s": 40.0, "enable_at_s": 20.0,
+         "schedule": [{"t_s": 0, "rpm": 60, "wob_n": 60000}]}
+STEP = {**FIELD, "description": "a speed step, short",
+        "schedule": [{"t_s": 0, "rpm": 60, "wob_n": 60000}, {"t_s": 25, "rpm": 80}],
+        "drive": {"accel_rpm_s": 10.0, "command_delay_s": 0.004}}
+STREAK = {**FIELD, "formation": [{"top_m": 0.0}, {"top_m": 0.05}]}
+
+
+def write(path: Path, data: dict) -> Path:
+    path.write_text(yaml.safe_dump(data))
+    return path
+
+
+def suite(tmp_path: Path, *files: Path) -> str:
+    args = ["suite", "--controller", "none", "--controller", "soft_torque", "--workers", "1",
+            "--out", str(tmp_path / "out")]
+    for f in files:
+        args += ["--scenario", str(f)]
+    result = drill_sim(*args, timeout=600)
+    assert result.returncode == 0, result.stderr[-2000:]
+    return result.stdout
+
+
+@pytest.fixture(scope="module")
+def league(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, str, list[Path]]:
+    tmp = tmp_path_factory.mktemp("suite")
+    files = [write(tmp / "field.yaml", FIELD), write(tmp / "step.yaml", STEP),
+             write(tmp / "streak.yaml", STREAK)]
+    return tmp, suite(tmp, *files), files
+
+
+def test_the_table_and_its_files(league: tuple[Path, str, list[Path]]) -> None:
+    tmp, stdout, files = league
+    out = tmp / "out"
+    lines = [line.split() for line in stdout.splitlines()]
+    status = {(w[0], w[1]): " ".join(w[-1:]) for w in lines if w and w[0] in ("field", "step")}
+    # physics: the drive's own loop leaves stick-slip; soft torque damps it (tests/control)
+    assert status[("field", "none")] == "stick-slip"
+    assert status[("field", "soft_torque")] == "ok"
+    assert "needs formation_layers" in stdout
+    doc = json.loads((out / "suite.json").read_text())
+    by = {(e["scenario"], e["controller"]): e for e in doc["entries"]}
+    assert len(by) == 6 and by[("streak", "none")]["status"] == "needs formation_layers"
+    # the numbers that came back from the worker are the bench's, run here independently
+    for name, path in (("field", files[0]), ("step", files[1])):
+        scenario = load_scenario(path).with_(controller="soft_torque", params={})
+        preset = scenario.load_preset()
+        card = score(run_in_process(scenario).rows, scenario.enable_at_s,
+                     scenario.setpoints(preset), rig_physics(preset), scenario.period_s)
+        got = by[(name, "soft_torque")]["score"]
+        for key in ("ssi_mean", "stick_fraction", "rop_m_h", "mse_mpa", "saturation_count"):
+            assert got[key] == pytest.approx(card[key], rel=1e-12), key
+    ds = xr.load_dataset(out / "suite.nc", engine="h5netcdf")
+    assert list(ds["scenario"].values) == ["field", "step", "streak"]
+    assert ds["status"].sel(scenario="field").values.tolist() == ["stick-slip", "ok"]
+    assert np.isnan(ds["ssi_mean"].sel(scenario="streak")).all()
+    report = (out / "report.md").read_text()
+    for name in ("field", "step"):
+        png = out / f"{name}.png"
+        assert f"![{name}]({name}.png)" in report
+        assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and png.stat().st_size > 30_000
+    assert not (out / "streak.png").exists()
+
+
+def test_resume_computes_only_what_is_missing_or_changed(
+        league: tuple[Path, str, list[Path]]) -> None:
+    tmp, first, files = league
+    runs = tmp / "out" / "runs"
+    stamps = {p.name: p.stat().st_mtime_ns for p in runs.glob("*.npz")}
+    assert len(stamps) == 4                            # the streak needs the model core
+    again = suite(tmp, *files)
+    assert "(0 computed now)" in again
+    assert {p.name: p.stat().st_mtime_ns for p in runs.glob("*.npz")} == stamps
+    (runs / "field__none.npz").unlink()
+    write(files[1], {**STEP, "schedule": [{"t_s": 0, "rpm": 60, "wob_n": 60000},
+                                          {"t_s": 25, "rpm": 70}]})
+    third = suite(tmp, *files)
+    assert "(3 computed now)" in third                 # field/none and both step runs
+    assert {p.name: p.stat().st_mtime_ns for p in runs.glob("*.npz")}[
+        "field__soft_torque.npz"] == stamps["field__soft_torque.npz"]
+    assert first.splitlines()[1:3] == third.splitlines()[1:3]    # the field rows agree
