@@ -23,6 +23,9 @@ from drill_sim_ros.model.top_drive import MODES, TopDrive, TopDrivePhysical
 
 PRESET_SECTIONS = ("description", "physical", "dimensionless", "numerics", "top_drive",
                    "string")      # 'string' is checked by model.presets (string_from_dict)
+# the lumped string's geometry: given by ``string.sections`` when the preset has them
+GEOMETRY_KEYS = ("pipe_outer_radius_m", "pipe_inner_radius_m", "pipe_length_m",
+                 "bha_outer_radius_m", "bha_inner_radius_m", "bha_length_m")
 INTEGER_KEYS = frozenset({"n", "n_blades", "n_nodes"})
 STRING_KEYS = frozenset({"mode"})
 NUMERICS_KEYS = ("dtau", "n_nodes")
@@ -64,8 +67,10 @@ def check_value(where: str, key: str, value: Any) -> None:
         raise ParameterError(f"'{where}.{key}' = {value!r} must be finite")
 
 
-def check_section(where: str, values: Any, known: tuple[str, ...], required: bool) -> None:
-    """A mapping of ``known`` keys only (all of them if ``required``), each of its type."""
+def check_section(where: str, values: Any, known: tuple[str, ...], required: bool,
+                  optional: tuple[str, ...] = ()) -> None:
+    """A mapping of ``known`` keys only (all of them but ``optional`` if ``required``), each
+    of its type."""
     if not isinstance(values, dict):
         raise ParameterError(f"'{where}' must be a mapping of {', '.join(known)}; "
                              f"got {values!r}")
@@ -73,7 +78,7 @@ def check_section(where: str, values: Any, known: tuple[str, ...], required: boo
     if unknown:
         raise ParameterError(f"unknown key(s) {', '.join(unknown)} in '{where}'; known: "
                              f"{', '.join(known)}")
-    missing = [k for k in known if k not in values]
+    missing = [k for k in known if k not in values and k not in optional]
     if required and missing:
         raise ParameterError(f"'{where}' is missing {', '.join(missing)} (a preset gives "
                              "every quantity; there is no silent default)")
@@ -103,7 +108,9 @@ def check_preset_mapping(data: Any) -> None:
     if physical == ("dimensionless" in data):
         raise ParameterError("a preset needs exactly one of 'physical' or 'dimensionless'")
     if physical:
-        check_section("physical", data["physical"], _names(PhysicalParams), required=True)
+        sections = isinstance(data.get("string"), dict) and "sections" in data["string"]
+        check_section("physical", data["physical"], _names(PhysicalParams), required=True,
+                      optional=GEOMETRY_KEYS if sections else ())
     else:
         check_section("dimensionless", data["dimensionless"], _names(DimensionlessParams),
                       required=True)

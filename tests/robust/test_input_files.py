@@ -111,3 +111,12 @@ def test_the_shipped_and_multi_node_params_files_pass(tmp_path: Path) -> None:
                     "/**:\n  ros__parameters:\n    use_sim_time: false\n"
                     "/rig/drill_sim:\n  ros__parameters:\n    model:\n      preset: fig5_8a\n")
     check_params_files(["sim_node", "--ros-args", "--params-file", str(both)])
+
+
+def test_a_lumped_preset_must_give_its_geometry(capsys, tmp_path: Path) -> None:
+    data = yaml.safe_load((ROOT / "config/presets/field_8p5in_shale_lumped.yaml").read_text())
+    del data["physical"]["pipe_length_m"]
+    path = tmp_path / "lumped.yaml"
+    path.write_text(yaml.safe_dump(data))
+    rc, _, err = run_cli(capsys, "info", str(path))
+    one_error_line(rc, err, str(path), "missing pipe_length_m")
