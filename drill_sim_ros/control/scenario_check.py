@@ -15,7 +15,7 @@ from typing import Any
 
 from drill_sim_ros.model.errors import ParameterError
 from drill_sim_ros.model.measurement import MAX_DELAY_PERIODS, SIGNALS
-from drill_sim_ros.model.validate_input import as_number
+from drill_sim_ros.model.validate_input import as_number, check_known_keys
 
 CONTROL_RATE_RANGE_HZ = (1.0, 1000.0)      # sim_node's publish_rate_hz
 MAX_PERIODS = 2_000_000                    # 2e6 rows x 21 float64 = 336 MB per run
@@ -72,10 +72,7 @@ def check_sensors(sensors: Any) -> dict[str, Any]:
         if not isinstance(spec, dict):
             raise ParameterError(f"scenario: 'sensors.{name}' = {spec!r} must be a mapping "
                                  f"of {', '.join(SIGNAL_KEYS)}")
-        unknown = sorted(str(k) for k in set(spec) - set(SIGNAL_KEYS))
-        if unknown:
-            raise ParameterError(f"scenario: unknown key(s) {', '.join(unknown)} in "
-                                 f"'sensors.{name}'; known: {', '.join(SIGNAL_KEYS)}")
+        check_known_keys(spec, SIGNAL_KEYS, f"sensors.{name}")
         for key, value in spec.items():
             if key == "delay_periods":
                 spec[key] = check_integer(f"sensors.{name}.{key}", value, 0,

@@ -67,6 +67,15 @@ def check_value(where: str, key: str, value: Any) -> None:
         raise ParameterError(f"'{where}.{key}' = {value!r} must be finite")
 
 
+def check_known_keys(values: dict[Any, Any], known: tuple[str, ...], where: str = "") -> None:
+    """ParameterError naming the keys of ``values`` that are not ``known`` (and the known)."""
+    unknown = sorted(str(k) for k in set(values) - set(known))
+    if unknown:
+        place = f" in '{where}'" if where else ""
+        raise ParameterError(f"unknown key(s) {', '.join(unknown)}{place}; known: "
+                             f"{', '.join(known)}")
+
+
 def check_section(where: str, values: Any, known: tuple[str, ...], required: bool,
                   optional: tuple[str, ...] = ()) -> None:
     """A mapping of ``known`` keys only (all of them but ``optional`` if ``required``), each
@@ -74,10 +83,7 @@ def check_section(where: str, values: Any, known: tuple[str, ...], required: boo
     if not isinstance(values, dict):
         raise ParameterError(f"'{where}' must be a mapping of {', '.join(known)}; "
                              f"got {values!r}")
-    unknown = sorted(str(k) for k in set(values) - set(known))
-    if unknown:
-        raise ParameterError(f"unknown key(s) {', '.join(unknown)} in '{where}'; known: "
-                             f"{', '.join(known)}")
+    check_known_keys(values, known, where)
     missing = [k for k in known if k not in values and k not in optional]
     if required and missing:
         raise ParameterError(f"'{where}' is missing {', '.join(missing)} (a preset gives "
@@ -100,10 +106,7 @@ def check_preset_mapping(data: Any) -> None:
     if not isinstance(data, dict):
         raise ParameterError(f"a preset file holds a mapping of {', '.join(PRESET_SECTIONS)}; "
                              f"got {data!r}")
-    unknown = sorted(str(k) for k in set(data) - set(PRESET_SECTIONS))
-    if unknown:
-        raise ParameterError(f"unknown key(s) {', '.join(unknown)}; known: "
-                             f"{', '.join(PRESET_SECTIONS)}")
+    check_known_keys(data, PRESET_SECTIONS)
     physical = "physical" in data
     if physical == ("dimensionless" in data):
         raise ParameterError("a preset needs exactly one of 'physical' or 'dimensionless'")
