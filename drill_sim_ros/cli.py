@@ -1,5 +1,5 @@
-"""Offline command line: ``drill_sim run | sweep | presets | info | closed-loop | suite |
-map | map-plot | figures``.
+"""Offline command line: ``drill_sim run | sweep | presets | params | info | closed-loop |
+suite | modes | reflection | map | map-plot | figures``.
 
 ``drill_sim run`` integrates the RGD07 model without ROS and prints a summary (or one JSON
 object with ``--json``). The run is dimensionless unless ``--params`` names a physical
@@ -25,7 +25,7 @@ from drill_sim_ros.model import analysis, telemetry
 from drill_sim_ros.model import kernel as k
 from drill_sim_ros.model.errors import DrillSimError
 from drill_sim_ros.model.params import GROUPS, UNIT_SCALES, DimensionlessParams, Scales
-from drill_sim_ros.model.presets import Preset, available_presets, load_preset
+from drill_sim_ros.model.presets import DEFAULT_PRESET, Preset, available_presets, load_preset
 from drill_sim_ros.model.simulator import SimConfig, Simulator
 from drill_sim_ros.model.top_drive import MODES, TopDrive
 from drill_sim_ros.model.validate_input import load_checked_preset
@@ -117,6 +117,11 @@ def build_parser() -> argparse.ArgumentParser:
     sweep.add_argument("--values", required=True,
                        help="comma-separated values, or start:stop:count")
     sub.add_parser("presets", help="list the presets")
+    params = sub.add_parser("params", help="every sim_node parameter: type, unit, range, "
+                            "default, runtime-changeable (what `ros2 param describe` shows)")
+    params.add_argument("--preset", default=DEFAULT_PRESET,
+                        help="take the physical defaults from this preset")
+    params.add_argument("--json", action="store_true", help="one JSON list, not a table")
     closed_loop_cli.add_parser(sub)
     info = sub.add_parser("info", help="groups, scales and stability of a preset")
     info.add_argument("preset", nargs="?", default="field_8p5in_shale")
@@ -403,6 +408,9 @@ def main(argv: Sequence[str] | None = None) -> int:
             for name in available_presets():
                 print(f"{name:22s} {load_preset(name).description.splitlines()[0]}")
             return 0
+        if args.command == "params":             # imports rclpy: only when asked
+            from drill_sim_ros.ros import parameter_list
+            return parameter_list.run(args)
         if args.command == "map":
             return study_cli.cmd_map(args, _resolve)
         return {"run": _cmd_run, "sweep": _cmd_sweep, "info": _cmd_info,

@@ -11,7 +11,8 @@ build="$venv/build/drill_sim_msgs"
 # (/opt/python/cpXY-cpXY/...): point them at this venv's.
 py_include=$("$py" -c 'import sysconfig; print(sysconfig.get_paths()["include"])')
 np_include=$("$py" -c 'import numpy; print(numpy.get_include())')
-grep -l '/opt/python/' "$venv"/share/*/cmake/*Export.cmake 2>/dev/null | while read -r file; do
+{ grep -l '/opt/python/' "$venv"/share/*/cmake/*Export.cmake 2>/dev/null || true; } |
+while read -r file; do   # (none left on a second run)
   sed -i -e "s#/opt/python/[^;\"]*/include/python3\.[0-9]*#$py_include#g" \
          -e "s#/opt/python/[^;\"]*/site-packages/numpy/_core/include#$np_include#g" "$file"
 done

@@ -7,7 +7,8 @@ lockstep_trigger:=command``), so both give the same telemetry bit for bit:
 1. the session is built from the same settings sim_node takes from its parameters
    (:func:`session_config`, :func:`sim_node_parameters`), and its t = 0 sample is taken
    (sim_node publishes it at start; the sensors' noise and delay lines see it);
-2. the controller's first command reacts to no measurement (the initial state, stamp 0);
+2. the controller's first command answers the t = 0 sample (stamp 0), which sim_node
+   publishes, latched, before it waits for its first command;
 3. each command is applied with sim_node's limits (``control.command.apply_command``: speed and WOB
    within [0, limit], motor torque within +-the drive's limit) and stamped with the sample it
    reacts to; then exactly one period runs under it (zero-order hold), and the sample at the
@@ -65,11 +66,12 @@ class ClosedLoopRun:
     interrupted: bool = False     # Ctrl-C: ``rows`` holds the periods done
 
 
-def drive_of(preset: Preset, mode: str) -> TopDrivePhysical:
-    """The preset's drive in SI, in ``mode``."""
+def drive_of(preset: Preset, mode: str, motor_lag_s: float | None = None) -> TopDrivePhysical:
+    """The preset's drive in SI, in ``mode`` (and with ``motor_lag_s`` when given)."""
     d = preset.top_drive.physical(preset.scales)
     return TopDrivePhysical(mode=mode, inertia_kg_m2=d.inertia_kg_m2, kp_nm_s=d.kp_nm_s,
-                            ki_nm=d.ki_nm, max_torque_nm=d.max_torque_nm)
+                            ki_nm=d.ki_nm, max_torque_nm=d.max_torque_nm,
+                            motor_lag_s=d.motor_lag_s if motor_lag_s is None else motor_lag_s)
 
 
 def session_config(scenario: Scenario, preset: Preset) -> SessionConfig:
@@ -80,7 +82,8 @@ def session_config(scenario: Scenario, preset: Preset) -> SessionConfig:
         n_nodes=preset.n_nodes or 2048, perturb_v=PERTURB_V,
         applied_wob_n=schedule.wob_at(0.0), surface_rpm=schedule.rpm_at(0.0),
         window_s=WINDOW_S, submerged_weight_n=submerged_string_weight_n(preset),
-        top_drive=drive_of(preset, scenario.mode), sensors=scenario.rig_sensors(),
+        top_drive=drive_of(preset, scenario.mode, scenario.drive.get("motor_lag_s")),
+        sensors=scenario.rig_sensors(), formation=tuple(scenario.formation),
         top_drive_accel_rpm_s=float(scenario.drive.get("accel_rpm_s", 0.0)),
         wob_rate_n_s=float(scenario.drive.get("wob_rate_n_s", 0.0)),
         command_delay_s=float(scenario.drive.get("command_delay_s", 0.0)))
@@ -179,7 +182,7 @@ def run_in_process(scenario: Scenario,
     controller = build_controller(scenario, bench.preset)
     sim = bench.session.sim
     start = time.perf_counter()
-    command = controller.update(None)
+    command = controller.update(bench.measurement())   # the answer to t = 0
     snapshot = sim.accumulators if snapshot_after == 0 else None
     interrupted = False
     try:

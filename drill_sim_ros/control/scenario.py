@@ -19,16 +19,17 @@ does not give it)::
       string_torque_nm: {noise_std: 50.0}
     description: a short text     # shown in the suite's report
     overrides:                    # changes to the preset's own sections (in process only)
-      physical: {pipe_length_m: 4000.0}
+      string: {sections: [{outer_radius_m: 0.0635, inner_radius_m: 0.0543, length_m: 4000},
+                          {outer_radius_m: 0.0857, inner_radius_m: 0.0357, length_m: 200}]}
     drive:                        # the drive and the command path (sim_node's parameters)
       accel_rpm_s: 10             # speed ramp limit, rev/min per s (limits.top_drive_accel_rpm_s)
       wob_rate_n_s: 2000          # applied-WOB rate limit, N/s (limits.wob_rate_n_s)
       max_torque_nm: 20000        # motor torque limit, N m (top_drive.max_torque_nm)
       command_delay_s: 0.004      # command transport delay, s, also < a period
                                   # (commands.delay_s)
-      motor_lag_s: 0.05           # first-order motor torque lag: NOT YET SUPPORTED
-    formation:                    # rock layers by depth: NOT YET SUPPORTED (model core)
-      - {top_m: 0.0, intrinsic_specific_energy_pa: 230e6}
+      motor_lag_s: 0.05           # first-order motor torque lag, s (top_drive.motor_lag_s)
+    formation:                    # rock layers by depth below the start (model.formation)
+      - {top_m: 0.2, intrinsic_specific_energy_pa: 460e6, mu_gamma: 0.6}
     needs: [distributed_string]   # model features the scenario needs (see MODEL_FEATURES)
 
 A scenario that uses a feature the model core does not have yet (``formation``,
@@ -64,7 +65,8 @@ SCENARIO_KEYS = ("preset", "duration_s", "control_rate_hz", "mode", "controller"
 DRIVE_KEYS = ("accel_rpm_s", "wob_rate_n_s", "max_torque_nm", "command_delay_s",
               "motor_lag_s")
 # what this model core can run beyond the keys above; the lead's kernel adds the others
-MODEL_FEATURES: frozenset[str] = frozenset()
+MODEL_FEATURES: frozenset[str] = frozenset(
+    ("formation_layers", "motor_lag", "distributed_string"))
 FEATURES = ("formation_layers", "motor_lag", "distributed_string")
 
 

@@ -132,6 +132,10 @@ def preset_from_dict(name: str, data: dict[str, Any]) -> Preset:
     if has_phys:
         physical = physical_from_dict(data["physical"])
         string = string_from_dict(data.get("string") or {}, physical)
+        shorthand = sorted(key for key in data["physical"] if key.startswith(("pipe_", "bha_")))
+        if shorthand and (data.get("string") or {}).get("sections") is not None:
+            raise ParameterError(f"preset '{name}': physical {', '.join(shorthand)} would be "
+                                 "ignored: string.sections defines the string (give one)")
         params, scales = scale(physical, string)
     else:
         if "string" in data:

@@ -55,6 +55,7 @@ class SessionConfig:
     top_drive: TopDrivePhysical | None = None   # None: the preset's drive
     sensors: RigSensors | None = None           # None: perfect surface sensors
     command_delay_s: float = 0.0         # transport delay of the set_* inputs (0: none)
+    formation: tuple[dict, ...] = ()     # rock layers by depth (model.formation, SI keys)
 
 
 @dataclass(slots=True)
@@ -110,6 +111,8 @@ class SimSession:
         period_tau = self.period_ns / NS_PER_S / self.scales.time_s
         self.steps = steps_per_period(period_tau, cfg.dtau_max)
         self.sim = build_simulator(cfg, period_tau, self.steps)
+        if cfg.formation:
+            self.set_formation(list(cfg.formation))
         self.submerged_weight_n = cfg.submerged_weight_n
         self.command_stamp_ns: int | None = None    # stamp of the command in force, if any
         self.sensors = cfg.sensors or RigSensors()

@@ -5,12 +5,14 @@ fully qualified name (``rig1/drill_sim`` under ``-r __ns:=/rig1``), with the rig
 namespace) as hardware_id, so two sims stay apart in an aggregator. A level means a fault:
 
 ``simulation``: state, sim time, target and achieved real-time factor, overruns, tick
-lateness, rejected commands, recorder counts. ERROR on a numerical fault or a recording that
-stopped; WARN while overruns or recorder drops grow (since the last report) or when the
-controller fell silent (no command for ``command_timeout_s`` of sim time after one came).
-``bit dynamics``: mode, stick-slip severity, under-torque ratio and stick fraction of the
-last window; stick-slip is the message (and ``severity``: none, mild, severe), the level
-stays OK: it is how the bit drills, not a fault of the simulation.
+lateness, rejected, stale and lost commands, matched command publishers, lockstep's wait,
+recorder counts. ERROR on a numerical fault or a recording that stopped; WARN while
+lockstep waits past ``lockstep.warn_after_s``, while overruns or recorder drops grow (since
+the last report) or when the controller fell silent (no command for ``command_timeout_s``
+of sim time after one came). ``bit dynamics``: mode, stick-slip severity, under-torque
+ratio and stick fraction of the last window; stick-slip is the message (and ``severity``:
+none, mild, severe), the level stays OK: it is how the bit drills, not a fault of the
+simulation.
 """
 
 from __future__ import annotations
@@ -66,6 +68,12 @@ class Figures:
     window_s: float
     command_silence_s: float | None = None    # sim s since the last command (None: none)
     command_timeout_s: float = 0.0            # silence above this warns; 0 = never
+    # command-triggered lockstep's handshake (drill_sim_ros.ros.handshake)
+    stale: int = 0                 # commands that did not answer the latest sample
+    lost_commands: int = 0         # commands DDS reports lost on their way
+    command_publishers: int = 0    # publishers matched on drill/cmd/top_drive
+    waiting: str | None = None     # what lockstep waits for, past lockstep.warn_after_s
+    waits: int = 0                 # waits that went past lockstep.warn_after_s
 
 
 class Diagnostics:
@@ -113,6 +121,11 @@ def node_status(f: Figures, source: Source, growing: bool = False) -> Diagnostic
         "tick_lateness_p99_ms": f"{p99:.4g}",
         "rejected_commands": str(f.rejected),
         "saturated_commands": str(f.saturated),
+        "stale_commands": str(f.stale),
+        "lost_commands": str(f.lost_commands),
+        "command_publishers": str(f.command_publishers),
+        "lockstep_waits": str(f.waits),
+        "waiting": f.waiting or "",
         "recorder_dropped": str(f.dropped),
         "recorder_written": str(f.written),
         "fault": f.fault or "",
@@ -124,6 +137,8 @@ def node_status(f: Figures, source: Source, growing: bool = False) -> Diagnostic
         level, message = DiagnosticStatus.ERROR, f"numerical fault: {f.fault}"
     elif f.record_error is not None:
         level, message = DiagnosticStatus.ERROR, f"recording stopped: {f.record_error}"
+    elif f.waiting is not None:
+        level, message = DiagnosticStatus.WARN, f.waiting
     elif growing:
         level, message = DiagnosticStatus.WARN, "overruns or recorder drops"
     elif controller_silent(f):

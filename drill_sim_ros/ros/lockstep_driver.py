@@ -8,10 +8,11 @@ stamp. The sample is, by ``sample_topic``, one SI telemetry row (``drill/telemet
 ``TELEMETRY_FIELDS`` order: the whole truth, for tests and tools) or the rig's surface
 measurement (``drill/surface/measured`` as a
 :class:`~drill_sim_ros.control.command.SurfaceMeasurement`: what a controller may read).
-Its first command (when the sim's subscription and publisher have matched) reacts to the
-sim's initial state at t = 0 (``policy(None)``), so the loop starts whether or not the
-t = 0 sample arrived.
-Nothing is lost: both directions are reliable and deep, and each side waits for the other.
+The sample topics are latched (reliable, transient local, depth 1), so the first sample the
+driver receives is the latest the sim published (t = 0 at the start of a run), whenever the
+driver starts; it answers that one too, and sends nothing before it (the handshake of
+docs/control-loop.md). Nothing is lost: both directions are reliable, and each side waits
+for the other.
 """
 
 from __future__ import annotations
@@ -21,7 +22,6 @@ from collections.abc import Callable
 from typing import Any
 
 import numpy as np
-from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
 from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.serialization import deserialize_message
@@ -31,7 +31,7 @@ from std_msgs.msg import Float64MultiArray
 from drill_sim_ros import topics
 from drill_sim_ros.control.command import Command, SurfaceMeasurement
 from drill_sim_ros.model.telemetry import NS_PER_S, TELEMETRY_INDEX
-from drill_sim_ros.ros.messages import stamp, stamp_ns
+from drill_sim_ros.ros.messages import LATEST_SAMPLE_QOS, stamp, stamp_ns
 
 __all__ = ["LOCKSTEP_QOS", "Command", "LockstepDriver", "Policy", "top_drive_command"]
 
@@ -39,7 +39,7 @@ LOCKSTEP_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1000,
                           reliability=ReliabilityPolicy.RELIABLE)
 _TIME = TELEMETRY_INDEX["sim_time_s"]
 
-# A policy: the sample it reacts to (None: the initial state at t = 0) -> the command.
+# A policy: the sample it reacts to -> the command.
 Policy = Callable[[Any], Command]
 
 
@@ -75,9 +75,10 @@ SAMPLE_DECODERS = {topics.TELEMETRY: telemetry_sample, topics.SURFACE_MEASURED: 
 
 
 class LockstepDriver(Node):
-    """Runs ``periods`` periods of a sim in command lockstep (0: until stopped); with
-    ``keep``, ``rows`` keeps every sample received (their raw payloads in ``payloads``);
-    ``done`` once the last one is in."""
+    """Runs ``periods`` periods of a sim in command lockstep (0: until stopped): answers the
+    first sample it receives (``first_sample``: t = 0 on a fresh sim) and the next
+    ``periods - 1``; with ``keep``, ``rows`` keeps every sample after the first (their raw
+    payloads in ``payloads``); ``done`` once the last one is in."""
 
     def __init__(self, policy: Policy, periods: int, name: str = "lockstep_driver",
                  sample_topic: str = topics.TELEMETRY, keep: bool = True,
@@ -90,34 +91,27 @@ class LockstepDriver(Node):
         self.keep = keep
         self.rows: list[Any] = []
         self.payloads: list[bytes] = []
+        self.first_sample: Any = None
         self._reacted_ns = -1
         self._decode = SAMPLE_DECODERS[sample_topic]
         self._pub = self.create_publisher(JointState, topics.node_relative(
             topics.CMD_TOP_DRIVE), LOCKSTEP_QOS)
         msg_type = JointState if sample_topic == topics.SURFACE_MEASURED else Float64MultiArray
         self._sub = self.create_subscription(msg_type, topics.node_relative(sample_topic),
-                                             self._on_sample, LOCKSTEP_QOS, raw=True)
-        # steady: with use_sim_time the ROS clock stands still until the sim publishes,
-        # and the sim publishes only after this first command (command lockstep)
-        self._start = self.create_timer(0.05, self._start_when_matched,
-                                        clock=Clock(clock_type=ClockType.STEADY_TIME))
+                                             self._on_sample, LATEST_SAMPLE_QOS, raw=True)
 
     @property
     def done(self) -> bool:
         return self.periods > 0 and self.received >= self.periods
 
-    def _start_when_matched(self) -> None:
-        """The first command reacts to the initial state (t = 0)."""
-        if self._pub.get_subscription_count() == 0 or self._sub.get_publisher_count() == 0 \
-                or self._reacted_ns >= 0:
-            return
-        self.destroy_timer(self._start)
-        self._command(None, 0)
-
     def _on_sample(self, raw: bytes) -> None:
         sample, time_ns = self._decode(raw)
-        if time_ns <= max(self._reacted_ns, 0):
-            return       # the t = 0 sample: the first command reacts to None, always
+        if time_ns <= self._reacted_ns:
+            return                          # answered already
+        if self._reacted_ns < 0:
+            self.first_sample = sample
+            self._command(sample, time_ns)
+            return
         self.received += 1
         if self.keep:
             self.rows.append(sample)

@@ -16,6 +16,16 @@ HARDWARE_ID = "drill_sim_ros"
 RUN_INFO_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1,
                           reliability=ReliabilityPolicy.RELIABLE,
                           durability=DurabilityPolicy.TRANSIENT_LOCAL)
+# What a controller reads, drill/surface/measured, is latched the same way: a subscriber
+# asking for transient local gets the latest sample when it connects, whether it started
+# before sim_node, after it, or again mid-run; volatile subscribers still match.
+LATEST_SAMPLE_QOS = RUN_INFO_QOS
+# drill/telemetry (the whole truth, for tests and tools) keeps a deeper history, so that a
+# subscriber falling behind in free run still gets lost samples repaired; a transient-local
+# subscriber joining gets up to that many recent samples (one, t = 0, at the start of a run).
+TELEMETRY_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=100,
+                           reliability=ReliabilityPolicy.RELIABLE,
+                           durability=DurabilityPolicy.TRANSIENT_LOCAL)
 
 
 def type_of(topic: str) -> type:

@@ -47,6 +47,7 @@ class ParamSpec:
     high: float | None = None
     read_only: bool = False
     choices: tuple[str, ...] = ()     # the allowed values of a string (empty: any)
+    unit: str | None = None           # None: the [unit] its description names, if any
 
     def default_for(self, preset: Preset | None) -> Any:
         return self.default(preset) if callable(self.default) else self.default
@@ -100,7 +101,7 @@ def _sensor_specs() -> tuple[ParamSpec, ...]:
                       0.0, 1e9, read_only=True),
             ParamSpec(f"sensors.{signal}.delay_periods", INTEGER, 0,
                       f"Delay of the measured {signal} in whole publish periods.",
-                      0, MAX_DELAY_PERIODS, read_only=True),
+                      0, MAX_DELAY_PERIODS, read_only=True, unit="periods"),
         ]
     return tuple(out)
 
@@ -118,12 +119,13 @@ SPECS: tuple[ParamSpec, ...] = (
               "/drill/cmd/surface_rpm changes the live setpoint.", 0.0, 1e4, read_only=True),
     ParamSpec("model.dtau", DOUBLE, _preset_dtau,
               "Largest dimensionless integrator step (RGD07 units of t*); refined so that a "
-              "whole number of steps fills one publish period.", 1e-7, 0.05, read_only=True),
+              "whole number of steps fills one publish period.", 1e-7, 0.05, read_only=True,
+              unit="1"),
     ParamSpec("model.n_nodes", INTEGER, _preset_nodes,
               "Bottom-hole profile nodes per blade sector.", 16, 1 << 22, read_only=True),
     ParamSpec("model.perturb_v", DOUBLE, 1e-3,
               "Dimensionless axial-velocity perturbation added at t = 0 (seeds the "
-              "instability).", -1e3, 1e3, read_only=True),
+              "instability).", -1e3, 1e3, read_only=True, unit="1"),
     ParamSpec("model.submerged_string_weight_n", DOUBLE, submerged_string_weight_n,
               "Buoyed weight of drill pipe + BHA [N]; hook load = this - applied WOB. "
               "Default: steel mass x g x (1 - 1200 kg/m3 mud / steel density); 0 for "
@@ -144,16 +146,21 @@ SPECS: tuple[ParamSpec, ...] = (
               "nearest it, also within a publish period; 0 = from the next step.", 0.0, 60.0,
               read_only=True),
     ParamSpec("publish_rate_hz", DOUBLE, 100.0,
-              "Samples published per second of SIMULATED time.", 1.0, 1000.0, read_only=True),
+              "Samples published per second of SIMULATED time.", 1.0, 1000.0, read_only=True,
+              unit="Hz"),
     ParamSpec("publish_clock", BOOL, True, "Publish /clock (rosgraph_msgs/Clock) in sim time."),
     ParamSpec("clock_rate_hz", DOUBLE, 100.0,
               "/clock messages per second of SIMULATED time, on the samples' stamps: at most "
               "one per sample (at or above publish_rate_hz, every sample).", 1.0, 1000.0,
               read_only=True),
     ParamSpec("real_time_factor", DOUBLE, 1.0,
-              "Simulated seconds per wall second; 0 = as fast as possible.", 0.0, 1000.0),
+              "Simulated seconds per wall second; 0 = as fast as possible.", 0.0, 1000.0,
+              unit="1"),
     ParamSpec("lockstep", BOOL, False,
               "Advance one publish period per trigger (lockstep_trigger) only; deterministic."),
+    ParamSpec("lockstep.warn_after_s", DOUBLE, 2.0,
+              "In lockstep, warn on /diagnostics and in the log after this many wall seconds "
+              "without a command (or a ~/step call) [s]; 0 = never.", 0.0, 1e6),
     ParamSpec("lockstep_trigger", STRING, "service",
               "What advances one period in lockstep: 'service' (a ~/step call) or 'command' "
               "(each message on drill/cmd/top_drive, applied first).",
@@ -177,7 +184,7 @@ SPECS: tuple[ParamSpec, ...] = (
     *_sensor_specs(),
     ParamSpec("run_seconds", DOUBLE, 0.0,
               "Exit cleanly after this many wall seconds; 0 = run until stopped.", 0.0, 1e9,
-              read_only=True),
+              read_only=True, unit="s"),
     ParamSpec("record.path", STRING, "",
               "Record every published message to this MCAP file (in process); '' = off. "
               "An existing file is refused unless record.overwrite.", read_only=True),
@@ -186,13 +193,13 @@ SPECS: tuple[ParamSpec, ...] = (
               "to start.", read_only=True),
     ParamSpec("record.split_size_mb", DOUBLE, 0.0,
               "Start a new numbered file (run_0000.mcap, ...) after this many MB; 0 = one "
-              "file.", 0.0, 1e6, read_only=True),
+              "file.", 0.0, 1e6, read_only=True, unit="MB"),
     ParamSpec("record.split_duration_s", DOUBLE, 0.0,
               "Start a new numbered file after this many simulated seconds; 0 = one file.",
-              0.0, 1e9, read_only=True),
+              0.0, 1e9, read_only=True, unit="s"),
     ParamSpec("diagnostics.window_s", DOUBLE, 20.0,
               "Simulated seconds of bit speed behind the stick-slip severity on /diagnostics.",
-              0.1, 3600.0, read_only=True),
+              0.1, 3600.0, read_only=True, unit="s"),
     ParamSpec("diagnostics.command_timeout_s", DOUBLE, 1.0,
               "Once a drill/cmd/top_drive command came, /diagnostics warns (controller "
               "silent) when none follows for this many SIMULATED seconds; 0 = never.", 0.0, 1e6),

@@ -26,7 +26,7 @@ import numpy as np
 import rclpy
 from rcl_interfaces.msg import SetParametersResult
 from rclpy.clock import Clock, ClockType
-from rclpy.event_handler import PublisherEventCallbacks
+from rclpy.event_handler import PublisherEventCallbacks, SubscriptionEventCallbacks
 from rclpy.executors import ExternalShutdownException
 from rclpy.impl.implementation_singleton import rclpy_implementation
 from rclpy.node import Node
@@ -53,7 +53,8 @@ from drill_sim_ros.ros import messages, typed
 from drill_sim_ros.ros.command_types import ForeignCommandTypes
 from drill_sim_ros.ros.diagnostics import Diagnostics, Figures, source_of
 from drill_sim_ros.ros.frame import SAMPLE_TOPICS
-from drill_sim_ros.ros.messages import RUN_INFO_QOS, stamp_ns
+from drill_sim_ros.ros.handshake import COMMAND_MODE, SERVICE_MODE, Handshake
+from drill_sim_ros.ros.messages import LATEST_SAMPLE_QOS, RUN_INFO_QOS, TELEMETRY_QOS, stamp_ns
 from drill_sim_ros.ros.parameters import (
     SPEC_BY_NAME,
     coerce,
@@ -70,9 +71,10 @@ DATA_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=100,
                       reliability=ReliabilityPolicy.RELIABLE)
 CLOCK_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=10,
                        reliability=ReliabilityPolicy.RELIABLE)
-# Deep enough that a controller driving command-triggered lockstep never loses a command.
-COMMAND_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1000,
-                         reliability=ReliabilityPolicy.RELIABLE)
+# The node's queue never drops a command (a flood is held back by DDS flow control, and what
+# a publisher's own history overwrites is reported lost): in command-triggered lockstep a
+# controller's answer is never lost behind other commands.
+COMMAND_QOS = QoSProfile(history=HistoryPolicy.KEEP_ALL, reliability=ReliabilityPolicy.RELIABLE)
 # Reliable volatile publishers match every subscriber but transient-local ones; without the
 # default QoS-event handlers the executor's wait set is 2 entities per publisher smaller.
 QUIET_PUBLISHER = PublisherEventCallbacks(use_default_callbacks=False)
@@ -83,6 +85,7 @@ DIAGNOSTICS_PERIOD_S = 1.0
 STATUS_PERIOD_S = 0.25
 WARN_THROTTLE_S = 1.0
 GIL_SWITCH_INTERVAL_S = 0.0005
+WAIT_CHECK_PERIOD_S = 0.1    # how often lockstep's wait is compared with lockstep.warn_after_s
 
 
 def session_config(values: dict[str, Any], preset: Any) -> SessionConfig:
@@ -176,18 +179,26 @@ class SimNode(Node):
                                 topics.RUN_INFO)}
         self._sinks = SampleSinks(self._pubs)
         self._command_names: dict[str, str] = {}      # command topic -> its resolved name
+        self._command_subs = {}
         for topic, callback in ((topics.CMD_SURFACE_RPM, self._on_surface_rpm),
                                 (topics.CMD_WOB, self._on_wob),
                                 (topics.CMD_TOP_DRIVE, self._on_top_drive)):
-            sub = self.create_subscription(messages.type_of(topic), topics.node_relative(topic),
-                                           callback, COMMAND_QOS, raw=True)
+            sub = self.create_subscription(
+                messages.type_of(topic), topics.node_relative(topic), callback, COMMAND_QOS,
+                raw=True, event_callbacks=SubscriptionEventCallbacks(
+                    message_lost=self._on_commands_lost(topic)))
             self._command_names[topic] = sub.topic_name
+            self._command_subs[topic] = sub
         self._foreign_commands = ForeignCommandTypes(
             {name: topics.MSG_TYPES[topic] for topic, name in self._command_names.items()})
         self._typed_pubs = self._add_typed_topics()
         self.create_service(Trigger, "~/reset", self._on_reset)
         self.create_service(SetBool, "~/pause", self._on_pause)
-        self.create_service(Trigger, "~/step", self._on_step)
+        step = self.create_service(Trigger, "~/step", self._on_step)
+        self._handshake = Handshake(self.get_logger(), self._command_names[topics.CMD_TOP_DRIVE],
+                                    self.resolve_service_name(step.srv_name),
+                                    time.monotonic())
+        self.create_timer(WAIT_CHECK_PERIOD_S, self._check_waiting, clock=self._steady)
         self._ticker = Ticker(self._tick, self._on_tick_error, name="drill_sim_ticker")
         self._first_spin = self.create_timer(0.0, self._start_ticker, clock=self._steady)
         self._first_spin.cancel()                      # start() arms it
@@ -232,6 +243,7 @@ class SimNode(Node):
             self._sinks.recorder = self._open_recorder(self._values["record.path"])
             self._publish_run_info()
             self._initial_pending = True       # t = 0 goes out before the first period
+        self._handshake.restart(time.monotonic())     # a wait counts from here
         self._first_spin.reset()
         if self._values["run_seconds"] > 0:
             self._stop_timer.reset()
@@ -241,6 +253,10 @@ class SimNode(Node):
     def _qos(topic: str) -> QoSProfile:
         if topic in (topics.RUN_INFO, topics.TYPED_RUN_INFO):
             return RUN_INFO_QOS
+        if topic == topics.SURFACE_MEASURED:
+            return LATEST_SAMPLE_QOS
+        if topic == topics.TELEMETRY:
+            return TELEMETRY_QOS
         return CLOCK_QOS if topic in (topics.CLOCK, topics.DIAGNOSTICS) else DATA_QOS
 
     def _open_recorder(self, path: str) -> Any:
@@ -314,7 +330,7 @@ class SimNode(Node):
             if names & {"top_drive.kp_nm_s", "top_drive.ki_nm", "top_drive.max_torque_nm",
                         "top_drive.mode"}:
                 self._session.set_top_drive(top_drive(self._values))   # between runs: no bump
-            if names & {"real_time_factor", "lockstep"}:
+            if names & {"real_time_factor", "lockstep", "lockstep_trigger"}:
                 self._restart_ticks()
 
     # ---- pacing and the one tick path --------------------------------------------------
@@ -329,9 +345,14 @@ class SimNode(Node):
         self._ticker.start()
 
     def _restart_ticks(self) -> None:
-        """New schedule for the current factor, anchored now (call with the lock held)."""
+        """New schedule for the current factor, anchored now; in command-triggered lockstep
+        the latest sample (at start: t = 0) is out for a controller to answer (call with the
+        lock held)."""
         self._pacer = Pacer(self._wall_period_ns(self._rtf))
         self._anchor()
+        self._handshake.restart(time.monotonic())
+        if self._command_steps():
+            self._emit_initial()
 
     def _anchor(self) -> None:
         """The next tick is due now; wake the ticker (call with the lock held)."""
@@ -382,6 +403,7 @@ class SimNode(Node):
         self._sinks.emit(block, self._values["publish_clock"])
         if len(block):
             self._last_row = block.rows[-1]
+            self._handshake.published(int(block.stamps_ns[-1]), time.monotonic())
 
     def _on_tick_error(self, exc: Exception) -> bool:
         """An unexpected error on the ticker: quiet at shutdown, else a fault until reset."""
@@ -411,20 +433,16 @@ class SimNode(Node):
 
     def _on_top_drive(self, raw: bytes) -> None:
         """drill/cmd/top_drive: apply what it commands and, in command-triggered lockstep,
-        advance exactly one period under it."""
+        advance exactly one period under it if it answers the latest sample (else it is
+        stale: not applied, counted)."""
         msg = deserialize_message(raw, JointState)
         topic = topics.CMD_TOP_DRIVE
         if (problem := malformed_joint_state(msg)) is not None:
             with self._lock.urgent():
                 self._reject(topic, problem)
             return
-        values = joint_commands(msg)
-        for joint, interface in set(values) - set(COMMAND_INTERFACES):
-            self._reject(topic, f"joint {joint!r} takes no {interface} command "
-                                "(top_drive: velocity, effort; hook: effort)")
-        command = Command(**{name: values[key] for key, name in COMMAND_INTERFACES.items()
-                             if key in values})
-        self._take_top_drive(topic, command, stamp_ns(msg.header.stamp), raw)
+        self._take_top_drive(topic, self._top_drive_command(msg), stamp_ns(msg.header.stamp),
+                             raw)
 
     def _on_typed_top_drive(self, raw: bytes) -> None:
         """drill/typed/cmd/top_drive: the same command as drill/cmd/top_drive, typed."""
@@ -434,14 +452,32 @@ class SimNode(Node):
 
     def _take_top_drive(self, topic: str, command: Command, reacts_to_ns: int,
                         raw: bytes) -> None:
-        """Apply a top-drive command and, in command-triggered lockstep, advance one period."""
+        """Record a top-drive command; apply it and, in command-triggered lockstep, advance
+        one period, unless it does not answer the latest sample there (stale: counted)."""
         with self._lock.urgent():
+            self._record_command(topic, raw)
+            steps = self._command_steps()
+            if steps and not self._handshake.admit(topic, reacts_to_ns):
+                return
             self._apply(topic, command)
             self._last_command_ns = self._session.sim_time_ns     # the controller is alive
             self._session.command_stamp_ns = reacts_to_ns
-            self._record_command(topic, raw)
-            if self._command_steps():
+            if steps:
                 self._advance(1)
+
+    def _top_drive_command(self, msg: JointState) -> Command:
+        """The Command of a drill/cmd/top_drive message; a joint/interface it does not know
+        is rejected (counted)."""
+        values = joint_commands(msg)
+        for joint, interface in set(values) - set(COMMAND_INTERFACES):
+            self._reject(topics.CMD_TOP_DRIVE, f"joint {joint!r} takes no {interface} command "
+                                               "(top_drive: velocity, effort; hook: effort)")
+        return Command(**{name: values[key] for key, name in COMMAND_INTERFACES.items()
+                          if key in values})
+
+    def _on_commands_lost(self, topic: str) -> Any:
+        """The message_lost event handler of the ``topic`` subscription."""
+        return lambda info: self._handshake.lost(topic, info.total_count_change)
 
     def _command_steps(self) -> bool:
         """Each drill/cmd/top_drive message advances one period (lock held)."""
@@ -485,6 +521,9 @@ class SimNode(Node):
             if self._fault is not None:
                 self._fault = None
                 self._anchor()       # no catching up on the time spent in the fault
+            if self._command_steps():        # the reset state is the sample to answer now
+                self._initial_pending = False
+                self._emit(self._session.current())
             time_s = self._session.sim_time_ns * 1e-9
         response.success = True
         response.message = (f"model reset to its initial state at t = {time_s:.3f} s "
@@ -519,6 +558,22 @@ class SimNode(Node):
         return response
 
     # ---- diagnostics, status, shutdown -------------------------------------------------
+    def _lockstep_mode(self) -> str | None:
+        """What advances the sim now: COMMAND_MODE, SERVICE_MODE, or None (it runs by itself,
+        or cannot run: a fault, closing) (lock held)."""
+        if not self._lockstep or self._fault is not None or self._closing:
+            return None
+        return COMMAND_MODE if self._values["lockstep_trigger"] == "command" else SERVICE_MODE
+
+    def _check_waiting(self) -> None:
+        """One warning when lockstep has waited longer than lockstep.warn_after_s."""
+        if self._session is None:
+            return
+        publishers = self._command_subs[topics.CMD_TOP_DRIVE].get_publisher_count()
+        with self._lock.urgent():
+            self._handshake.check(self._lockstep_mode(), time.monotonic(),
+                                  self._values["lockstep.warn_after_s"], publishers)
+
     def _publish_diagnostics(self) -> None:
         """/diagnostics: the figures are copied under the lock, the message is built and
         serialized outside it, so the ticker waits for a copy, not for the formatting."""
@@ -550,7 +605,18 @@ class SimNode(Node):
             window_s=self._values["diagnostics.window_s"],
             command_silence_s=None if self._last_command_ns is None else
             (time_ns - self._last_command_ns) * 1e-9,
-            command_timeout_s=self._values["diagnostics.command_timeout_s"])
+            command_timeout_s=self._values["diagnostics.command_timeout_s"],
+            **self._handshake_figures())
+
+    def _handshake_figures(self) -> dict[str, Any]:
+        """The lockstep handshake's part of the figures (lock held)."""
+        waiting = self._handshake.waiting(self._lockstep_mode(), time.monotonic())
+        return {"stale": self._handshake.gate.stale,
+                "lost_commands": self._handshake.lost_commands,
+                "command_publishers":
+                    self._command_subs[topics.CMD_TOP_DRIVE].get_publisher_count(),
+                "waiting": None if waiting is None else waiting.text,
+                "waits": self._handshake.watch.waits}
 
     def _recorder_count(self, name: str) -> int:
         recorder = self._sinks.recorder

@@ -20,15 +20,32 @@ F = TELEMETRY_INDEX
 
 
 def drill_sim(*args: str) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, "-m", "drill_sim_ros.cli", "closed-loop", *args],
-                          capture_output=True, text=True, timeout=300, cwd=ROOT)
+    return subprocess.run(
+        [sys.executable, "-m", "drill_sim_ros.cli", "closed-loop", *args],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        cwd=ROOT,
+    )
 
 
 def test_json_table_and_plot(tmp_path: Path) -> None:
     png = tmp_path / "cl.png"
-    result = drill_sim("--params", "field_8p5in_shale_lumped", "--controller", "z_torque",
-                       "--mode", "torque", "--t-end", "60", "--enable-at", "20", "--json",
-                       "--plot", str(png))
+    result = drill_sim(
+        "--params",
+        "field_8p5in_shale_lumped",
+        "--controller",
+        "z_torque",
+        "--mode",
+        "torque",
+        "--t-end",
+        "60",
+        "--enable-at",
+        "20",
+        "--json",
+        "--plot",
+        str(png),
+    )
     assert result.returncode == 0, result.stderr
     out = json.loads(result.stdout)
     assert out["periods"] == 6000 and out["scenario"]["mode"] == "torque"
@@ -40,25 +57,43 @@ def test_json_table_and_plot(tmp_path: Path) -> None:
 
 
 def test_user_controller_by_module_and_class(tmp_path: Path) -> None:
-    result = drill_sim("--controller", "tests.control.user_controller:TorqueDamper",
-                       "--t-end", "40", "--enable-at", "10", "--json", "--no-baseline")
+    result = drill_sim(
+        "--controller",
+        "tests.control.user_controller:TorqueDamper",
+        "--t-end",
+        "40",
+        "--enable-at",
+        "10",
+        "--json",
+        "--no-baseline",
+    )
     assert result.returncode == 0, result.stderr
     assert json.loads(result.stdout)["scenario"]["controller"].endswith(":TorqueDamper")
     # the bare protocol: its commands reach the drive (75 rpm from the first command on)
-    rows = run_in_process(Scenario(controller="tests.control.user_controller:ConstantSpeed",
-                                   duration_s=2.0, enable_at_s=0.0, params={"rpm": 75.0})).rows
+    rows = run_in_process(
+        Scenario(
+            preset="field_8p5in_shale_lumped",
+            controller="tests.control.user_controller:ConstantSpeed",
+            duration_s=2.0,
+            enable_at_s=0.0,
+            params={"rpm": 75.0},
+        )
+    ).rows
     np.testing.assert_allclose(rows[1:, F["speed_setpoint_rpm"]], 75.0, rtol=1e-12)
 
 
-@pytest.mark.parametrize(("args", "names"), [
-    (("--controller", "bogus"), "bogus"),
-    (("--controller", "nowhere.module:Class"), "nowhere.module"),
-    (("--controller", "none", "--mode", "torque"), "none"),
-    (("--params", "fig5_8a"), "fig5_8a"),
-    (("--t-end", "10", "--enable-at", "20"), "enable_at_s"),
-    (("--set", "damping_ratio=x"), "damping_ratio"),
-    (("--controller", "soft_torque", "--set", "gain=1"), "gain"),
-])
+@pytest.mark.parametrize(
+    ("args", "names"),
+    [
+        (("--controller", "bogus"), "bogus"),
+        (("--controller", "nowhere.module:Class"), "nowhere.module"),
+        (("--controller", "none", "--mode", "torque"), "none"),
+        (("--params", "fig5_8a"), "fig5_8a"),
+        (("--t-end", "10", "--enable-at", "20"), "enable_at_s"),
+        (("--set", "damping_ratio=x"), "damping_ratio"),
+        (("--controller", "soft_torque", "--set", "gain=1"), "gain"),
+    ],
+)
 def test_bad_input_is_one_line(args: tuple[str, ...], names: str) -> None:
     result = drill_sim(*args, "--t-end", "1") if "--t-end" not in args else drill_sim(*args)
     assert result.returncode == 2

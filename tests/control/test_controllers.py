@@ -37,8 +37,13 @@ ENABLE_S, END_S = 60.0, 180.0
 
 @cache
 def run(controller: str, mode: str) -> np.ndarray:
-    scenario = Scenario(controller=controller, mode=mode, duration_s=END_S,
-                        enable_at_s=ENABLE_S)
+    scenario = Scenario(
+        preset="field_8p5in_shale_lumped",
+        controller=controller,
+        mode=mode,
+        duration_s=END_S,
+        enable_at_s=ENABLE_S,
+    )
     return run_in_process(scenario).rows
 
 
@@ -52,8 +57,8 @@ def test_stiff_leaves_stick_slip(mode: str) -> None:
     rows = run("stiff", mode)
     for start_s in np.arange(ENABLE_S, END_S, 20.0):
         window = between(rows, start_s, start_s + 20.0)
-        assert (window[:, F["mode"]] == 2).any(), start_s      # the bit stops
-        assert window[:, F["bit_rpm"]].max() > 1.5 * RPM0   # and slips (RGD07 Fig. 8: ~2 x)
+        assert (window[:, F["mode"]] == 2).any(), start_s  # the bit stops
+        assert window[:, F["bit_rpm"]].max() > 1.5 * RPM0  # and slips (RGD07 Fig. 8: ~2 x)
 
 
 @pytest.mark.parametrize("mode", ["speed", "torque"])
@@ -61,7 +66,7 @@ def test_stiff_leaves_stick_slip(mode: str) -> None:
 def test_soft_controllers_remove_stick_slip(controller: str, mode: str) -> None:
     rows = run(controller, mode)
     before = between(rows, 20.0, ENABLE_S)
-    assert (before[:, F["mode"]] == 2).any()                     # it was there
+    assert (before[:, F["mode"]] == 2).any()  # it was there
     settled = between(rows, END_S - 60.0, END_S)
     assert not (settled[:, F["mode"]] == 2).any()
     assert settled[:, F["bit_rpm"]].min() > 0.5 * RPM0
@@ -89,8 +94,8 @@ def test_soft_torque_is_a_damper_of_the_lumped_mode_by_hand() -> None:
     c = math.sqrt(RIG.stiffness_nm_rad * RIG.bit_inertia_kg_m2) / 0.5
     assert ctrl.damping_nm_s == pytest.approx(c, rel=1e-12)
     omega0 = RPM0 * 2 * math.pi / 60
-    ctrl.update(measurement(0.01, omega0, 3000.0, 3000.0))             # filter starts at 3000
-    cmd = ctrl.update(measurement(0.02, omega0, 4000.0, 4000.0))       # a 1 kN m step
+    ctrl.update(measurement(0.01, omega0, 3000.0, 3000.0))  # filter starts at 3000
+    cmd = ctrl.update(measurement(0.02, omega0, 4000.0, 4000.0))  # a 1 kN m step
     alpha = 1 - math.exp(-0.5 * 0.01)
     assert cmd.speed_rad_s == pytest.approx(omega0 - 1000.0 * (1 - alpha) / c, rel=1e-12)
     assert cmd.wob_n == 60e3
@@ -102,29 +107,32 @@ def test_z_torque_estimates_the_string_torque_from_the_drive() -> None:
     ctrl = ZTorque(RIG, Schedule(RPM0, 60e3), period_s=0.01)
     accel, motor = 0.8, 9000.0
     speeds = 6.0 + accel * 0.01 * np.arange(5)
-    estimates = [ctrl.string_torque_estimate_nm(measurement(0.01 * i, w, motor, 0.0))
-                 for i, w in enumerate(speeds)]
+    estimates = [
+        ctrl.string_torque_estimate_nm(measurement(0.01 * i, w, motor, 0.0))
+        for i, w in enumerate(speeds)
+    ]
     expected = motor - RIG.drive_inertia_kg_m2 * accel
     np.testing.assert_allclose(estimates[1:], expected, rtol=1e-9)
     assert ctrl.params["impedance_nm_s"] == pytest.approx(
-        0.5 * math.pi * (0.0635**4 - 0.0543**4) * math.sqrt(79.3e9 * 7850.0), rel=1e-12)
+        0.5 * math.pi * (0.0635**4 - 0.0543**4) * math.sqrt(79.3e9 * 7850.0), rel=1e-12
+    )
 
 
 def test_torque_mode_loop_is_critically_damped_on_the_drive() -> None:
     """kp = 2 J w_c, ki = J w_c^2: a speed error e gives kp e + ki e P at the first step."""
-    ctrl = Stiff(RIG, Schedule(RPM0, 60e3), mode="torque", period_s=0.01,
-                 loop_bandwidth_rad_s=4.0)
+    ctrl = Stiff(RIG, Schedule(RPM0, 60e3), mode="torque", period_s=0.01, loop_bandwidth_rad_s=4.0)
     omega0 = RPM0 * 2 * math.pi / 60
     cmd = ctrl.update(measurement(0.01, omega0 - 0.1, 3000.0, 3000.0))
     j = RIG.drive_inertia_kg_m2
     assert cmd.speed_rad_s is None
-    assert cmd.motor_torque_nm == pytest.approx(3000.0 + 2 * j * 4.0 * 0.1
-                                                + j * 16.0 * 0.1 * 0.01, rel=1e-12)
+    assert cmd.motor_torque_nm == pytest.approx(
+        3000.0 + 2 * j * 4.0 * 0.1 + j * 16.0 * 0.1 * 0.01, rel=1e-12
+    )
 
 
 def test_speed_references_stay_within_the_drive_limits() -> None:
     ctrl = SoftTorque(RIG, Schedule(RPM0, 60e3), period_s=0.01)
     ctrl.update(measurement(0.01, 6.0, 0.0, 0.0))
-    cmd = ctrl.update(measurement(0.02, 6.0, 0.0, 1e6))      # a huge torque: reference < 0
+    cmd = ctrl.update(measurement(0.02, 6.0, 0.0, 1e6))  # a huge torque: reference < 0
     assert cmd.speed_rad_s == 0.0
     assert ctrl.clamped_commands == 1

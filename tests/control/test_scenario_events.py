@@ -30,10 +30,10 @@ from drill_sim_ros.model.errors import ParameterError
 from drill_sim_ros.model.presets import load_preset
 from drill_sim_ros.model.telemetry import TELEMETRY_INDEX as F
 
-PRESET = load_preset("field_8p5in_shale")
+PRESET = load_preset("field_8p5in_shale_lumped")
 PERIOD_S = 0.01
 # a sample is what the next integrator step records at its start: a ramp is one step ahead
-STEP_S = PERIOD_S / Bench(Scenario()).session.steps
+STEP_S = PERIOD_S / Bench(Scenario(preset="field_8p5in_shale_lumped")).session.steps
 
 
 def times(rows: np.ndarray) -> np.ndarray:
@@ -41,19 +41,33 @@ def times(rows: np.ndarray) -> np.ndarray:
 
 
 def test_speed_ramp_limit_turns_a_step_into_a_ramp() -> None:
-    rows = run_in_process(Scenario(controller="none", duration_s=10.0, enable_at_s=0.0,
-                                   schedule=({"t_s": 2.0, "rpm": 90.0},),
-                                   drive={"accel_rpm_s": 10.0})).rows
+    rows = run_in_process(
+        Scenario(
+            preset="field_8p5in_shale_lumped",
+            controller="none",
+            duration_s=10.0,
+            enable_at_s=0.0,
+            schedule=({"t_s": 2.0, "rpm": 90.0},),
+            drive={"accel_rpm_s": 10.0},
+        )
+    ).rows
     t, setpoint = times(rows), rows[:, F["speed_setpoint_rpm"]]
-    expected = np.clip(60.0 + 10.0 * (t - 2.0), 60.0, 90.0)      # from the 2.00 s command
+    expected = np.clip(60.0 + 10.0 * (t - 2.0), 60.0, 90.0)  # from the 2.00 s command
     np.testing.assert_allclose(setpoint, expected, rtol=0, atol=10.0 * STEP_S * 1.001)
     assert setpoint[t <= 2.0 + 1e-9].max() == pytest.approx(60.0)
 
 
 def test_wob_rate_limit_turns_a_step_into_a_ramp() -> None:
-    rows = run_in_process(Scenario(controller="none", duration_s=20.0, enable_at_s=0.0,
-                                   schedule=({"t_s": 3.0, "wob_n": 80e3},),
-                                   drive={"wob_rate_n_s": 2000.0})).rows
+    rows = run_in_process(
+        Scenario(
+            preset="field_8p5in_shale_lumped",
+            controller="none",
+            duration_s=20.0,
+            enable_at_s=0.0,
+            schedule=({"t_s": 3.0, "wob_n": 80e3},),
+            drive={"wob_rate_n_s": 2000.0},
+        )
+    ).rows
     t = times(rows)
     expected = np.clip(60e3 + 2000.0 * (t - 3.0), 60e3, 80e3)
     applied = rows[:, F["applied_wob_n"]]
@@ -65,13 +79,19 @@ def test_wob_rate_limit_turns_a_step_into_a_ramp() -> None:
 def test_a_torque_limit_below_the_bit_torque_stalls_the_bit() -> None:
     t0_nm = PRESET.scales.tob_nm(analysis.trivial_solution(PRESET.params).torque)
     limit = 0.7 * t0_nm
-    scenario = Scenario(controller="none", duration_s=60.0, enable_at_s=0.0,
-                        drive={"max_torque_nm": limit})
+    scenario = Scenario(
+        preset="field_8p5in_shale_lumped",
+        controller="none",
+        duration_s=60.0,
+        enable_at_s=0.0,
+        drive={"max_torque_nm": limit},
+    )
     rows = run_in_process(scenario).rows
     motor = rows[1:, F["motor_torque_nm"]]
-    assert np.abs(motor).max() == pytest.approx(limit, rel=1e-9)      # at the limit
-    card = score(rows, 0.0, scenario.setpoints(PRESET), rig_physics(scenario.load_preset()),
-                 PERIOD_S)
+    assert np.abs(motor).max() == pytest.approx(limit, rel=1e-9)  # at the limit
+    card = score(
+        rows, 0.0, scenario.setpoints(PRESET), rig_physics(scenario.load_preset()), PERIOD_S
+    )
     assert card["status"] == "stalled"
     stall_s = card["stall_time_s"]
     assert stall_s is not None and 0.0 < stall_s < 50.0
@@ -96,8 +116,13 @@ class TorqueStep:
 
 def drive_speed(delay_s: float, at_s: float = 1.0, torque_nm: float = 20e3) -> np.ndarray:
     """Drive speed (rad/s) of each sample of a torque step at ``at_s`` delayed ``delay_s``."""
-    scenario = Scenario(mode="torque", duration_s=1.5, enable_at_s=0.0,
-                        drive={"command_delay_s": delay_s})
+    scenario = Scenario(
+        preset="field_8p5in_shale_lumped",
+        mode="torque",
+        duration_s=1.5,
+        enable_at_s=0.0,
+        drive={"command_delay_s": delay_s},
+    )
     bench = Bench(scenario)
     controller = TorqueStep(at_s, torque_nm)
     command = controller.update(None)
@@ -115,24 +140,53 @@ def test_a_delay_of_whole_periods_is_the_command_sent_that_much_later() -> None:
 
 @pytest.mark.parametrize("fraction", [0.25, 0.6])
 def test_a_delay_within_a_period_moves_the_step_inside_it(fraction: float) -> None:
-    k = 100                             # the command reacts to the sample at 1.00 s
+    k = 100  # the command reacts to the sample at 1.00 s
     never = drive_speed(0.0, at_s=99.0)
     gain = drive_speed(0.0)[k + 1] - never[k + 1]
     delayed = drive_speed(fraction * PERIOD_S)
-    assert np.array_equal(delayed[:k + 1], never[:k + 1])      # nothing before it arrives
+    assert np.array_equal(delayed[: k + 1], never[: k + 1])  # nothing before it arrives
     inertia = rig_physics(PRESET).drive_inertia_kg_m2
-    assert gain > 0.5 * (20e3 - 5e3) * PERIOD_S / inertia    # a real kick (T < 5 kN m)
+    assert gain > 0.5 * (20e3 - 5e3) * PERIOD_S / inertia  # a real kick (T < 5 kN m)
     assert (delayed[k + 1] - never[k + 1]) / gain == pytest.approx(1 - fraction, abs=0.02)
 
 
-def test_features_of_the_model_core_to_come_are_refused_by_name() -> None:
-    formation = scenario_from_dict({"formation": [{"top_m": 0.0}, {"top_m": 3.0}]})
-    assert formation.unsupported() == ["formation_layers"]
-    with pytest.raises(ParameterError, match="formation_layers"):
-        Bench(formation)
-    with pytest.raises(ParameterError, match="motor_lag"):
-        Bench(scenario_from_dict({"drive": {"motor_lag_s": 0.05}}))
-    with pytest.raises(ParameterError, match="distributed_string"):
-        Bench(scenario_from_dict({"needs": ["distributed_string"]}))
+def test_a_scenario_formation_reaches_the_bit_law_at_its_top() -> None:
+    """A hard streak in the scenario file: above its top the run is the plain one bit for
+    bit; from the period whose start finds the bit in it, T = (eps / eps_ref) delta +
+    beta lambda in cutting (eq. 30 with the layer's rock)."""
+    base = {
+        "preset": "field_8p5in_shale_lumped",
+        "controller": "none",
+        "duration_s": 20.0,
+        "enable_at_s": 0.0,
+    }
+    plain = run_in_process(scenario_from_dict(base)).rows
+    depth = plain[:, F["bit_depth_m"]] - plain[0, F["bit_depth_m"]]
+    top = float(0.5 * depth[-1])
+    layered = scenario_from_dict(
+        {**base, "formation": [{"top_m": top, "intrinsic_specific_energy_pa": 460e6}]}
+    )
+    assert layered.unsupported() == []
+    rows = run_in_process(layered).rows
+    below = np.flatnonzero(rows[:, F["bit_depth_m"]] - rows[0, F["bit_depth_m"]] >= top)
+    assert below.size and np.array_equal(rows[: below[0] - 1], plain[: below[0] - 1])
+    assert not np.array_equal(rows[below[0] + 1 :], plain[below[0] + 1 :])
+
+
+def test_a_scenario_motor_lag_reaches_the_drive() -> None:
+    lagged = scenario_from_dict(
+        {
+            "preset": "field_8p5in_shale_lumped",
+            "mode": "torque",
+            "controller": "stiff",
+            "duration_s": 2.0,
+            "enable_at_s": 0.0,
+            "drive": {"motor_lag_s": 0.05},
+        }
+    )
+    assert lagged.unsupported() == []
+    assert Bench(lagged).session.sim.top_drive.motor_lag == pytest.approx(
+        0.05 / PRESET.scales.time_s
+    )
     with pytest.raises(ParameterError, match="command_delay_s"):
         scenario_from_dict({"drive": {"command_delay_s": -1.0}})

@@ -50,7 +50,7 @@ def test_figures_by_their_definitions() -> None:
     after = rows[rows[:, 0] > 20.0]
     assert card["stick_fraction"] == pytest.approx(500 / after.shape[0], rel=1e-12)
     assert card["time_to_suppress_s"] == pytest.approx(45.0 - 20.0)
-    assert card["utr"] == pytest.approx(1.0)            # (60 - 0) / 60
+    assert card["utr"] == pytest.approx(1.0)  # (60 - 0) / 60
     assert card["rop_m_h"] == pytest.approx(10.0)
     bit_rad_s = after[:, F["bit_rpm"]] / RPM_PER_RAD_S
     mse = (60e3 + np.mean(3000.0 * bit_rad_s) / (10.0 / 3600)) / (math.pi * 0.108**2)
@@ -69,8 +69,14 @@ def test_stick_in_the_last_window_means_not_suppressed() -> None:
 
 
 def test_ssi_is_model_analysis_on_the_same_windows() -> None:
-    rows = run_in_process(Scenario(controller="soft_torque", duration_s=100.0,
-                                   enable_at_s=20.0)).rows
+    rows = run_in_process(
+        Scenario(
+            preset="field_8p5in_shale_lumped",
+            controller="soft_torque",
+            duration_s=100.0,
+            enable_at_s=20.0,
+        )
+    ).rows
     card = score(rows, 20.0, Schedule(60.0, 60e3), RIG, PERIOD_S)
     t, bit = rows[:, F["sim_time_s"]], rows[:, F["bit_rpm"]]
     by_hand, by_analysis = [], []
@@ -87,15 +93,16 @@ def test_ssi_is_model_analysis_on_the_same_windows() -> None:
 def test_status_stalled_with_its_time_never_null() -> None:
     rows = synthetic(100.0)
     t = rows[:, F["sim_time_s"]]
-    end_stuck = t > 80.0                       # stuck from 80.01 s to the end: 20 s
+    end_stuck = t > 80.0  # stuck from 80.01 s to the end: 20 s
     rows[end_stuck, F["bit_rpm"]] = 0.0
     rows[end_stuck, F["mode"]] = 2
     card = score(rows, 20.0, Schedule(60.0, 60e3), RIG, PERIOD_S)
     assert card["status"] == "stalled"
     assert card["stall_time_s"] == pytest.approx(80.01)
     short = synthetic(100.0)
-    short[t > 95.0, F["mode"]] = 2             # a 5 s stick at the end: a stick phase
+    short[t > 95.0, F["mode"]] = 2  # a 5 s stick at the end: a stick phase
     card = score(short, 20.0, Schedule(60.0, 60e3), RIG, PERIOD_S)
     assert card["status"] == "stick-slip" and card["stall_time_s"] is None
-    assert score(synthetic(100.0), 20.0, Schedule(60.0, 60e3), RIG,
-                 PERIOD_S)["status"] == "ok"                 # last stick at 45 s
+    assert (
+        score(synthetic(100.0), 20.0, Schedule(60.0, 60e3), RIG, PERIOD_S)["status"] == "ok"
+    )  # last stick at 45 s

@@ -15,24 +15,41 @@ from drill_sim_ros.ros.controller_node import ControllerNode
 from tests.ros.harness import overrides, ros_context
 
 pytestmark = pytest.mark.ros
-SENSORS = {"seed": 7, "string_torque_nm": {"noise_std": 25.0, "quantum": 1.0},
-           "drive_speed_rad_s": {"noise_std": 1e-3, "delay_periods": 2},
-           "motor_torque_nm": {"noise_std": 40.0}}
+SENSORS = {
+    "seed": 7,
+    "string_torque_nm": {"noise_std": 25.0, "quantum": 1.0},
+    "drive_speed_rad_s": {"noise_std": 1e-3, "delay_periods": 2},
+    "motor_torque_nm": {"noise_std": 40.0},
+}
 
 
 # the drive's limits and a command delay within a period, as sim_node parameters
-DRIVE = {"accel_rpm_s": 20.0, "wob_rate_n_s": 3000.0, "max_torque_nm": 20e3,
-         "command_delay_s": 0.0042}
+DRIVE = {
+    "accel_rpm_s": 20.0,
+    "wob_rate_n_s": 3000.0,
+    "max_torque_nm": 20e3,
+    "command_delay_s": 0.0042,
+}
 
 
-@pytest.mark.parametrize(("controller", "mode", "drive"), [
-    ("z_torque", "speed", {}), ("soft_torque", "torque", {}), ("z_torque", "speed", DRIVE)])
-def test_in_process_and_over_dds_give_the_same_telemetry(controller: str, mode: str,
-                                                         drive: dict) -> None:
+@pytest.mark.parametrize(
+    ("controller", "mode", "drive"),
+    [("z_torque", "speed", {}), ("soft_torque", "torque", {}), ("z_torque", "speed", DRIVE)],
+)
+def test_in_process_and_over_dds_give_the_same_telemetry(
+    controller: str, mode: str, drive: dict
+) -> None:
     sensors = {**SENSORS, "hook_load_n": {"noise_std": 500.0}} if drive else SENSORS
-    scenario = Scenario(controller=controller, mode=mode, duration_s=30.0, enable_at_s=10.0,
-                        sensors=sensors, schedule=({"t_s": 20.0, "rpm": 70.0, "ramp_s": 5.0},
-                                                   {"t_s": 22.0, "wob_n": 65e3}), drive=drive)
+    scenario = Scenario(
+        preset="field_8p5in_shale_lumped",
+        controller=controller,
+        mode=mode,
+        duration_s=30.0,
+        enable_at_s=10.0,
+        sensors=sensors,
+        schedule=({"t_s": 20.0, "rpm": 70.0, "ramp_s": 5.0}, {"t_s": 22.0, "wob_n": 65e3}),
+        drive=drive,
+    )
     local = run_in_process(scenario).rows
     remote = run_over_dds(scenario, timeout_s=240.0).rows
     assert local.shape == remote.shape == (3001, len(topics.TELEMETRY_FIELDS))
@@ -41,16 +58,24 @@ def test_in_process_and_over_dds_give_the_same_telemetry(controller: str, mode: 
     setpoint = local[1:, topics.TELEMETRY_INDEX["speed_setpoint_rpm"]]
     if mode == "speed":
         assert np.ptp(setpoint[1000:]) > 1.0
-    np.testing.assert_allclose(local[1:, topics.TELEMETRY_INDEX["command_stamp_s"]],
-                               local[1:, 0] - 0.01, atol=1e-9)
+    np.testing.assert_allclose(
+        local[1:, topics.TELEMETRY_INDEX["command_stamp_s"]], local[1:, 0] - 0.01, atol=1e-9
+    )
 
 
 def test_the_controller_node_subscribes_to_surface_measurements_only() -> None:
     with ros_context() as ros:
-        node = ros.add(ControllerNode(context=ros.context, parameter_overrides=overrides(
-            controller="soft_torque", enable_at_s=5.0, soft_torque__damping_ratio=0.3)))
+        node = ros.add(
+            ControllerNode(
+                context=ros.context,
+                parameter_overrides=overrides(
+                    controller="soft_torque", enable_at_s=5.0, soft_torque__damping_ratio=0.3
+                ),
+            )
+        )
         assert [sub.topic_name for sub in node.subscriptions] == [topics.SURFACE_MEASURED]
-        assert [pub.topic_name for pub in node.publishers if "cmd" in pub.topic_name] == \
-            [topics.CMD_TOP_DRIVE]
+        assert [pub.topic_name for pub in node.publishers if "cmd" in pub.topic_name] == [
+            topics.CMD_TOP_DRIVE
+        ]
         assert node.controller.params["damping_ratio"] == 0.3
         assert node.scenario.enable_at_s == 5.0

@@ -90,11 +90,11 @@ def test_one_period_of_latency_and_identical_bytes_run_after_run(tmp_path):
     # sample k ran under the command that reacted to sample k - 1 (the first: t = 0)
     np.testing.assert_allclose(rows[:, F["command_stamp_s"]], times - PERIOD_S, atol=1e-12)
     # ... and already shows its effect: the surface speed commanded from the previous sample
-    commands = [speed_schedule(None)] + [speed_schedule(r) for r in rows[:-1]]
+    commands = [speed_schedule(first.first_sample)] + [speed_schedule(r) for r in rows[:-1]]
     np.testing.assert_allclose(rows[:, F["surface_rpm"]],
                                np.array([c.speed_rad_s for c in commands]) * RPM_PER_RAD_S,
                                rtol=1e-12)
-    commanded_wob = [WOB0] + [c.wob_n for c in commands[1:]]
+    commanded_wob = [c.wob_n for c in commands]
     np.testing.assert_allclose(rows[:, F["applied_wob_n"]], commanded_wob, rtol=1e-12)
 
 
@@ -103,7 +103,7 @@ def test_torque_mode_applies_the_commanded_motor_torque_within_the_limit(tmp_pat
     driver = run_sim(tmp_path, "torque", periods, 60.0, "top_drive.mode:=torque",
                      f"top_drive.max_torque_nm:={MAX_TORQUE_NM}", policy=torque_schedule)
     rows = np.array(driver.rows)
-    commanded = np.array([torque_schedule(None).motor_torque_nm]
+    commanded = np.array([torque_schedule(driver.first_sample).motor_torque_nm]
                          + [torque_schedule(r).motor_torque_nm for r in rows[:-1]])
     np.testing.assert_allclose(rows[:, F["motor_torque_nm"]],
                                np.minimum(commanded, MAX_TORQUE_NM), rtol=1e-12)
