@@ -40,6 +40,8 @@ TRACE_SI_COLUMNS = ("time_s", "bit_rpm", "rop_m_s", "wob_n", "tob_nm", "depth_of
 TRACE_SI_FIELDS = ("sim_time_s", "bit_rpm", "rop_m_s", "wob_n", "tob_nm", "depth_of_cut_m",
                    "surface_torque_nm")
 CHUNK_STEPS = 500_000
+MAX_STEPS = 1e10           # about 3 min of the kernel at ~16 ns per step
+MAX_SWEEP_VALUES = 10_000
 
 
 @dataclass(frozen=True)
@@ -147,6 +149,10 @@ def _resolve(args: argparse.Namespace) -> RunSpec:
         raise DrillSimError(f"--average-from = {average_from!r} must lie in [0, tau-end = "
                             f"{tau_end!r}]")
     config = SimConfig(dtau=dtau, method=args.method, **({"n_nodes": nodes} if nodes else {}))
+    if tau_end / config.dtau > MAX_STEPS:
+        raise DrillSimError(f"--tau-end = {tau_end:g} (--t-end) at dtau = {config.dtau:g} is "
+                            f"{tau_end / config.dtau:.3g} steps; at most {MAX_STEPS:.0e} (a "
+                            "few minutes of the kernel): shorten the run or raise --dtau")
     return RunSpec(params, scales, physical, tau_end, config.dtau, average_from,
                    args.perturb_v, args.perturb_omega, args.method, config.n_nodes,
                    _top_drive(args, preset.top_drive if preset else TopDrive()),
@@ -355,12 +361,19 @@ def format_summary(d: dict[str, Any]) -> str:
 
 
 def _sweep_values(text: str) -> list[float]:
-    if ":" in text:
-        start, stop, count = text.split(":")
-        n = int(count)
-        return [float(start) + i * (float(stop) - float(start)) / max(n - 1, 1)
-                for i in range(n)]
-    return [float(x) for x in text.split(",") if x.strip()]
+    try:
+        if ":" in text:
+            start, stop, count = text.split(":")
+            n = int(count)
+            if not 1 <= n <= MAX_SWEEP_VALUES:
+                raise DrillSimError(f"--values {text!r}: COUNT = {n} must be in "
+                                    f"[1, {MAX_SWEEP_VALUES}]")
+            return [float(start) + i * (float(stop) - float(start)) / max(n - 1, 1)
+                    for i in range(n)]
+        return [float(x) for x in text.split(",") if x.strip()]
+    except ValueError:
+        raise DrillSimError(f"--values {text!r}: expected V1,V2,... or START:STOP:COUNT "
+                            "(numbers)") from None
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
