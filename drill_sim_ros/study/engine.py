@@ -37,6 +37,7 @@ from drill_sim_ros.study.scheduler_probe import check_scheduler
 TASKS_PER_WORKER = 8      # enough tasks for balance and a live progress bar
 TASKS_IN_FLIGHT = 4       # tasks queued per worker at a time
 CONNECT_TIMEOUT_S = 30.0
+POLL_S = 0.02             # how often the loop looks for a finished task (and for Ctrl-C)
 MAX_BATCH = 64
 LOOPBACK = "127.0.0.1"
 
@@ -173,45 +174,52 @@ def run_map(spec: MapSpec, out: Path, client: object,
     size = batch or batch_size(todo.size, n_workers)
     _say(log, f"drill_sim map: {total:,} points ({' x '.join(map(str, spec.shape))}), "
               f"{todo.size:,} to compute in tasks of {size} on {n_workers} workers")
-    client.run(warm_up)
-    start = time.perf_counter()           # the rate is measured from here, the kernel loaded
-    if progress:
-        progress(done0, total, 0.0)
-    chunks = (todo[i:i + size] for i in range(0, todo.size, size))
-    queue = as_completed()
-    futures = []
+    # Ctrl-C ends the loop between results (a KeyboardInterrupt raised inside distributed's
+    # calls makes it log tracebacks); the rate is measured from the kernel loaded
+    with _deferred_interrupt() as sigint:
+        client.run(warm_up)
+        start = time.perf_counter()
+        if progress:
+            progress(done0, total, 0.0)
+        chunks = (todo[i:i + size] for i in range(0, todo.size, size))
+        queue = as_completed()
+        futures = []
 
-    def submit(count: int) -> None:
-        for chunk in itertools.islice(chunks, count):
-            futures.append(client.submit(evaluate_batch, spec, chunk, pure=False))
-            queue.add(futures[-1])
+        def submit(count: int) -> None:
+            for chunk in itertools.islice(chunks, count):
+                futures.append(client.submit(evaluate_batch, spec, chunk, pure=False))
+                queue.add(futures[-1])
 
-    submit(TASKS_IN_FLIGHT * n_workers)
-    results: list[BatchResult] = []
-    computed, last_save, interrupted = 0, time.monotonic(), False
-    try:
-        for future in queue:
-            res: BatchResult = _result(future)
-            submit(1)
-            store.store_results(ds, res.indices, res.values)
-            results.append(res)
-            computed += len(res.indices)
-            if res.error is not None:
-                raise DrillSimError(res.error)
-            elapsed = time.perf_counter() - start
-            if progress:
-                progress(done0 + computed, total, elapsed)
-            if len(results) == min(n_workers, math.ceil(todo.size / size)):
-                _say(log, estimate_line(computed, todo.size, elapsed))
-            if time.monotonic() - last_save > checkpoint_s:
+        submit(TASKS_IN_FLIGHT * n_workers)
+        results: list[BatchResult] = []
+        computed, last_save, interrupted = 0, time.monotonic(), False
+        try:
+            while not queue.is_empty() and not sigint:
+                if not queue.has_ready():
+                    time.sleep(POLL_S)
+                    continue
+                res: BatchResult = _result(next(queue))
+                submit(1)
+                store.store_results(ds, res.indices, res.values)
+                results.append(res)
+                computed += len(res.indices)
+                if res.error is not None:
+                    raise DrillSimError(res.error)
+                elapsed = time.perf_counter() - start
+                if progress:
+                    progress(done0 + computed, total, elapsed)
+                if len(results) == min(n_workers, math.ceil(todo.size / size)):
+                    _say(log, estimate_line(computed, todo.size, elapsed))
+                if time.monotonic() - last_save > checkpoint_s:
+                    store.save(ds, out)
+                    last_save = time.monotonic()
+            interrupted = bool(sigint)
+        except KeyboardInterrupt:
+            interrupted = True
+        finally:
+            client.cancel(futures)
+            if computed or existed:
                 store.save(ds, out)
-                last_save = time.monotonic()
-    except KeyboardInterrupt:
-        interrupted = True
-    finally:
-        client.cancel(futures)
-        if computed or existed:
-            store.save(ds, out)
     return MapRun(ds, computed, total, time.perf_counter() - start, interrupted,
                   tuple(results))
 
