@@ -28,6 +28,7 @@ from drill_sim_ros.model.params import GROUPS, UNIT_SCALES, DimensionlessParams,
 from drill_sim_ros.model.presets import DEFAULT_PRESET, Preset, available_presets, load_preset
 from drill_sim_ros.model.simulator import SimConfig, Simulator
 from drill_sim_ros.model.top_drive import MODES, TopDrive
+from drill_sim_ros.model.validate_input import load_checked_preset
 from drill_sim_ros.study import cli as study_cli
 from drill_sim_ros.study import suite_cli
 from drill_sim_ros.terminal import StatusLine
@@ -39,6 +40,8 @@ TRACE_SI_COLUMNS = ("time_s", "bit_rpm", "rop_m_s", "wob_n", "tob_nm", "depth_of
 TRACE_SI_FIELDS = ("sim_time_s", "bit_rpm", "rop_m_s", "wob_n", "tob_nm", "depth_of_cut_m",
                    "surface_torque_nm")
 CHUNK_STEPS = 500_000
+MAX_STEPS = 1e10           # about 3 min of the kernel at ~16 ns per step
+MAX_SWEEP_VALUES = 10_000
 
 
 @dataclass(frozen=True)
@@ -132,7 +135,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 def _resolve(args: argparse.Namespace) -> RunSpec:
     """Turn parsed arguments into a validated :class:`RunSpec`."""
-    preset: Preset | None = load_preset(args.params) if args.params else None
+    preset: Preset | None = load_checked_preset(args.params) if args.params else None
     base = preset.params if preset else DimensionlessParams()
     overrides = {g: getattr(args, g) for g in GROUPS if getattr(args, g) is not None}
     params = base.with_(**overrides) if overrides else base
@@ -146,6 +149,10 @@ def _resolve(args: argparse.Namespace) -> RunSpec:
         raise DrillSimError(f"--average-from = {average_from!r} must lie in [0, tau-end = "
                             f"{tau_end!r}]")
     config = SimConfig(dtau=dtau, method=args.method, **({"n_nodes": nodes} if nodes else {}))
+    if tau_end / config.dtau > MAX_STEPS:
+        raise DrillSimError(f"--tau-end = {tau_end:g} (--t-end) at dtau = {config.dtau:g} is "
+                            f"{tau_end / config.dtau:.3g} steps; at most {MAX_STEPS:.0e} (a "
+                            "few minutes of the kernel): shorten the run or raise --dtau")
     return RunSpec(params, scales, physical, tau_end, config.dtau, average_from,
                    args.perturb_v, args.perturb_omega, args.method, config.n_nodes,
                    _top_drive(args, preset.top_drive if preset else TopDrive()),
@@ -354,12 +361,19 @@ def format_summary(d: dict[str, Any]) -> str:
 
 
 def _sweep_values(text: str) -> list[float]:
-    if ":" in text:
-        start, stop, count = text.split(":")
-        n = int(count)
-        return [float(start) + i * (float(stop) - float(start)) / max(n - 1, 1)
-                for i in range(n)]
-    return [float(x) for x in text.split(",") if x.strip()]
+    try:
+        if ":" in text:
+            start, stop, count = text.split(":")
+            n = int(count)
+            if not 1 <= n <= MAX_SWEEP_VALUES:
+                raise DrillSimError(f"--values {text!r}: COUNT = {n} must be in "
+                                    f"[1, {MAX_SWEEP_VALUES}]")
+            return [float(start) + i * (float(stop) - float(start)) / max(n - 1, 1)
+                    for i in range(n)]
+        return [float(x) for x in text.split(",") if x.strip()]
+    except ValueError:
+        raise DrillSimError(f"--values {text!r}: expected V1,V2,... or START:STOP:COUNT "
+                            "(numbers)") from None
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
@@ -385,7 +399,7 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
 
 
 def _cmd_info(args: argparse.Namespace) -> int:
-    preset = load_preset(args.preset)
+    preset = load_checked_preset(args.preset)
     p = preset.params
     print(f"{preset.name}: {preset.description}")
     print("  groups  " + "  ".join(f"{g}={getattr(p, g):.4g}" for g in GROUPS))
@@ -419,8 +433,11 @@ def main(argv: Sequence[str] | None = None) -> int:
                 "figures": study_cli.cmd_figures, "modes": string_cli.cmd_modes,
                 "reflection": string_cli.cmd_reflection}[args.command](args)
     except DrillSimError as exc:
-        print(f"drill_sim: error: {exc}", file=sys.stderr)
+        print(f"drill_sim: error: {' '.join(str(exc).splitlines())}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:
+        print(f"drill_sim {args.command}: interrupted", file=sys.stderr)
+        return 130
 
 
 if __name__ == "__main__":

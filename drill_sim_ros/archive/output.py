@@ -62,10 +62,14 @@ def open_output(path: str | Path, overwrite: bool, hint: str = OVERWRITE_HINT) -
         raise _os_error(path, exc) from None
 
 
-def temporary_beside(path: str | Path, overwrite: bool, hint: str = OVERWRITE_HINT) -> Path:
-    """A fresh temporary path in ``path``'s directory (checked writable) for :func:`commit`."""
+def temporary_beside(path: str | Path, overwrite: bool, hint: str = OVERWRITE_HINT,
+                     keep_suffix: bool = False) -> Path:
+    """A fresh temporary path in ``path``'s directory (checked writable) for :func:`commit`;
+    with ``keep_suffix`` it ends in ``path``'s suffix (for writers that pick the format
+    from it)."""
     path = check_output(path, overwrite, hint)
-    temporary = path.with_name(f".{path.name}.{os.getpid()}.partial")
+    suffix = path.suffix if keep_suffix else ""
+    temporary = path.with_name(f".{path.name}.{os.getpid()}.partial{suffix}")
     open_output(temporary, overwrite=True).close()
     return temporary
 

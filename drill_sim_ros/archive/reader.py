@@ -98,6 +98,14 @@ class ArchiveReader:
         except (*DAMAGE, EOFError, OSError):
             return None
 
+    def summary_channels(self, summary: Summary) -> list[RecordedChannel]:
+        """The channels listed in ``summary`` (registered as :meth:`messages` would)."""
+        for schema in summary.schemas.values():
+            self._register(schema)
+        for channel in summary.channels.values():
+            self._register(channel)
+        return [self.channels[i] for i in summary.channels]
+
     @property
     def lost_data(self) -> bool:
         """True if a damaged stretch of the data section was skipped (messages lost)."""

@@ -63,13 +63,33 @@ class Plan:
 
 
 def plan(reader: ArchiveReader, topics: re.Pattern[str]) -> Plan:
-    """Channels and time extent, from one pass over the file (which needs no summary)."""
+    """Channels and time extent: from the summary when it has statistics and every channel
+    with messages is replayed (instant, whatever the size), else from one pass over the file
+    (which needs no summary; logged first, it takes a while on a large file)."""
+    quick = _plan_from_summary(reader, topics)
+    if quick is not None:
+        return quick
+    _log.info("reading %s to plan the replay (%.0f MB; no usable summary)", reader.path,
+              reader.size / 1e6)
     first, last = None, 0
     for message in reader.messages(topics.fullmatch):
         first = message.log_time_ns if first is None else min(first, message.log_time_ns)
         last = max(last, message.log_time_ns)
     chosen = [c for c in reader.channels.values() if topics.fullmatch(c.topic)]
     return Plan(chosen, first or 0, last)
+
+
+def _plan_from_summary(reader: ArchiveReader, topics: re.Pattern[str]) -> Plan | None:
+    summary = reader.summary()
+    stats = None if summary is None else summary.statistics
+    if stats is None or stats.message_count == 0:
+        return None
+    channels = reader.summary_channels(summary)
+    with_messages = [c for c in channels if stats.channel_message_counts.get(c.channel_id)]
+    if not all(topics.fullmatch(c.topic) for c in with_messages):
+        return None             # the extent of a subset of topics needs the pass
+    chosen = [c for c in channels if topics.fullmatch(c.topic)]
+    return Plan(chosen, stats.message_start_time, stats.message_end_time)
 
 
 DELIVERY_TIMEOUT_S = 2.0    # before exiting, let reliable subscribers receive the tail
@@ -259,7 +279,11 @@ def main(args: list[str] | None = None) -> int:
     except ArchiveError as exc:
         _log.error("%s", exc)
         return 2
-    extent = plan(reader, re.compile(options.topics))
+    try:
+        extent = plan(reader, re.compile(options.topics))
+    except KeyboardInterrupt:
+        _log.info("interrupted while planning; nothing was sent")
+        return 130
     refusal = _nothing_to_send(reader, extent, options)
     if refusal is not None:
         _log.error("%s", refusal)

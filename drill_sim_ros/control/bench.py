@@ -30,6 +30,7 @@ from drill_sim_ros.control.command import (
     apply_command,
     measurement_of_row,
 )
+from drill_sim_ros.control.isolation import IsolatedController, build_isolated
 from drill_sim_ros.control.registry import make_controller
 from drill_sim_ros.control.rig import RigPhysics, rig_physics
 from drill_sim_ros.control.scenario import Scenario
@@ -60,6 +61,7 @@ class ClosedLoopRun:
     # ``snapshot_after`` when asked (differences of the sums are window sums)
     accumulators: np.ndarray | None = None
     snapshot: np.ndarray | None = None
+    interrupted: bool = False     # Ctrl-C: ``rows`` holds the periods done
 
 
 def drive_of(preset: Preset, mode: str, motor_lag_s: float | None = None) -> TopDrivePhysical:
@@ -109,12 +111,13 @@ DRIVE_PARAMETERS = {"accel_rpm_s": "limits.top_drive_accel_rpm_s",
                     "command_delay_s": "commands.delay_s"}
 
 
-def build_controller(scenario: Scenario, preset: Preset) -> object:
-    """The scenario's controller, tuned from the preset's physics."""
-    return make_controller(scenario.controller, rig=rig_physics(preset),
-                           schedule=scenario.setpoints(preset), mode=scenario.mode,
-                           period_s=scenario.period_s, enable_at_s=scenario.enable_at_s,
-                           **scenario.params)
+def build_controller(scenario: Scenario, preset: Preset) -> IsolatedController:
+    """The scenario's controller, tuned from the preset's physics, isolated
+    (:mod:`~drill_sim_ros.control.isolation`: its failures are one ControllerError line)."""
+    return build_isolated(scenario.controller, lambda: make_controller(
+        scenario.controller, rig=rig_physics(preset), schedule=scenario.setpoints(preset),
+        mode=scenario.mode, period_s=scenario.period_s, enable_at_s=scenario.enable_at_s,
+        **scenario.params), scenario.period_s)
 
 
 class Bench:
@@ -179,15 +182,19 @@ def run_in_process(scenario: Scenario,
     start = time.perf_counter()
     command = controller.update(bench.measurement())   # the answer to t = 0
     snapshot = sim.accumulators if snapshot_after == 0 else None
-    for i in range(bench.periods):
-        bench.step(command)
-        if snapshot_after == i + 1:
-            snapshot = sim.accumulators
-        if not bench.done:
-            command = controller.update(bench.measurement())
-        if progress is not None and (i + 1) % 1000 == 0:
-            progress(i + 1, bench.periods)
+    interrupted = False
+    try:
+        for i in range(bench.periods):
+            bench.step(command)
+            if snapshot_after == i + 1:
+                snapshot = sim.accumulators
+            if not bench.done:
+                command = controller.update(bench.measurement())
+            if progress is not None and (i + 1) % 1000 == 0:
+                progress(i + 1, bench.periods)
+    except KeyboardInterrupt:
+        interrupted = True
     wall_s = time.perf_counter() - start
-    return ClosedLoopRun(scenario, bench.rows, wall_s,
+    return ClosedLoopRun(scenario, bench.rows[:bench.period + 1], wall_s,
                          int(getattr(controller, "clamped_commands", 0)), sim.accumulators,
-                         snapshot)
+                         snapshot, interrupted)

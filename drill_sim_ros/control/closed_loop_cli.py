@@ -5,17 +5,26 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import sys
 from pathlib import Path
 from typing import Any
 
+from drill_sim_ros.archive.output import (
+    OutputError,
+    OutputExistsError,
+    commit,
+    temporary_beside,
+)
 from drill_sim_ros.control.bench import ClosedLoopRun, run_in_process
 from drill_sim_ros.control.controllers import CONTROL_MODES
 from drill_sim_ros.control.rig import rig_physics
 from drill_sim_ros.control.scenario import Scenario, load_scenario
 from drill_sim_ros.control.scorecard import SCORE_FIELDS, score, status_text
 from drill_sim_ros.model.errors import DrillSimError
+from drill_sim_ros.model.presets import Preset
 from drill_sim_ros.terminal import StatusLine
 
+PLOT_SUFFIXES = (".png", ".svg", ".pdf")
 LABELS = {"ssi_before_mean": "SSI before switch-on (mean)", "ssi_mean": "SSI after (mean)",
           "ssi_max": "SSI after (max)", "ssi_last": "SSI last 20 s",
           "stick_fraction": "stick fraction after",
@@ -45,7 +54,9 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--plot", type=Path, help="PNG of speeds with the setpoint, quill and "
                    "motor torque with its limit, WOB; stuck and saturated spans shaded; "
-                   "beside the uncontrolled run")
+                   "beside the uncontrolled run; also .svg or .pdf; an existing file is kept "
+                   "unless --overwrite")
+    p.add_argument("--overwrite", action="store_true", help="replace an existing --plot file")
     p.add_argument("--no-baseline", action="store_true", help="skip the uncontrolled run "
                    "(by default it runs too, for the comparison)")
     p.add_argument("--ros", action="store_true", help="run sim_node and the "
@@ -62,8 +73,8 @@ def _scenario(args: argparse.Namespace) -> Scenario:
             params[name.strip()] = float(value)
         except ValueError:
             sep = ""
-        if not sep:
-            raise DrillSimError(f"--set {item!r} must be NAME=NUMBER")
+        if not sep or not name.strip() or not math.isfinite(params[name.strip()]):
+            raise DrillSimError(f"--set {item!r} must be NAME=NUMBER (a finite number)")
     enable_at_s = args.enable_at
     if enable_at_s is None and args.t_end is not None and args.t_end < base.enable_at_s:
         enable_at_s = args.t_end / 3.0          # a short run: switch on after a third
@@ -99,33 +110,61 @@ def _table(columns: dict[str, dict[str, Any]]) -> str:
     return "\n".join(lines)
 
 
+def _plot_target(path: Path | None, overwrite: bool) -> Path | None:
+    """A writable temporary file beside ``--plot`` (checked before the run), or None."""
+    if path is None:
+        return None
+    if path.suffix.lower() not in PLOT_SUFFIXES:
+        raise DrillSimError(f"--plot {path}: unknown suffix {path.suffix!r}; use one of "
+                            f"{', '.join(PLOT_SUFFIXES)}")
+    try:
+        return temporary_beside(path, overwrite, keep_suffix=True)
+    except OutputExistsError as exc:
+        raise DrillSimError(f"--plot: {exc}") from None
+    except OutputError as exc:
+        reason = str(exc).rsplit(": ", 1)[-1]
+        raise DrillSimError(f"--plot {path}: cannot write there ({reason})") from None
+
+
 def cmd_closed_loop(args: argparse.Namespace) -> int:
     scenario = _scenario(args)
     preset = scenario.load_preset()
+    plot_tmp = _plot_target(args.plot, args.overwrite)
+    try:
+        return _closed_loop(args, scenario, preset, plot_tmp)
+    finally:
+        if plot_tmp is not None:
+            plot_tmp.unlink(missing_ok=True)
+
+
+def _interrupted(run: ClosedLoopRun) -> int:
+    done_s = (len(run.rows) - 1) * run.scenario.period_s
+    print(f"drill_sim closed-loop: interrupted at t = {done_s:g} s of "
+          f"{run.scenario.duration_s:g} s ({len(run.rows) - 1:,} of {run.scenario.periods:,} "
+          "periods); nothing scored or written", file=sys.stderr)
+    return 130
+
+
+def _closed_loop(args: argparse.Namespace, scenario: Scenario, preset: Preset,
+                 plot_tmp: Path | None) -> int:
     rig = rig_physics(preset)
     schedule = scenario.setpoints(preset)
     controlled = _run(scenario, args.ros, scenario.controller)
+    if controlled.interrupted:
+        return _interrupted(controlled)
     columns = {}
     baseline = None
     if not args.no_baseline and scenario.controller != "none":
         baseline = _run(scenario.with_(controller="none", mode="speed", params={}), False,
                         "no control")
+        if baseline.interrupted:
+            return _interrupted(baseline)
         columns["no control"] = score(baseline.rows, scenario.enable_at_s, schedule, rig,
                                       scenario.period_s)
     label = f"{scenario.controller.split(':')[-1]} ({scenario.mode})"
     columns[label] = score(controlled.rows, scenario.enable_at_s, schedule, rig,
                            scenario.period_s)
     rate = scenario.periods / controlled.wall_s if controlled.wall_s > 0 else math.nan
-    if args.plot:
-        from drill_sim_ros.control.plot import PlotContext, PlotRun, plot_runs, schedule_events
-        runs = [PlotRun(name, rows, speed_mode, status_text(columns[name]))
-                for name, rows, speed_mode in (
-                    ("no control", None if baseline is None else baseline.rows, True),
-                    (label, controlled.rows, scenario.mode == "speed")) if rows is not None]
-        plot_runs(args.plot, runs, PlotContext(
-            f"{preset.name}: {label}, switched on at {scenario.enable_at_s:g} s", schedule,
-            scenario.enable_at_s, rig.max_torque_nm, rig.max_surface_rpm,
-            schedule_events(schedule)))
     if args.json:
         print(json.dumps({"scenario": scenario.to_dict(), "path": "ros" if args.ros else
                           "in-process", "periods": scenario.periods,
@@ -136,4 +175,18 @@ def cmd_closed_loop(args: argparse.Namespace) -> int:
         print(f"{scenario.periods:,} periods of {scenario.period_s * 1e3:g} ms "
               f"{'over DDS' if args.ros else 'in process'}: {rate:,.0f} periods/s "
               f"({rate * scenario.period_s:,.0f}x real time)")
+    if plot_tmp is not None:
+        from drill_sim_ros.control.plot import PlotContext, PlotRun, plot_runs, schedule_events
+        runs = [PlotRun(name, rows, speed_mode, status_text(columns[name]))
+                for name, rows, speed_mode in (
+                    ("no control", None if baseline is None else baseline.rows, True),
+                    (label, controlled.rows, scenario.mode == "speed")) if rows is not None]
+        plot_runs(plot_tmp, runs, PlotContext(
+            f"{preset.name}: {label}, switched on at {scenario.enable_at_s:g} s", schedule,
+            scenario.enable_at_s, rig.max_torque_nm, rig.max_surface_rpm,
+            schedule_events(schedule)))
+        try:
+            commit(plot_tmp, args.plot, args.overwrite)
+        except OutputError as exc:
+            raise DrillSimError(f"--plot: {exc}") from None
     return 0

@@ -9,6 +9,7 @@ answers with a :class:`Command`, the content of one ``drill/cmd/top_drive`` mess
 from __future__ import annotations
 
 import math
+import sys
 from dataclasses import dataclass
 
 import numpy as np
@@ -76,6 +77,14 @@ def clamp_command(value: float, limit: float, unit: str, low: float = 0.0
     return value, None
 
 
+def rpm_of_rad_s(speed_rad_s: float) -> float:
+    """rev/min of a speed; a finite speed stays finite (1e308 rad/s saturates at the largest
+    float instead of overflowing to inf, so it is clamped, not rejected)."""
+    if not math.isfinite(speed_rad_s):
+        return speed_rad_s
+    return max(-sys.float_info.max, min(sys.float_info.max, speed_rad_s * RPM_PER_RAD_S))
+
+
 def apply_command(session: SimSession, command: Command, limits: CommandLimits
                   ) -> list[tuple[bool, str]]:
     """Set what ``command`` commands on ``session`` (from its next period), each value
@@ -91,7 +100,7 @@ def apply_command(session: SimSession, command: Command, limits: CommandLimits
         return applied
 
     if command.speed_rad_s is not None:
-        rpm = bounded(command.speed_rad_s * RPM_PER_RAD_S, limits.max_surface_rpm, "rev/min")
+        rpm = bounded(rpm_of_rad_s(command.speed_rad_s), limits.max_surface_rpm, "rev/min")
         if rpm is not None:
             session.set_surface_rpm(rpm)
     if command.motor_torque_nm is not None:

@@ -54,6 +54,7 @@ from drill_sim_ros.model.params import RPM_PER_RAD_S
 from drill_sim_ros.model.top_drive import speed_loop
 
 CONTROL_MODES = ("speed", "torque")
+MAX_PARAMETER = 1e9     # every parameter is a positive number at most this (SI)
 
 
 class LowPass:
@@ -104,9 +105,9 @@ class TopDriveController:
                 raise ParameterError(f"controller {self.name!r} has no parameter {key!r}; "
                                      f"known: {sorted(known)}")
             if isinstance(value, bool) or not isinstance(value, (int, float)) or \
-                    not (math.isfinite(value) and value > 0):
-                raise ParameterError(f"controller parameter {key!r} = {value!r} must be a "
-                                     "number > 0")
+                    not (math.isfinite(value) and 0 < value <= MAX_PARAMETER):
+                raise ParameterError(f"controller parameter {key!r} = {value!r} is outside "
+                                     f"(0, {MAX_PARAMETER:g}]")
         return {key: float(value) for key, value in params.items()}
 
     def reset(self) -> None:

@@ -46,6 +46,7 @@ from typing import Any
 
 import yaml
 
+from drill_sim_ros.control.scenario_check import check_scenario_mapping, check_scenario_size
 from drill_sim_ros.control.schedule import Schedule, schedule_from_list
 from drill_sim_ros.model.errors import ParameterError
 from drill_sim_ros.model.measurement import SIGNALS, RigSensors, SignalSpec
@@ -53,10 +54,10 @@ from drill_sim_ros.model.presets import (
     DEFAULT_PRESET,
     Preset,
     config_dirs,
-    load_preset,
     preset_from_dict,
     preset_path,
 )
+from drill_sim_ros.model.validate_input import check_preset_mapping, load_checked_preset
 
 SCENARIO_KEYS = ("preset", "duration_s", "control_rate_hz", "mode", "controller", "params",
                  "enable_at_s", "schedule", "sensors", "description", "overrides", "drive",
@@ -93,6 +94,7 @@ class Scenario:
             value = getattr(self, name)
             if not (isinstance(value, (int, float)) and math.isfinite(value) and value > low):
                 raise ParameterError(f"scenario: '{name}' = {value!r} must be a number > 0")
+        check_scenario_size(self.duration_s, self.control_rate_hz)
         if not (math.isfinite(self.enable_at_s) and 0.0 <= self.enable_at_s <= self.duration_s):
             raise ParameterError(f"scenario: 'enable_at_s' = {self.enable_at_s!r} must lie in "
                                  f"[0, duration_s = {self.duration_s:g}]")
@@ -143,7 +145,7 @@ class Scenario:
         if "max_torque_nm" in self.drive:
             overrides.setdefault("top_drive", {})["max_torque_nm"] = self.drive["max_torque_nm"]
         if not overrides:
-            return load_preset(self.preset)
+            return load_checked_preset(self.preset)
         path = preset_path(self.preset)
         data = yaml.safe_load(path.read_text()) or {}
         for section, values in overrides.items():
@@ -152,6 +154,7 @@ class Scenario:
                                      "is not a mapping")
             data[section] = {**(data.get(section) or {}), **values}
         try:
+            check_preset_mapping(data)
             return preset_from_dict(path.stem, data)
         except (ParameterError, TypeError) as exc:
             raise ParameterError(f"scenario: overrides of preset {self.preset!r}: {exc}"
@@ -208,25 +211,13 @@ def scenario_from_dict(data: dict[str, Any]) -> Scenario:
     unknown = sorted(set(data) - set(SCENARIO_KEYS))
     if unknown:
         raise ParameterError(f"scenario: unknown key(s) {unknown}; known: {list(SCENARIO_KEYS)}")
-    values = dict(data)
-    values["schedule"] = tuple(values.get("schedule") or ())
-    values["params"] = dict(values.get("params") or {})
-    values["sensors"] = dict(values.get("sensors") or {})
+    values = check_scenario_mapping(data)
     for key in ("overrides", "drive"):
         values[key] = dict(values.get(key) or {})
     values["formation"] = tuple(values.get("formation") or ())
     values["needs"] = tuple(values.get("needs") or ())
     values["description"] = " ".join(str(values.get("description") or "").split())
-    for key in ("duration_s", "control_rate_hz", "enable_at_s"):
-        if key in values:
-            values[key] = _float(key, values[key])
     return Scenario(**values)
-
-
-def _float(key: str, value: Any) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise ParameterError(f"scenario: '{key}' = {value!r} must be a number")
-    return float(value)
 
 
 def load_scenario(path: str | Path) -> Scenario:

@@ -11,6 +11,7 @@ the controller drives the pace for the scenario's periods and exits; then the si
 from __future__ import annotations
 
 import json
+import logging
 import os
 import random
 import signal
@@ -26,8 +27,12 @@ from mcap_ros2.decoder import DecoderFactory
 
 from drill_sim_ros import topics
 from drill_sim_ros.control.bench import ClosedLoopRun, sim_node_parameters
+from drill_sim_ros.control.isolation import ControllerError
 from drill_sim_ros.control.scenario import Scenario, save_scenario
 from drill_sim_ros.model.errors import DrillSimError
+from drill_sim_ros.model.telemetry import N_FIELDS
+
+_log = logging.getLogger(__name__)
 
 STOP_TIMEOUT_S = 20.0
 
@@ -72,6 +77,23 @@ def _stop(process: subprocess.Popen, sig: int = signal.SIGINT) -> int:
     return process.wait()
 
 
+def _recorded_rows(path: Path) -> np.ndarray:
+    """The telemetry recorded so far (an interrupted run), at least the t = 0 row slot."""
+    try:
+        rows = read_telemetry(path)
+    except Exception:  # (an unfinished file: what it holds is a bonus, not a promise)
+        rows = np.empty((0, N_FIELDS))
+    return rows if len(rows) else np.zeros((1, N_FIELDS))
+
+
+def _controller_error(stderr: str) -> str:
+    """The controller node's one line about the controller under test (exit 2)."""
+    from drill_sim_ros.ros.controller_node import CONTROLLER_ERROR_PREFIX
+    lines = [line for line in stderr.splitlines() if line.startswith(CONTROLLER_ERROR_PREFIX)]
+    return (lines[-1][len(CONTROLLER_ERROR_PREFIX):] + " (over DDS)") if lines else \
+        f"over DDS: top_drive_controller exited 2: {stderr.strip()[-300:]}"
+
+
 def run_over_dds(scenario: Scenario,
                  progress: Callable[[int, int], None] | None = None,
                  timeout_s: float | None = None) -> ClosedLoopRun:
@@ -103,9 +125,18 @@ def run_over_dds(scenario: Scenario,
             _stop(sim)
             raise DrillSimError(f"the controller node did not finish {periods} periods in "
                                 f"{timeout_s:g} s") from exc
+        except KeyboardInterrupt:                # the children had SIGINT too: both stop
+            _stop(sim)
+            return ClosedLoopRun(scenario, _recorded_rows(record_path), 0.0,
+                                 interrupted=True)
         finally:
             rc = _stop(sim)
             sim_log.close()
+        for line in controller.stderr.splitlines():     # e.g. a slow controller
+            if "warning: controller" in line:
+                _log.warning("%s (over DDS)", line[line.index("warning: controller"):])
+        if controller.returncode == 2:
+            raise ControllerError(_controller_error(controller.stderr))
         if controller.returncode != 0 or rc != 0:
             raise DrillSimError(
                 f"over DDS: top_drive_controller exited {controller.returncode}, sim_node "

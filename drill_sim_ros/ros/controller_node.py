@@ -29,12 +29,14 @@ from drill_sim_ros import topics
 from drill_sim_ros.control.bench import build_controller
 from drill_sim_ros.control.command import Command, SurfaceMeasurement
 from drill_sim_ros.control.controllers import CONTROL_MODES
+from drill_sim_ros.control.isolation import ControllerError
 from drill_sim_ros.control.registry import BUILTIN
 from drill_sim_ros.control.scenario import Scenario, load_scenario
 from drill_sim_ros.model.errors import DrillSimError
 from drill_sim_ros.ros.lockstep_driver import LockstepDriver
 
 NODE_NAME = "top_drive_controller"
+CONTROLLER_ERROR_PREFIX = f"{NODE_NAME}: error: "
 
 
 def _double(description: str, low: float = 0.0, high: float = 1e9) -> ParameterDescriptor:
@@ -112,7 +114,9 @@ class ControllerNode(LockstepDriver):
 
 def main(args: list[str] | None = None) -> int:
     """Console script ``top_drive_controller``; with ``periods`` > 0 it prints one JSON line
-    (periods, wall_s, periods_per_s) when done and exits 0."""
+    (periods, wall_s, periods_per_s) when done and exits 0. A failure of the controller
+    itself (an exception, a wrong type, a non-finite command: ``control.isolation``) is one
+    stderr line starting with CONTROLLER_ERROR_PREFIX, exit 2."""
     rclpy.init(args=args)
     node = None
     try:
@@ -125,6 +129,9 @@ def main(args: list[str] | None = None) -> int:
             print(json.dumps(node.summary()), flush=True)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
+    except ControllerError as exc:       # the controller under test failed: one line, exit 2
+        print(f"{CONTROLLER_ERROR_PREFIX}{exc}", file=sys.stderr, flush=True)
+        return 2
     except (DrillSimError, ValueError) as exc:
         rclpy.logging.get_logger(NODE_NAME).fatal(str(exc))
         return 1

@@ -29,6 +29,8 @@ from drill_sim_ros.model.measurement import MAX_DELAY_PERIODS, SIGNALS
 from drill_sim_ros.model.params import UNIT_SCALES
 from drill_sim_ros.model.presets import DEFAULT_PRESET, Preset, submerged_string_weight_n
 from drill_sim_ros.model.top_drive import MODES, TopDrive, TopDrivePhysical
+from drill_sim_ros.ros.params_file_check import check_params_content
+from drill_sim_ros.topics import NODE_NAME
 
 RCLError = rclpy_implementation.RCLError
 DOUBLE, INTEGER, BOOL, STRING = "double", "int", "bool", "string"
@@ -305,7 +307,8 @@ _SOURCE_LOCATION = re.compile(r",? at [^,]*\.c:\d+")
 
 
 def check_params_files(args: list[str]) -> None:
-    """Each ``--params-file`` must exist and parse as YAML (one ParameterError line if not).
+    """Each ``--params-file`` must exist, parse as YAML and set only sim_node parameters
+    (``ros.params_file_check``; one ParameterError line if not).
 
     Checked before rcl sees them, which would log its own parse error and a C source location.
     """
@@ -314,12 +317,13 @@ def check_params_files(args: list[str]) -> None:
             continue
         try:
             with open(path, encoding="utf-8") as stream:
-                yaml.safe_load(stream)
+                data = yaml.safe_load(stream)
         except OSError as exc:
             raise ParameterError(f"--params-file {path}: {exc.strerror or exc}") from None
         except yaml.YAMLError as exc:
             raise ParameterError(f"--params-file {path} is not valid YAML: "
                                  f"{' '.join(str(exc).split())}") from None
+        check_params_content(path, data, NODE_NAME, set(SPEC_BY_NAME))
 
 
 def check_parameter_rules(args: list[str]) -> None:

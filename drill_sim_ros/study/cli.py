@@ -61,7 +61,7 @@ def add_parsers(sub: Any, add_model_args: Callable[[argparse.ArgumentParser], No
 def map_spec_from(args: argparse.Namespace,
                   resolve: Callable[[argparse.Namespace], Any]) -> MapSpec:
     """A :class:`MapSpec` from the ``map`` options; ``resolve`` is ``drill_sim run``'s."""
-    from drill_sim_ros.model.presets import load_preset
+    from drill_sim_ros.model.validate_input import load_checked_preset
     from drill_sim_ros.study.grid import Control, MapSpec, Numerics, parse_vary
     control = None
     if args.controller is not None:
@@ -72,7 +72,7 @@ def map_spec_from(args: argparse.Namespace,
     num = Numerics(tau_end=run.tau_end, average_from=run.average_from, dtau=run.dtau,
                    n_nodes=run.n_nodes, method=run.method, perturb_v=run.perturb_v,
                    perturb_omega=run.perturb_omega)
-    name = load_preset(args.params).name if args.params else ""
+    name = load_checked_preset(args.params).name if args.params else ""
     return MapSpec(run.params, tuple(parse_vary(v) for v in args.vary), num,
                    scales=run.scales if run.physical else None, preset=name,
                    control=control)
@@ -81,19 +81,21 @@ def map_spec_from(args: argparse.Namespace,
 def cmd_map(args: argparse.Namespace, resolve: Callable[[argparse.Namespace], Any]) -> int:
     if args.batch is not None and not 1 <= args.batch <= 100_000:
         raise DrillSimError(f"--batch = {args.batch} must be in [1, 100000]")
-    from drill_sim_ros.study import engine
+    from drill_sim_ros.study import engine, store
     spec = map_spec_from(args, resolve)
     bar = MapProgress(args.progress or _isatty())
     try:
-        with engine.connect(args.scheduler, args.workers) as client:
-            result = engine.run_map(spec, args.out, client, progress=bar, batch=args.batch)
+        with store.map_lock(args.out), engine.connect(args.scheduler, args.workers) as client:
+            result = engine.run_map(spec, args.out, client, progress=bar, batch=args.batch,
+                                    log=bar.say)
     except KeyboardInterrupt:
         result = None
     finally:
         bar.close()
     if result is None or result.interrupted:
-        print(f"drill_sim map: interrupted; the points done are kept in {args.out}; "
-              "re-run the same command to resume")
+        kept = f"the points done are kept in {args.out}" if args.out.exists() else \
+            "no point was done"
+        print(f"drill_sim map: interrupted; {kept}; re-run the same command to resume")
         return 130
     done = int(result.dataset["done"].sum())
     rate = result.computed / result.seconds if result.seconds > 0 else 0.0

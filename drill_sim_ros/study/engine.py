@@ -14,8 +14,11 @@ numba's on-disk cache) and reused by every task it runs.
 from __future__ import annotations
 
 import contextlib
+import itertools
 import math
 import os
+import signal
+import threading
 import time
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
@@ -29,8 +32,12 @@ from drill_sim_ros.model.errors import DrillSimError
 from drill_sim_ros.study import store
 from drill_sim_ros.study.grid import MapSpec
 from drill_sim_ros.study.point import N_VARS, evaluate_point
+from drill_sim_ros.study.scheduler_probe import check_scheduler
 
 TASKS_PER_WORKER = 8      # enough tasks for balance and a live progress bar
+TASKS_IN_FLIGHT = 4       # tasks queued per worker at a time
+CONNECT_TIMEOUT_S = 30.0
+POLL_S = 0.02             # how often the loop looks for a finished task (and for Ctrl-C)
 MAX_BATCH = 64
 LOOPBACK = "127.0.0.1"
 
@@ -44,6 +51,7 @@ class BatchResult:
     pid: int
     cold: bool                # the kernel was not loaded in this process before the task
     seconds: float
+    error: str | None = None  # why the point after the last of ``indices`` failed
 
 
 @dataclass(frozen=True)
@@ -64,7 +72,13 @@ def evaluate_batch(spec: MapSpec, indices: np.ndarray) -> BatchResult:
     t0 = time.perf_counter()
     values = np.empty((len(indices), N_VARS))
     for row, flat in enumerate(indices):
-        values[row] = evaluate_spec_point(spec, int(flat))
+        try:
+            values[row] = evaluate_spec_point(spec, int(flat))
+        except Exception as exc:  # (returned, not raised: one line on the client, no log)
+            why = str(exc) if isinstance(exc, DrillSimError) else \
+                f"{type(exc).__name__}: {' '.join(str(exc).split())[:300]}"
+            return BatchResult(np.asarray(indices[:row]), values[:row], os.getpid(), cold,
+                               time.perf_counter() - t0, f"map point {int(flat)}: {why}")
     return BatchResult(np.asarray(indices), values, os.getpid(), cold,
                        time.perf_counter() - t0)
 
@@ -92,13 +106,16 @@ def batch_size(n_points: int, n_workers: int) -> int:
 
 @contextlib.contextmanager
 def connect(scheduler: str | None = None, workers: int | None = None) -> Iterator[object]:
-    """A distributed Client: to ``scheduler`` if given, else to a LocalCluster of
-    ``workers`` single-threaded processes (default: one per core), all bound to 127.0.0.1
-    (the HTTP endpoints on ephemeral loopback ports)."""
+    """A distributed Client: to ``scheduler`` if given (checked first by
+    :func:`~drill_sim_ros.study.scheduler_probe.check_scheduler`, so a wrong address or a
+    silent server is one line within its timeout), else to a LocalCluster of ``workers``
+    single-threaded processes (default: one per core), all bound to 127.0.0.1 (the HTTP
+    endpoints on ephemeral loopback ports)."""
     from distributed import Client, LocalCluster
     if scheduler:
+        address = check_scheduler(scheduler)
         try:
-            client = Client(scheduler, timeout=30)
+            client = Client(address, timeout=CONNECT_TIMEOUT_S)
         except (OSError, TimeoutError) as exc:
             raise DrillSimError(f"--scheduler {scheduler}: cannot connect ({exc})") from exc
         with client:
@@ -107,18 +124,45 @@ def connect(scheduler: str | None = None, workers: int | None = None) -> Iterato
     n = workers or os.cpu_count() or 1
     if not 1 <= n <= 1024:
         raise DrillSimError(f"--workers = {n} must be in [1, 1024]")
-    with LocalCluster(n_workers=n, threads_per_worker=1, processes=True, host=LOOPBACK,
-                      dashboard_address=f"{LOOPBACK}:0",
-                      worker_dashboard_address=f"{LOOPBACK}:0",
-                      silence_logs=40) as cluster, Client(cluster) as client:
+    with _deferred_interrupt() as interrupted:      # a half-started cluster cannot close
+        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                               host=LOOPBACK, dashboard_address=f"{LOOPBACK}:0",
+                               worker_dashboard_address=f"{LOOPBACK}:0", silence_logs=40)
+    with cluster, Client(cluster) as client:
+        if interrupted:
+            raise KeyboardInterrupt
         yield client
+
+
+@contextlib.contextmanager
+def _deferred_interrupt() -> Iterator[list[int]]:
+    """Hold Ctrl-C (SIGINT) back while the block runs; the list is non-empty after it if
+    one came. Outside the main thread, a plain block."""
+    if threading.current_thread() is not threading.main_thread():
+        yield []
+        return
+    received: list[int] = []
+    previous = signal.signal(signal.SIGINT, lambda signum, _frame: received.append(signum))
+    try:
+        yield received
+    finally:
+        signal.signal(signal.SIGINT, previous)
 
 
 def run_map(spec: MapSpec, out: Path, client: object,
             progress: Callable[[int, int, float], None] | None = None,
-            checkpoint_s: float = 10.0, batch: int | None = None) -> MapRun:
-    """Compute the points of ``spec`` not yet in ``out`` on ``client``; save to ``out``."""
+            checkpoint_s: float = 10.0, batch: int | None = None,
+            log: Callable[[str], None] | None = None) -> MapRun:
+    """Compute the points of ``spec`` not yet in ``out`` on ``client``; save to ``out``.
+
+    At most TASKS_IN_FLIGHT tasks per worker are queued at a time (the scheduler's memory
+    stays bounded whatever the map's size). ``log`` gets one line with the map's size
+    before the work and one with the rate measured over the first tasks and the time left;
+    ``progress`` gets (points done, total, seconds) from the start, so its rate is the real
+    one. A file that did not exist is only written once a point is computed.
+    """
     from distributed import as_completed
+    existed = out.exists()
     ds = store.open_map(spec, out)
     todo = store.pending(ds)
     total, done0 = spec.size, spec.size - todo.size
@@ -127,27 +171,89 @@ def run_map(spec: MapSpec, out: Path, client: object,
         store.save(ds, out)
         return MapRun(ds, 0, total, 0.0, False, ())
     n_workers = max(1, len(client.scheduler_info(n_workers=-1)["workers"]))
-    client.run(warm_up)
     size = batch or batch_size(todo.size, n_workers)
-    futures = [client.submit(evaluate_batch, spec, todo[i:i + size], pure=False)
-               for i in range(0, todo.size, size)]
-    results: list[BatchResult] = []
-    computed, last_save, interrupted = 0, time.monotonic(), False
-    try:
-        for future in as_completed(futures):
-            res: BatchResult = future.result()
-            store.store_results(ds, res.indices, res.values)
-            results.append(res)
-            computed += len(res.indices)
-            if progress:
-                progress(done0 + computed, total, time.perf_counter() - start)
-            if time.monotonic() - last_save > checkpoint_s:
+    _say(log, f"drill_sim map: {total:,} points ({' x '.join(map(str, spec.shape))}), "
+              f"{todo.size:,} to compute in tasks of {size} on {n_workers} workers")
+    # Ctrl-C ends the loop between results (a KeyboardInterrupt raised inside distributed's
+    # calls makes it log tracebacks); the rate is measured from the kernel loaded
+    with _deferred_interrupt() as sigint:
+        client.run(warm_up)
+        start = time.perf_counter()
+        if progress:
+            progress(done0, total, 0.0)
+        chunks = (todo[i:i + size] for i in range(0, todo.size, size))
+        queue = as_completed()
+        futures = []
+
+        def submit(count: int) -> None:
+            for chunk in itertools.islice(chunks, count):
+                futures.append(client.submit(evaluate_batch, spec, chunk, pure=False))
+                queue.add(futures[-1])
+
+        submit(TASKS_IN_FLIGHT * n_workers)
+        results: list[BatchResult] = []
+        computed, last_save, interrupted = 0, time.monotonic(), False
+        try:
+            while not queue.is_empty() and not sigint:
+                if not queue.has_ready():
+                    time.sleep(POLL_S)
+                    continue
+                res: BatchResult = _result(next(queue))
+                submit(1)
+                store.store_results(ds, res.indices, res.values)
+                results.append(res)
+                computed += len(res.indices)
+                if res.error is not None:
+                    raise DrillSimError(res.error)
+                elapsed = time.perf_counter() - start
+                if progress:
+                    progress(done0 + computed, total, elapsed)
+                if len(results) == min(n_workers, math.ceil(todo.size / size)):
+                    _say(log, estimate_line(computed, todo.size, elapsed))
+                if time.monotonic() - last_save > checkpoint_s:
+                    store.save(ds, out)
+                    last_save = time.monotonic()
+            interrupted = bool(sigint)
+        except KeyboardInterrupt:
+            interrupted = True
+        finally:
+            client.cancel(futures)
+            if computed or existed:
                 store.save(ds, out)
-                last_save = time.monotonic()
-    except KeyboardInterrupt:
-        interrupted = True
-        client.cancel(futures)
-    finally:
-        store.save(ds, out)
     return MapRun(ds, computed, total, time.perf_counter() - start, interrupted,
                   tuple(results))
+
+
+def estimate_line(computed: int, todo: int, elapsed_s: float) -> str:
+    """The rate measured over the first points and the time the rest will take."""
+    rate = computed / elapsed_s if elapsed_s > 0 else math.inf
+    left_s = (todo - computed) / rate if rate > 0 else math.inf
+    return (f"drill_sim map: the first {computed:,} points took {elapsed_s:.1f} s "
+            f"({rate:.3g} points/s): about {_duration(left_s)} for the other "
+            f"{todo - computed:,} (Ctrl-C keeps the points done; the same command resumes)")
+
+
+def _duration(seconds: float) -> str:
+    if not math.isfinite(seconds):
+        return "an unknown time"
+    for unit, size in (("days", 86400.0), ("h", 3600.0), ("min", 60.0)):
+        if seconds >= 2 * size:
+            return f"{seconds / size:.1f} {unit}"
+    return f"{seconds:.0f} s"
+
+
+def _say(log: Callable[[str], None] | None, line: str) -> None:
+    if log is not None:
+        log(line)
+
+
+def _result(future: object) -> BatchResult:
+    """A task's result; a failure on a worker is one DrillSimError line."""
+    try:
+        return future.result()
+    except DrillSimError:
+        raise
+    except Exception as exc:  # (a worker's failure: any type reaches here)
+        text = " ".join(str(exc).split())[:300]
+        raise DrillSimError(f"a map task failed on a worker: {type(exc).__name__}: "
+                            f"{text}") from None

@@ -9,6 +9,7 @@ force unit, eqs. 19-20). Points are numbered in C order over the axes.
 
 from __future__ import annotations
 
+import itertools
 import json
 import math
 from dataclasses import asdict, dataclass, field
@@ -29,7 +30,7 @@ AXIS_LABELS = {"n": "n (blades)", "psi": "ψ", "beta": "β", "lam": "λ", "w0": 
 # Axes that set W0 or omega0; at most one of each pair in a map.
 _W_AXES = ("w0", "w0_ratio", "wob_n")
 _OMEGA_AXES = ("omega0", "surface_rpm")
-MAX_POINTS = 10_000_000
+MAX_POINTS = 1_000_000      # the Dataset holds every point in memory (~100 MB)
 
 
 @dataclass(frozen=True)
@@ -96,7 +97,8 @@ class MapSpec:
         if self.control is not None:
             validate_control(self)
         if self.size > MAX_POINTS:
-            raise ParameterError(f"the map has {self.size} points; at most {MAX_POINTS}")
+            raise ParameterError(f"the map has {self.size:,} points; at most {MAX_POINTS:,}")
+        validate_corners(self)
 
     @property
     def shape(self) -> tuple[int, ...]:
@@ -143,6 +145,21 @@ def validate_axes(axes: tuple[Axis, ...], physical: bool) -> None:
                                  "vary only one of them")
     if len(set(names)) != len(names):
         raise ParameterError(f"--vary names a quantity twice: {names}")
+
+
+def validate_corners(spec: MapSpec) -> None:
+    """Every corner of the grid (each axis at its smallest and largest value) is a valid
+    point of the model, so every point is: the groups' ranges are intervals and each group
+    is monotonic in the axes that set it. Checked here, on the client, before any work."""
+    ends = [sorted({int(np.argmin(a.values)), int(np.argmax(a.values))}) for a in spec.axes]
+    for corner in itertools.product(*ends):
+        try:
+            spec.point(int(np.ravel_multi_index(corner, spec.shape)))
+        except ParameterError as exc:
+            where = ", ".join(f"{a.name}={a.values[i]:g}" for a, i in zip(spec.axes, corner,
+                                                                         strict=True))
+            raise ParameterError(f"--vary: the point {where} is outside the model's range: "
+                                 f"{exc}") from None
 
 
 def validate_control(spec: MapSpec) -> None:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import sys
 import time
 
 from drill_sim_ros.terminal import StatusLine
@@ -25,6 +26,11 @@ class MapProgress:
         frac = done / total if total else 1.0
         self.line.show(f"[{'#' * int(30 * frac):<30}] {done:,}/{total:,} points  "
                        f"{rate:6.2f} points/s  eta {eta:6.0f} s")
+
+    def say(self, text: str) -> None:
+        """One line on stderr (the map's size, its estimate), kept above the live line."""
+        self.line.close()
+        print(text, file=sys.stderr, flush=True)
 
     def close(self) -> None:
         self.line.close()

@@ -10,9 +10,12 @@ write never leaves a broken map.
 
 from __future__ import annotations
 
+import contextlib
+import fcntl
 import hashlib
 import json
 import os
+from collections.abc import Iterator
 from datetime import UTC, datetime
 from pathlib import Path
 
@@ -113,6 +116,39 @@ def open_map(spec: MapSpec, path: Path) -> xr.Dataset:
         raise DrillSimError(f"--out {path} was computed by another version of the model "
                             "code; choose another --out or delete the file")
     return ds
+
+
+def lock_path(path: Path) -> Path:
+    return path.with_name(f".{path.name}.lock")
+
+
+@contextlib.contextmanager
+def map_lock(path: Path) -> Iterator[None]:
+    """Hold ``path`` for one map run: a second run on it (same spec or not) is refused
+    with one DrillSimError line, at its start. An advisory ``flock`` on a file beside the
+    map, released by the kernel when the process ends however it ends."""
+    lock = lock_path(path)
+    try:
+        lock.parent.mkdir(parents=True, exist_ok=True)
+        stream = open(lock, "a+")  # noqa: SIM115 (held for the run, closed below)
+    except OSError as exc:
+        raise DrillSimError(f"--out {path}: cannot create {lock} ({exc.strerror or exc})"
+                            ) from None
+    try:
+        try:
+            fcntl.flock(stream, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            stream.seek(0)
+            owner = stream.read().strip() or "another process"
+            raise DrillSimError(f"--out {path} is in use by another drill_sim map ({owner}); "
+                                "wait for it to end or choose another --out") from None
+        stream.seek(0)
+        stream.truncate()
+        stream.write(f"pid {os.getpid()}")
+        stream.flush()
+        yield
+    finally:
+        stream.close()
 
 
 def save(ds: xr.Dataset, path: Path) -> None:

@@ -26,8 +26,8 @@ def test_interrupted_map_resumes_without_recomputing(tmp_path: Path) -> None:
     seen = []
 
     def stop_after_two(done: int, total: int, _s: float) -> None:
-        seen.append(done)
-        if len(seen) == 2:
+        seen.append(done)                          # the first call is the start (0 done)
+        if len(seen) == 3:
             raise KeyboardInterrupt                # what Ctrl-C raises in the loop
 
     with engine.connect(workers=1) as client:

@@ -1,0 +1,152 @@
+"""Checks of a preset file's raw YAML mapping, before it is turned into a preset.
+
+A preset names every value it sets: an unknown key (a misspelling is the common case) is an
+error naming it and the known ones, a physical or dimensionless section must give every
+quantity (no silent default), and every value has its type: a number is a YAML number (not
+``abc``, not ``true``), an integer is a whole number (``n_blades: 6.5`` is refused, not
+truncated). Each error is one :class:`ParameterError` line naming the key, the value and
+what is allowed; :func:`load_checked_preset` adds the file.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import fields
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from drill_sim_ros.model.errors import ParameterError
+from drill_sim_ros.model.params import DimensionlessParams, PhysicalParams
+from drill_sim_ros.model.top_drive import MODES, TopDrive, TopDrivePhysical
+
+PRESET_SECTIONS = ("description", "physical", "dimensionless", "numerics", "top_drive",
+                   "string")      # 'string' is checked by model.presets (string_from_dict)
+# the lumped string's geometry: given by ``string.sections`` when the preset has them
+GEOMETRY_KEYS = ("pipe_outer_radius_m", "pipe_inner_radius_m", "pipe_length_m",
+                 "bha_outer_radius_m", "bha_inner_radius_m", "bha_length_m")
+INTEGER_KEYS = frozenset({"n", "n_blades", "n_nodes"})
+STRING_KEYS = frozenset({"mode"})
+NUMERICS_KEYS = ("dtau", "n_nodes")
+DTAU_RANGE = (1e-7, 0.1)
+N_NODES_RANGE = (16, 1_000_000)
+
+
+def _names(cls: type) -> tuple[str, ...]:
+    return tuple(f.name for f in fields(cls))
+
+
+def as_number(value: Any) -> float | int | None:
+    """``value`` as a number; YAML 1.1 reads ``79.3e9`` (no dot, no exponent sign) as a
+    string, so a string that is a number counts as one (``abc`` does not)."""
+    if isinstance(value, bool):
+        return None
+    if isinstance(value, (int, float)):
+        return value
+    if isinstance(value, str):
+        try:
+            return float(value)
+        except ValueError:
+            return None
+    return None
+
+
+def check_value(where: str, key: str, value: Any) -> None:
+    """``value`` of ``where.key`` has its key's type: an integer, a string or a number."""
+    if key in STRING_KEYS:
+        if not isinstance(value, str):
+            raise ParameterError(f"'{where}.{key}' = {value!r} must be a string")
+        return
+    number = as_number(value)
+    if number is None:
+        raise ParameterError(f"'{where}.{key}' = {value!r} must be a number")
+    if key in INTEGER_KEYS and not float(number).is_integer():
+        raise ParameterError(f"'{where}.{key}' = {value!r} must be a whole number")
+    if not math.isfinite(number) and not (key.startswith("max_torque") and number > 0):
+        raise ParameterError(f"'{where}.{key}' = {value!r} must be finite")
+
+
+def check_known_keys(values: dict[Any, Any], known: tuple[str, ...], where: str = "") -> None:
+    """ParameterError naming the keys of ``values`` that are not ``known`` (and the known)."""
+    unknown = sorted(str(k) for k in set(values) - set(known))
+    if unknown:
+        place = f" in '{where}'" if where else ""
+        raise ParameterError(f"unknown key(s) {', '.join(unknown)}{place}; known: "
+                             f"{', '.join(known)}")
+
+
+def check_section(where: str, values: Any, known: tuple[str, ...], required: bool,
+                  optional: tuple[str, ...] = ()) -> None:
+    """A mapping of ``known`` keys only (all of them but ``optional`` if ``required``), each
+    of its type."""
+    if not isinstance(values, dict):
+        raise ParameterError(f"'{where}' must be a mapping of {', '.join(known)}; "
+                             f"got {values!r}")
+    check_known_keys(values, known, where)
+    missing = [k for k in known if k not in values and k not in optional]
+    if required and missing:
+        raise ParameterError(f"'{where}' is missing {', '.join(missing)} (a preset gives "
+                             "every quantity; there is no silent default)")
+    for key, value in values.items():
+        check_value(where, key, value)
+
+
+def check_numerics(values: Any) -> None:
+    """``numerics``: dtau in DTAU_RANGE, n_nodes a whole number in N_NODES_RANGE."""
+    check_section("numerics", values, NUMERICS_KEYS, required=False)
+    for key, (low, high) in (("dtau", DTAU_RANGE), ("n_nodes", N_NODES_RANGE)):
+        if key in values and not low <= as_number(values[key]) <= high:
+            raise ParameterError(f"'numerics.{key}' = {values[key]!r} is outside the allowed "
+                                 f"range [{low:g}, {high:g}]")
+
+
+def check_preset_mapping(data: Any) -> None:
+    """The raw mapping of a preset file (see the module doc); ParameterError if not."""
+    if not isinstance(data, dict):
+        raise ParameterError(f"a preset file holds a mapping of {', '.join(PRESET_SECTIONS)}; "
+                             f"got {data!r}")
+    check_known_keys(data, PRESET_SECTIONS)
+    physical = "physical" in data
+    if physical == ("dimensionless" in data):
+        raise ParameterError("a preset needs exactly one of 'physical' or 'dimensionless'")
+    if physical:
+        sections = isinstance(data.get("string"), dict) and "sections" in data["string"]
+        check_section("physical", data["physical"], _names(PhysicalParams), required=True,
+                      optional=GEOMETRY_KEYS if sections else ())
+    else:
+        check_section("dimensionless", data["dimensionless"], _names(DimensionlessParams),
+                      required=True)
+    if data.get("numerics") is not None:
+        check_numerics(data["numerics"])
+    if data.get("top_drive") is not None:
+        drive = data["top_drive"]
+        check_section("top_drive", drive, _names(TopDrivePhysical if physical else TopDrive),
+                      required=False)
+        if drive.get("mode", MODES[0]) not in MODES:
+            raise ParameterError(f"'top_drive.mode' = {drive['mode']!r} is not one of "
+                                 f"{', '.join(MODES)}")
+
+
+def check_preset_file(path: Path) -> None:
+    """Read ``path`` and check its mapping; the error names the file."""
+    try:
+        data = yaml.safe_load(path.read_text())
+    except OSError as exc:
+        raise ParameterError(f"preset file {path}: {exc.strerror or exc}") from None
+    except yaml.YAMLError as exc:
+        raise ParameterError(f"preset file {path} is not valid YAML: "
+                             f"{' '.join(str(exc).split())}") from None
+    try:
+        check_preset_mapping(data)
+    except ParameterError as exc:
+        raise ParameterError(f"preset file {path}: {exc}") from None
+
+
+def load_checked_preset(name_or_path: Any) -> Any:
+    """:func:`~drill_sim_ros.model.presets.load_preset` after :func:`check_preset_file`."""
+    from drill_sim_ros.model.presets import load_preset, preset_path
+    if not isinstance(name_or_path, str) or not name_or_path:
+        raise ParameterError(f"preset = {name_or_path!r} must be a preset name or a YAML path")
+    check_preset_file(preset_path(name_or_path))
+    return load_preset(name_or_path)
