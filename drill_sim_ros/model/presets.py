@@ -41,6 +41,7 @@ from drill_sim_ros.model.string import (
     kernel_string,
 )
 from drill_sim_ros.model.top_drive import TopDrive, top_drive_from_dict
+from drill_sim_ros.model.validate_input import check_preset_mapping
 
 DEFAULT_PRESET = "field_8p5in_shale"
 GRAVITY_M_S2 = 9.80665
@@ -123,6 +124,7 @@ def preset_from_dict(name: str, data: dict[str, Any]) -> Preset:
     """Build a :class:`Preset` from a parsed preset mapping."""
     if not isinstance(data, dict):
         raise ParameterError(f"preset '{name}' must be a mapping")
+    check_preset_mapping(data)                # unknown, missing and mistyped keys, one line
     numerics = data.get("numerics") or {}
     has_phys, has_dimless = "physical" in data, "dimensionless" in data
     if has_phys == has_dimless:

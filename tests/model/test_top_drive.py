@@ -199,14 +199,15 @@ def test_si_commands_and_readings_use_the_scales_of_the_field_preset() -> None:
 
 
 def test_preset_top_drive_sections_are_validated_and_scaled() -> None:
-    dimless = {"dimensionless": {"w0": 7.0}, "top_drive": {"mode": "speed", "kp": 50.0}}
+    groups = {"n": 6, "beta": 0.3, "lam": 5.0, "psi": 50.0, "w0": 7.0, "omega0": 5.0}
+    dimless = {"dimensionless": groups, "top_drive": {"mode": "speed", "kp": 50.0}}
     drive = preset_from_dict("x", dimless).top_drive
     assert (drive.mode, drive.kp) == ("speed", 50.0)
-    assert preset_from_dict("x", {"dimensionless": {}}).top_drive.mode == "kinematic"
+    assert preset_from_dict("x", {"dimensionless": groups}).top_drive.mode == "kinematic"
     with pytest.raises(ParameterError, match="inertia_kg_m2"):   # SI key in scaled units
-        preset_from_dict("x", {"dimensionless": {}, "top_drive": {"inertia_kg_m2": 1.0}})
+        preset_from_dict("x", {"dimensionless": groups, "top_drive": {"inertia_kg_m2": 1.0}})
     with pytest.raises(ParameterError, match=r"top_drive\.mode"):
-        preset_from_dict("x", {"dimensionless": {}, "top_drive": {"mode": "position"}})
+        preset_from_dict("x", {"dimensionless": groups, "top_drive": {"mode": "position"}})
     with pytest.raises(ParameterError, match=r"top_drive\.max_torque"):
         TopDrive(max_torque=0.0)
 
