@@ -276,10 +276,9 @@ def advance(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarra
     (:func:`_surface`); ``wave*`` None: lumped; a row of ``out`` when step % every == 0;
     stops after the step that reaches ``prm[P_LAYER_U]``. Returns (status, rows)."""
     u, v, phi, omega, phi_s, omega_s, w_app, stuck, node, frac, h_old, step, omega_ref, \
-        integral, motor, v_hook, hook_int = _unpack(st)
+        integral, motor, v_hook, hook_int, head, count, cursor = _unpack(st, meta)
     dt, tau_avg, beta, lam, n_blades, psi, off_bottom, layer_u, cut_factor, sector, tgt_w, \
         w_rate = _law_params(prm, tgt)
-    head, count, cursor = meta[0], meta[1], meta[2]
     td_mode, tgt_omega, tgt_torque, omega_rate, td_j, td_kp, td_ki, td_max, td_lag, _ = \
         _drive_params(prm, tgt)
     stats, countdown, n_rows, status, probe = _stats(acc), _first_countdown(step, every), 0, \
@@ -396,12 +395,12 @@ def _drive_params(prm: np.ndarray, tgt: np.ndarray) -> tuple:
 
 
 @njit(cache=True, inline="always")
-def _unpack(st: np.ndarray) -> tuple:
-    """The state vector as the loop's locals."""
+def _unpack(st: np.ndarray, meta: np.ndarray) -> tuple:
+    """The state vector and the history's bookkeeping as the loop's locals."""
     return (st[S_U], st[S_V], st[S_PHI], st[S_OMEGA], st[S_PHI_S], st[S_OMEGA_S],
             st[S_W_APP], st[S_STUCK] != 0.0, int(st[S_NODE]), st[S_FRAC], st[S_H_OLD],
             int(st[S_STEP]), st[S_OMEGA_REF], st[S_TD_INTEGRAL], st[S_MOTOR_TORQUE],
-            st[S_V_HOOK], st[S_HOOK_INTEGRAL])
+            st[S_V_HOOK], st[S_HOOK_INTEGRAL], meta[0], meta[1], meta[2])
 
 
 @njit(cache=True, inline="always")

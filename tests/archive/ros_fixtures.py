@@ -42,10 +42,11 @@ def ros_node(name: str) -> Iterator[Node]:
 
 
 def step_sim(node: Node, count: int) -> None:
-    """Call sim_node's ~/step ``count`` times, each answered within 10 s."""
+    """Call sim_node's ~/step ``count`` times, each answered within 30 s (a first call may
+    wait for the kernel's compilation on a loaded machine with a cold numba cache)."""
     client = node.create_client(Trigger, f"/{topics.NODE_NAME}/step")
     assert client.wait_for_service(timeout_sec=30), "sim_node's ~/step never appeared"
     for _ in range(count):
         future = client.call_async(Trigger.Request())
-        assert wait_for(future.done, 10), "~/step did not answer"
+        assert wait_for(future.done, 30), "~/step did not answer"
         assert future.result().success, future.result().message
