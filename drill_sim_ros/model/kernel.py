@@ -254,6 +254,21 @@ def _cutting(cut_factor: float, off_bottom: bool, doc: float) -> float:
 
 
 @njit(cache=True, inline="always")
+def _book(stats: tuple, out: np.ndarray, n_rows: int, countdown: int, every: int, tau: float,
+          tau_avg: float, x: tuple) -> tuple:
+    """The step's statistics, and its sample row when one is due (``x``: the columns of
+    :func:`_write_row` after tau). Returns (stats, rows written, countdown)."""
+    u, v, phi, omega, phi_s, omega_s, w_app, wob, tob, doc, w_f, t_top, mode, motor, \
+        omega_ref, f_top, omega_bha = x
+    stats = _accumulate(stats, tau, tau_avg, mode, w_f, tob, doc, wob, omega, t_top, v)
+    if countdown == 0 and n_rows < out.shape[0]:
+        _write_row(out[n_rows], tau, u, v, phi, omega, phi_s, omega_s, w_app, wob, tob, doc,
+                   w_f, t_top, mode, motor, omega_ref, f_top, omega_bha)
+        n_rows += 1
+    return stats, n_rows, every - 1 if countdown == 0 else countdown - 1
+
+
+@njit(cache=True, inline="always")
 def _write_row(r: np.ndarray, tau: float, u: float, v: float, phi: float, omega: float,
                phi_s: float, omega_s: float, w_app: float, wob: float, tob: float,
                doc: float, w_f: float, t_top: float, mode: int, motor: float,
@@ -272,20 +287,21 @@ def advance(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarra
             hist: np.ndarray, meta: np.ndarray, acc: np.ndarray, out: np.ndarray,
             wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray,
             n_steps: int, every: int, exact: bool) -> tuple[int, int]:
-    """Up to ``n_steps`` of bit law, drive and string; delay from ``profile`` or ``hist``
-    (:func:`_surface`); ``wave*`` None: lumped; a row of ``out`` when step % every == 0;
-    stops after the step that reaches ``prm[P_LAYER_U]``. Returns (status, rows)."""
+    """Up to ``n_steps`` of bit law, drive and string (module doc). Returns (status, rows)."""
     u, v, phi, omega, phi_s, omega_s, w_app, stuck, node, frac, h_old, step, omega_ref, \
         integral, motor, v_hook, hook_int, head, count, cursor = _unpack(st, meta)
     dt, tau_avg, beta, lam, n_blades, psi, off_bottom, layer_u, cut_factor, sector, tgt_w, \
         w_rate = _law_params(prm, tgt)
     td_mode, tgt_omega, tgt_torque, omega_rate, td_j, td_kp, td_ki, td_max, td_lag, _ = \
         _drive_params(prm, tgt)
+    inv_spacing, bha = profile.shape[0] / sector, int(prm[P_BHA_PART])
     stats, countdown, n_rows, status, probe = _stats(acc), _first_countdown(step, every), 0, \
         STATUS_OK, 0.0                       # (a NaN probe survives the contact logic)
     for _ in range(n_steps):
-        surface, cursor = _surface(exact, hist, profile, head, count, cursor, node, frac,
-                                   h_old, phi - sector)
+        if exact:                     # the delay: U(tau - tau_n), eqs. 6-7, 26-28
+            surface, cursor = br.delayed_depth(hist[0], hist[1], head, count, cursor, phi - sector)
+        else:
+            surface = br.profile_surface(profile, node, frac, h_old)
         doc = n_blades * (u - surface)          # delta = n (U - U(tau - tau_n)), eq. 8
         if wave is None:                      # the lumped string (compiled apart)
             v0, kick_v, f_ext, omega0, kick_w, t_ext, t_top, f_top = _lumped_ends(
@@ -300,14 +316,10 @@ def advance(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarra
             td_mode, omega_s, omega_ref, integral, motor, t_top, tgt_omega, tgt_torque,
             omega_rate, td_j, td_kp, td_ki, td_max, td_lag, dt)
         probe += w_f + tob + motor
-        stats = _accumulate(stats, step * dt, tau_avg, mode, w_f, tob, doc, wob, omega, t_top, v)
-        if countdown == 0 and n_rows < out.shape[0]:
-            omega_bha = omega if wave is None else \
-                sg.speed_at_top_of(wave, wave_i, wave_f, int(prm[P_BHA_PART]))
-            _write_row(out[n_rows], step * dt, u, v, phi, omega, phi_s, omega_s, w_app, wob, tob,
-                       doc, w_f, t_top, mode, motor, omega_ref, f_top, omega_bha)
-            n_rows += 1
-        countdown = every - 1 if countdown == 0 else countdown - 1
+        stats, n_rows, countdown = _book(stats, out, n_rows, countdown, every, step * dt, tau_avg,(
+            u, v, phi, omega, phi_s, omega_s, w_app, wob, tob, doc, w_f, t_top, mode, motor,
+            omega_ref, f_top, omega if wave is None else sg.speed_at_top_of(wave, wave_i,
+                                                                            wave_f, bha)))
         if wave is None:    # kinematic: the angle moves at the step's starting speed
             phi_s += (omega_s if td_mode == TD_KINEMATIC else omega_s_next) * dt
         else:
@@ -316,9 +328,12 @@ def advance(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarra
             phi_s += omega_s_next * dt
         omega_s = omega_s_next
         u_new, phi_new = u + v_new * dt, phi + omega_new * dt     # symplectic Euler, eq. C.1
-        head, count, cursor, node, frac, h_old, ok = _remember(
-            exact, hist, profile, head, count, cursor, node, frac, h_old, u, u_new, phi,
-            phi_new, profile.shape[0] / sector)
+        if exact:
+            head, count, cursor, ok = br.history_store(hist, head, count, cursor, phi,
+                                                       phi_new, u_new)
+        else:
+            node, frac, h_old, ok = br.profile_recut(profile, node, frac, h_old, u, u_new,
+                                                     (phi_new - phi) * inv_spacing)
         u, v, phi, omega = u_new, v_new, phi_new, omega_new
         w_app = ramp(w_app, tgt_w, w_rate, dt)
         step += 1
@@ -345,32 +360,6 @@ def _stats(acc: np.ndarray) -> tuple:
     """The statistics as a tuple of locals (``A_*`` order)."""
     return (acc[0], acc[1], acc[2], acc[3], acc[4], acc[5], acc[6], acc[7], acc[8], acc[9],
             acc[10], acc[11], acc[12])
-
-
-@njit(cache=True, inline="always")
-def _surface(exact: bool, hist: np.ndarray, profile: np.ndarray, head: int, count: int,
-             cursor: int, node: int, frac: float, h_old: float,
-             phi_target: float) -> tuple[float, int]:
-    """The rock height the bit cuts down to now, U(tau - tau_n) (eqs. 6-7, 26-28): from the
-    bottom-hole profile, or from the exact history at the angle one sector back."""
-    if exact:
-        return br.delayed_depth(hist[0], hist[1], head, count, cursor, phi_target)
-    return br.profile_surface(profile, node, frac, h_old), cursor
-
-
-@njit(cache=True, inline="always")
-def _remember(exact: bool, hist: np.ndarray, profile: np.ndarray, head: int, count: int,
-              cursor: int, node: int, frac: float, h_old: float, u: float, u_new: float,
-              phi: float, phi_new: float, inv_spacing: float) -> tuple:
-    """The delay's memory after the bit moved: the history stores (PHI, U), or the profile
-    nodes passed are re-cut. Returns (head, count, cursor, node, frac, h_old, ok)."""
-    if exact:
-        head, count, cursor, ok = br.history_store(hist, head, count, cursor, phi, phi_new,
-                                                   u_new)
-        return head, count, cursor, node, frac, h_old, ok
-    node, frac, h_old, ok = br.profile_recut(profile, node, frac, h_old, u, u_new,
-                                             (phi_new - phi) * inv_spacing)
-    return head, count, cursor, node, frac, h_old, ok
 
 
 @njit(cache=True, inline="always")
