@@ -150,6 +150,8 @@ class Simulator:
         self._prm[k.P_TAU_AVG] = c.tau_avg
         d = self.top_drive
         self._prm[k.P_TD_MODE] = td.mode_index(d.mode)
+        if d.mode == "speed":
+            td.check_speed_loop(d, c.dtau, self.scales)
         self._prm[k.P_TD_INERTIA] = d.inertia_ratio
         self._prm[k.P_TD_KP] = d.kp
         self._prm[k.P_TD_KI] = d.ki
@@ -301,6 +303,8 @@ class Simulator:
         inside ``kernel.advance`` (which holds the state in locals and writes them back);
         the commands are single stores into the targets, read when a run starts."""
         index = td.mode_index(mode)
+        if index == td.TD_SPEED:
+            td.check_speed_loop(self.top_drive, self.config.dtau, self.scales)
         if index == int(self._prm[k.P_TD_MODE]):
             return                             # no switch: the loop and the command stay
         st, limit = self._state, self._prm[k.P_TD_MAX_TORQUE]

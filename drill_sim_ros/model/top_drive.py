@@ -203,6 +203,24 @@ class TopDrivePhysical:
                         motor_lag=self.motor_lag_s / t_star)
 
 
+def check_speed_loop(drive: TopDrive, dtau: float, scales: Scales) -> None:
+    """The speed loop as stepped (explicit, on the drive's inertia) is stable: with
+    a = kp dtau / j and b = ki dtau^2 / j, the closed loop's poles lie inside the unit circle
+    when a < 2 and 2 a + b < 4 (Jury's test on z^2 - (2 - a - b) z + (1 - a)); else one line
+    naming the gain, its value and the largest kp that holds at this step."""
+    a = drive.kp * dtau / drive.inertia_ratio
+    b = drive.ki * dtau**2 / drive.inertia_ratio
+    if a < 2.0 and 2.0 * a + b < 4.0:
+        return
+    si = drive.physical(scales)
+    kp_max = min(2.0, (4.0 - b) / 2.0) * drive.inertia_ratio / dtau * scales.torque_nm \
+        * scales.time_s
+    raise ParameterError(
+        f"top_drive.kp_nm_s = {si.kp_nm_s:.6g} (ki_nm = {si.ki_nm:.6g}) makes the drive's "
+        f"speed loop unstable at this time step: kp dt / J = {a:.3g} must be < 2 and "
+        f"2 kp dt / J + ki dt^2 / J = {2 * a + b:.3g} < 4; kp_nm_s < {kp_max:.6g} holds")
+
+
 def _from_dict(cls: type, values: dict[str, Any]) -> Any:
     known = {f.name for f in fields(cls)}
     unknown = sorted(set(values) - known)

@@ -1,0 +1,46 @@
+"""Numerical safety of the kernel: an unstable speed loop is refused with its bound, and a
+state that runs away ends as a fault (no loop in the kernel runs without bound)."""
+
+from __future__ import annotations
+
+import pytest
+
+from drill_sim_ros.model.errors import NumericalFault, ParameterError
+from drill_sim_ros.model.presets import load_preset
+from drill_sim_ros.model.simulator import SimConfig, Simulator
+from drill_sim_ros.model.top_drive import TopDrive
+from tests.study.helpers import drill_sim
+
+PRESET = load_preset("field_8p5in_shale_lumped")
+
+
+def test_a_speed_loop_unstable_at_the_step_is_refused_with_its_bound() -> None:
+    dtau = 1e-4
+    j = PRESET.top_drive.inertia_ratio
+    stable = PRESET.top_drive.with_(kp=1.9 * j / dtau, ki=0.0)   # a = 1.9 < 2
+    Simulator(PRESET.params, SimConfig(dtau=dtau), top_drive=stable, scales=PRESET.scales)
+    unstable = PRESET.top_drive.with_(kp=2.1 * j / dtau, ki=0.0)
+    with pytest.raises(ParameterError, match=r"kp dt / J = 2\.1 must be < 2"):
+        Simulator(PRESET.params, SimConfig(dtau=dtau), top_drive=unstable,
+                  scales=PRESET.scales)
+    sim = Simulator(PRESET.params, SimConfig(dtau=dtau), scales=PRESET.scales,
+                    top_drive=TopDrive(mode="torque", inertia_ratio=j, kp=2.1 * j / dtau))
+    with pytest.raises(ParameterError, match="unstable"):      # switching into speed mode
+        sim.set_top_drive_mode("speed")
+
+
+def test_a_run_away_state_ends_as_a_fault() -> None:
+    sim = Simulator(PRESET.params, SimConfig(dtau=1e-4), scales=PRESET.scales)
+    sim.set_inputs(omega_s=1e15)                       # kinematic top: the twist explodes
+    with pytest.raises(NumericalFault, match=r"runaway|non-finite"):
+        sim.advance(10_000)
+    assert sim.fault is not None
+
+
+def test_the_stiff_drive_of_the_issue_is_one_line() -> None:
+    result = drill_sim("run", "--params", "field_8p5in_shale_lumped", "--t-end", "1",
+                       "--drive-kp", "1e6", "--drive-max-torque", "inf", "--top-drive",
+                       "speed", timeout=120)
+    assert result.returncode == 2, result.stderr
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and "kp dt / J" in lines[0] and "Traceback" not in result.stderr
