@@ -34,7 +34,7 @@ from drill_sim_ros.model.telemetry import (
     stamped_si_rows,
     surface_truth,
 )
-from drill_sim_ros.model.top_drive import TopDrivePhysical
+from drill_sim_ros.model.top_drive import TopDrivePhysical, check_speed_loop
 
 WINDOW_BUCKETS = 20
 
@@ -325,6 +325,12 @@ class SimSession:
 
     def _set_wob(self, wob_n: float) -> None:
         self.sim.set_inputs(w_app=self.scales.w_from_newton(wob_n))
+
+    def check_top_drive(self, drive: TopDrivePhysical) -> None:
+        """ParameterError (one line, with the bound) when ``drive`` in speed mode would be
+        unstable at this session's step; nothing changes."""
+        if drive.mode == "speed":
+            check_speed_loop(drive.scaled(self.scales), self.dtau, self.scales)
 
     def set_top_drive(self, drive: TopDrivePhysical) -> None:
         """New drive gains, limit and mode (SI) from the next period, without a bump; the

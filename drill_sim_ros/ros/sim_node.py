@@ -106,6 +106,10 @@ def session_config(values: dict[str, Any], preset: Any) -> SessionConfig:
         string_rate_hz=values["string.rate_hz"], string_depths=values["string.depths"])
 
 
+DRIVE_PARAMETERS = {"top_drive.kp_nm_s", "top_drive.ki_nm", "top_drive.max_torque_nm",
+                    "top_drive.mode"}
+
+
 def top_drive(values: dict[str, Any]) -> TopDrivePhysical:
     """The drive of the ``top_drive.*`` parameters (a torque limit of 0: none)."""
     limit = values["top_drive.max_torque_nm"]
@@ -322,6 +326,14 @@ class SimNode(Node):
             reason = None if spec is None else validate(spec, param.value)
             if reason is not None:
                 return SetParametersResult(successful=False, reason=reason)
+        drive = {p.name for p in params} & DRIVE_PARAMETERS
+        if drive and self._session is not None:   # the new drive must be stable at the step
+            values = {**self._values, **{p.name: coerce(SPEC_BY_NAME[p.name], p.value)
+                                         for p in params if p.name in drive}}
+            try:
+                self._session.check_top_drive(top_drive(values))
+            except ParameterError as exc:
+                return SetParametersResult(successful=False, reason=str(exc))
         return SetParametersResult(successful=True)
 
     def _apply_parameters(self, params: list[Parameter]) -> None:
@@ -333,8 +345,7 @@ class SimNode(Node):
                 return
             self._session.submerged_weight_n = self._values["model.submerged_string_weight_n"]
             names = {p.name for p in params}
-            if names & {"top_drive.kp_nm_s", "top_drive.ki_nm", "top_drive.max_torque_nm",
-                        "top_drive.mode"}:
+            if names & DRIVE_PARAMETERS:
                 self._session.set_top_drive(top_drive(self._values))   # between runs: no bump
             if names & {"real_time_factor", "lockstep", "lockstep_trigger"}:
                 self._restart_ticks()

@@ -268,6 +268,8 @@ def test_bad_parameters_are_rejected_with_a_reason(ros):
     assert ok, reason
     ok, reason = set_parameter(ros, probe, "top_drive.mode", "speed")  # at runtime
     assert ok, reason
+    ok, reason = set_parameter(ros, probe, "top_drive.kp_nm_s", 1e12)  # in range, but the
+    assert not ok and "unstable" in reason and "kp_nm_s <" in reason   # loop is unstable
     request = GetParameters.Request(names=["real_time_factor", "publish_rate_hz"])
     values = ros.call(probe, GetParameters, f"{NODE}/get_parameters", request).values
     assert values[0].integer_value == 2 and values[1].double_value == 100.0
