@@ -17,6 +17,7 @@ lockstep_trigger:=command``), so both give the same telemetry bit for bit:
 
 from __future__ import annotations
 
+import json
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -101,14 +102,17 @@ def sim_node_parameters(scenario: Scenario, preset: Preset) -> dict[str, object]
     for key, name in DRIVE_PARAMETERS.items():
         if key in scenario.drive:
             out[name] = float(scenario.drive[key])
+    if scenario.formation:
+        out["formation.layers"] = json.dumps([dict(x) for x in scenario.formation])
     return out
 
 
-# scenario drive keys -> sim_node parameters (motor_lag_s: not yet a parameter)
+# scenario drive keys -> sim_node parameters
 DRIVE_PARAMETERS = {"accel_rpm_s": "limits.top_drive_accel_rpm_s",
                     "wob_rate_n_s": "limits.wob_rate_n_s",
                     "max_torque_nm": "top_drive.max_torque_nm",
-                    "command_delay_s": "commands.delay_s"}
+                    "command_delay_s": "commands.delay_s",
+                    "motor_lag_s": "top_drive.motor_lag_s"}
 
 
 def build_controller(scenario: Scenario, preset: Preset) -> IsolatedController:

@@ -337,6 +337,11 @@ class SimSession:
         inertia is fixed for a session."""
         self.sim.set_top_drive(drive.scaled(self.scales))
 
+    def check_formation(self, layers: list[dict]) -> None:
+        """ParameterError (one line naming the layer and key) if ``layers`` are not valid."""
+        if layers:
+            layers_from_dicts(layers, self.cfg.preset.rock)
+
     def set_formation(self, layers: list[dict]) -> None:
         """Rock layers by depth below the start (SI keys of model.formation.LAYER_KEYS), from
         the next period; ``[]``: the preset's rock throughout."""

@@ -53,7 +53,9 @@ def _ros_args(values: dict[str, object]) -> list[str]:
     out = []
     for name, value in values.items():
         text = ("true" if value else "false") if isinstance(value, bool) else \
-            repr(value) if isinstance(value, float) else str(value)
+            repr(value) if isinstance(value, float) else \
+            "'" + value.replace("'", "''") + "'" if isinstance(value, str) else str(value)
+        # (a string is single-quoted YAML, so '[...]' stays a string, e.g. formation.layers)
         out += ["-p", f"{name}:={text}"]
     return out
 

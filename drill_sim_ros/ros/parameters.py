@@ -184,6 +184,15 @@ SPECS: tuple[ParamSpec, ...] = (
               "Speed loop integral gain [N m per rad] (speed mode).", 0.0, 1e12),
     ParamSpec("top_drive.max_torque_nm", DOUBLE, _drive_value("max_torque_nm"),
               "Motor torque limit +-[N m] (speed and torque modes); 0 = none.", 0.0, 1e12),
+    ParamSpec("top_drive.motor_lag_s", DOUBLE, _drive_value("motor_lag_s"),
+              "Time constant of the first-order lag of the motor torque behind its command "
+              "(the drive's torque bandwidth) [s] (speed and torque modes); 0 = none.",
+              0.0, 60.0),
+    ParamSpec("formation.layers", STRING, "",
+              "Rock layers by depth below the start, as a JSON list of {top_m, "
+              "intrinsic_specific_energy_pa, mu_gamma, contact_stress_times_wearflat_n_per_m} "
+              "(a missing rock key keeps the preset's); each applies from the step the bit "
+              "reaches its top; '' = the preset's rock throughout."),
     ParamSpec("sensors.seed", INTEGER, 0, "Seed of the surface sensors' noise.", 0,
               2**31 - 1, read_only=True),
     *_sensor_specs(),

@@ -103,11 +103,12 @@ def session_config(values: dict[str, Any], preset: Any) -> SessionConfig:
         submerged_weight_n=values["model.submerged_string_weight_n"],
         top_drive=top_drive(values), sensors=rig_sensors(values),
         command_delay_s=values["commands.delay_s"],
-        string_rate_hz=values["string.rate_hz"], string_depths=values["string.depths"])
+        string_rate_hz=values["string.rate_hz"], string_depths=values["string.depths"],
+        formation=tuple(formation_layers(values["formation.layers"])))
 
 
 DRIVE_PARAMETERS = {"top_drive.kp_nm_s", "top_drive.ki_nm", "top_drive.max_torque_nm",
-                    "top_drive.mode"}
+                    "top_drive.mode", "top_drive.motor_lag_s"}
 
 
 def top_drive(values: dict[str, Any]) -> TopDrivePhysical:
@@ -116,7 +117,21 @@ def top_drive(values: dict[str, Any]) -> TopDrivePhysical:
     return TopDrivePhysical(mode=values["top_drive.mode"],
                             inertia_kg_m2=values["top_drive.inertia_kg_m2"],
                             kp_nm_s=values["top_drive.kp_nm_s"], ki_nm=values["top_drive.ki_nm"],
-                            max_torque_nm=limit if limit > 0 else math.inf)
+                            max_torque_nm=limit if limit > 0 else math.inf,
+                            motor_lag_s=values["top_drive.motor_lag_s"])
+
+
+def formation_layers(text: str) -> list[dict[str, Any]]:
+    """The ``formation.layers`` parameter: a JSON list of layer mappings ('' = none)."""
+    if not text.strip():
+        return []
+    try:
+        layers = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise ParameterError(f"parameter 'formation.layers' is not JSON: {exc}") from exc
+    if not isinstance(layers, list):
+        raise ParameterError("parameter 'formation.layers' must be a JSON list of layers")
+    return layers
 
 
 def rig_sensors(values: dict[str, Any]) -> RigSensors:
@@ -334,6 +349,12 @@ class SimNode(Node):
                 self._session.check_top_drive(top_drive(values))
             except ParameterError as exc:
                 return SetParametersResult(successful=False, reason=str(exc))
+        for p in params:
+            if p.name == "formation.layers" and self._session is not None:
+                try:
+                    self._session.check_formation(formation_layers(p.value))
+                except ParameterError as exc:
+                    return SetParametersResult(successful=False, reason=str(exc))
         return SetParametersResult(successful=True)
 
     def _apply_parameters(self, params: list[Parameter]) -> None:
@@ -347,6 +368,8 @@ class SimNode(Node):
             names = {p.name for p in params}
             if names & DRIVE_PARAMETERS:
                 self._session.set_top_drive(top_drive(self._values))   # between runs: no bump
+            if "formation.layers" in names:
+                self._session.set_formation(formation_layers(self._values["formation.layers"]))
             if names & {"real_time_factor", "lockstep", "lockstep_trigger"}:
                 self._restart_ticks()
 

@@ -32,12 +32,17 @@ DRIVE = {
 }
 
 
+# a hard streak crossed at 2 cm (about 10 s in) and a motor torque lag, as sim_node parameters
+STREAK = ({"top_m": 0.02, "intrinsic_specific_energy_pa": 400e6, "mu_gamma": 0.6},)
+
+
 @pytest.mark.parametrize(
-    ("controller", "mode", "drive"),
-    [("z_torque", "speed", {}), ("soft_torque", "torque", {}), ("z_torque", "speed", DRIVE)],
+    ("controller", "mode", "drive", "formation"),
+    [("z_torque", "speed", {}, ()), ("soft_torque", "torque", {}, ()),
+     ("z_torque", "speed", DRIVE, ()), ("soft_torque", "torque", {"motor_lag_s": 0.05}, STREAK)],
 )
 def test_in_process_and_over_dds_give_the_same_telemetry(
-    controller: str, mode: str, drive: dict
+    controller: str, mode: str, drive: dict, formation: tuple
 ) -> None:
     sensors = {**SENSORS, "hook_load_n": {"noise_std": 500.0}} if drive else SENSORS
     scenario = Scenario(
@@ -49,6 +54,7 @@ def test_in_process_and_over_dds_give_the_same_telemetry(
         sensors=sensors,
         schedule=({"t_s": 20.0, "rpm": 70.0, "ramp_s": 5.0}, {"t_s": 22.0, "wob_n": 65e3}),
         drive=drive,
+        formation=formation,
     )
     local = run_in_process(scenario).rows
     remote = run_over_dds(scenario, timeout_s=240.0).rows
