@@ -101,6 +101,10 @@ def test_two_rigs_in_two_namespaces_each_recorded_and_bridged(tmp_path) -> None:
                             in log.read_text(), 60), log.read_text()
         with ros_context() as ros:
             node = ros.add(Node("stepper", context=ros.context))
+            for rig in rigs:                     # each sim hears its recorder and bridge
+                name = f"/{rig}{topics.TELEMETRY}"  # before the steps (20 take ~1 s)
+                assert ros.spin_until(lambda name=name: node.count_subscribers(name) >= 2, 30)
+            ros.spin_for(1.0)
             for rig in rigs:
                 step_all(node, ros, f"/{rig}/drill_sim/step", STEPS)
             for rig in rigs:
