@@ -20,6 +20,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from drill_sim_ros.model.errors import ParameterError
+from drill_sim_ros.model.validate_input import check_known_keys
 
 LAYER_KEYS = ("top_m", "intrinsic_specific_energy_pa", "mu_gamma",
               "contact_stress_times_wearflat_n_per_m")
@@ -69,10 +70,7 @@ def layers_from_dicts(layers: Any, rock: Rock) -> tuple[Layer, ...]:
     for i, layer in enumerate(layers):
         if not isinstance(layer, dict):
             raise ParameterError(f"formation[{i}] must be a mapping of {', '.join(LAYER_KEYS)}")
-        unknown = sorted(set(layer) - set(LAYER_KEYS))
-        if unknown:
-            raise ParameterError(f"unknown key(s) {unknown} in formation[{i}]; known: "
-                                 f"{', '.join(LAYER_KEYS)}")
+        check_known_keys(layer, LAYER_KEYS, f"formation[{i}]")
         if "top_m" not in layer:
             raise ParameterError(f"formation[{i}] needs top_m (depth below the start, m)")
         top = _value(i, layer, "top_m", 0.0, 0.0, 1e5)

@@ -41,7 +41,7 @@ from drill_sim_ros.model.string import (
     kernel_string,
 )
 from drill_sim_ros.model.top_drive import TopDrive, top_drive_from_dict
-from drill_sim_ros.model.validate_input import check_preset_mapping
+from drill_sim_ros.model.validate_input import check_known_keys, check_preset_mapping
 
 DEFAULT_PRESET = "field_8p5in_shale"
 GRAVITY_M_S2 = 9.80665
@@ -180,10 +180,7 @@ def _section(where: str, values: Any, defaults: dict[str, float]) -> Section:
     """One section mapping (SI keys of :class:`Section`), checked."""
     if not isinstance(values, dict):
         raise ParameterError(f"'{where}' must be a mapping of {', '.join(SECTION_KEYS[:3])}")
-    unknown = sorted(set(values) - set(SECTION_KEYS))
-    if unknown:
-        raise ParameterError(f"unknown key(s) {unknown} in '{where}'; known: "
-                             f"{', '.join(SECTION_KEYS)}")
+    check_known_keys(values, SECTION_KEYS, where)
     missing = [key for key in SECTION_KEYS[:3] if key not in values]
     if missing:
         raise ParameterError(f"'{where}' needs {', '.join(missing)}")
