@@ -303,3 +303,18 @@ def test_sim_yaml_sets_only_parameters_that_exist_with_valid_values() -> None:
     assert unknown == [], f"config/sim.yaml sets parameters sim_node does not have: {unknown}"
     reasons = [validate(SPEC_BY_NAME[name], value) for name, value in values.items()]
     assert [r for r in reasons if r is not None] == []
+
+
+def test_the_topic_table_says_keep_all_for_the_command_subscriptions() -> None:
+    """The command subscriptions keep every command (docs/control-loop.md): the table must
+    not show them as keep-last (rclpy gives a KEEP_ALL profile a depth of 10)."""
+    from rclpy.qos import HistoryPolicy
+
+    from drill_sim_ros import topics
+    from drill_sim_ros.ros.sim_node import COMMAND_QOS
+
+    assert COMMAND_QOS.history == HistoryPolicy.KEEP_ALL
+    rows = {row.split(" | ")[0].strip("| `"): row
+            for row in _load_generator().topic_table().splitlines()[2:]}
+    for topic in topics.COMMANDS:
+        assert "keep-all" in rows[topic] and "keep-last" not in rows[topic], rows[topic]
