@@ -426,7 +426,7 @@ class SimNode(Node):
         """Simulate ``periods`` and hand the block to the sinks; False on a numerical fault
         (call with the lock held)."""
         try:
-            self._emit_initial()
+            self._emit_initial(then_advance=True)
             block = self._session.run(periods)
         except NumericalFault as exc:
             self._on_fault(exc)
@@ -434,21 +434,23 @@ class SimNode(Node):
         self._emit(block)
         return True
 
-    def _emit_initial(self) -> None:
+    def _emit_initial(self, then_advance: bool = False) -> None:
         """The state at t = 0, what a controller first reacts to, once: just before the first
-        period or the first command, whichever comes first (lock held)."""
+        period or the first command, whichever comes first; ``then_advance``: periods follow
+        at once, so the sim has not advanced yet (lock held)."""
         if self._initial_pending:
             self._initial_pending = False
-            self._emit(self._session.current())
+            self._emit(self._session.current(), advanced=not then_advance)
 
-    def _emit(self, block: Block) -> None:
-        """Hand ``block`` to the sinks (call with the lock held)."""
+    def _emit(self, block: Block, advanced: bool = True) -> None:
+        """Hand ``block`` to the sinks; ``advanced``: the sim advanced to its last sample
+        (call with the lock held)."""
         self._sinks.emit(block, self._values["publish_clock"])
         if block.strings:
             self._string_sink.emit(block.strings)
         if len(block):
             self._last_row = block.rows[-1]
-            self._handshake.published(int(block.stamps_ns[-1]), time.monotonic())
+            self._handshake.published(int(block.stamps_ns[-1]), time.monotonic(), advanced)
 
     def _on_tick_error(self, exc: Exception) -> bool:
         """An unexpected error on the ticker: quiet at shutdown, else a fault until reset."""
