@@ -103,8 +103,8 @@ def parameter_table() -> str:
 
 def _qos_text(profile: Any) -> str:
     durability = profile.durability.name.lower().replace("_", " ")
-    return (f"{profile.reliability.name.lower()}, {durability}, "
-            f"keep-last {profile.depth}")
+    history = "keep-all" if profile.history.name == "KEEP_ALL" else f"keep-last {profile.depth}"
+    return f"{profile.reliability.name.lower()}, {durability}, {history}"
 
 
 def _content(topic: str) -> str:

@@ -92,10 +92,11 @@ SURFACE_JOINTS = ("top_drive", "hook")
 # drill/string/torsion: string_<depth below the top, m, as 0000.0>m, top to bottom
 STRING_JOINT_PATTERN = "string_DDDD.Dm"
 # What the rig's surface sensors give (the only signals a controller should read):
-MEASURED_JOINTS = ("top_drive", "quill", "hook", "wob_estimate")
+# (no joint "hook" here: "hook" means the applied WOB, in the state and in the command)
+MEASURED_JOINTS = ("top_drive", "quill", "hook_load", "wob_estimate")
 # top_drive:    angle rad, measured speed rad/s (encoder), measured motor torque N m
 # quill:        angle rad, measured speed rad/s, measured string torque N m (torque sub)
-# hook:         bit depth m, rate of penetration m/s, measured hook load N (load cell)
+# hook_load:    bit depth m, rate of penetration m/s, measured hook load N (load cell)
 # wob_estimate: bit depth m, rate of penetration m/s, applied WOB estimate N
 #               (submerged string weight - measured hook load)
 
@@ -151,9 +152,10 @@ JOINT_FIELDS: dict[str, dict[str, tuple[str, str, str]]] = {
     },
     SURFACE_MEASURED: {
         "top_drive": ("angle rad", "encoder speed rad/s", "motor torque N m"),
-        "quill": ("angle rad", "speed rad/s", "string torque N m (torque sub)"),
-        "hook": ("-", "-", "measured hook load N"),
-        "wob_estimate": ("-", "-", "applied WOB estimate N (submerged weight - hook load)"),
+        "quill": ("angle rad", "encoder speed rad/s", "string torque N m (torque sub)"),
+        "hook_load": ("bit depth m", "ROP m/s", "measured hook load N (load cell)"),
+        "wob_estimate": ("bit depth m", "ROP m/s",
+                         "applied WOB estimate N (submerged weight - measured hook load)"),
     },
     STRING_TORSION: {
         STRING_JOINT_PATTERN: ("-", "angular speed rad/s at that depth",

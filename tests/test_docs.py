@@ -303,3 +303,35 @@ def test_sim_yaml_sets_only_parameters_that_exist_with_valid_values() -> None:
     assert unknown == [], f"config/sim.yaml sets parameters sim_node does not have: {unknown}"
     reasons = [validate(SPEC_BY_NAME[name], value) for name, value in values.items()]
     assert [r for r in reasons if r is not None] == []
+
+
+def test_the_topic_table_says_keep_all_for_the_command_subscriptions() -> None:
+    """The command subscriptions keep every command (docs/control-loop.md): the table must
+    not show them as keep-last (rclpy gives a KEEP_ALL profile a depth of 10)."""
+    from rclpy.qos import HistoryPolicy
+
+    from drill_sim_ros import topics
+    from drill_sim_ros.ros.sim_node import COMMAND_QOS
+
+    assert COMMAND_QOS.history == HistoryPolicy.KEEP_ALL
+    rows = {row.split(" | ")[0].strip("| `"): row
+            for row in _load_generator().topic_table().splitlines()[2:]}
+    for topic in topics.COMMANDS:
+        assert "keep-all" in rows[topic] and "keep-last" not in rows[topic], rows[topic]
+
+
+def test_every_ros2_run_or_param_in_the_docs_gives_the_venv_equivalent() -> None:
+    """The venv has no ``ros2`` command (issue 22): within a few lines of each ``ros2 run``
+    or ``ros2 param`` a page shows what works there (``.venv/bin/...``, ``drill_sim
+    params``)."""
+    pages = [ROOT / "README.md", ROOT / "config" / "sim.yaml", *sorted((ROOT / "docs").glob(
+        "*.md"))]
+    bare = []
+    for page in pages:
+        lines = page.read_text(encoding="utf-8").splitlines()
+        for i, line in enumerate(lines):
+            if re.search(r"ros2 (run|param)\b", line):
+                near = "\n".join(lines[max(0, i - 8):i + 9])
+                if ".venv/bin/" not in near and "drill_sim params" not in near:
+                    bare.append(f"{page.relative_to(ROOT)}:{i + 1}")
+    assert not bare, bare

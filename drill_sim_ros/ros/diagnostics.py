@@ -71,7 +71,7 @@ class Figures:
     # command-triggered lockstep's handshake (drill_sim_ros.ros.handshake)
     stale: int = 0                 # commands that did not answer the latest sample
     lost_commands: int = 0         # commands DDS reports lost on their way
-    command_publishers: int = 0    # publishers matched on drill/cmd/top_drive
+    command_publishers: int = 0    # publishers matched on drill/cmd/top_drive (and typed)
     waiting: str | None = None     # what lockstep waits for, past lockstep.warn_after_s
     waits: int = 0                 # waits that went past lockstep.warn_after_s
 

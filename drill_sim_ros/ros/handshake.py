@@ -8,7 +8,9 @@ ROS-free; sim_node holds one :class:`CommandGate` and one :class:`WaitWatch` und
   before any sample was seen) is *stale*: neither applied nor advancing, only counted.
 - Whatever advances lockstep (an admitted command, a ``~/step`` call), the wall time since
   the sim last advanced is watched: past ``lockstep.warn_after_s`` it is reported once, and
-  once more when the sim advances again.
+  once more when the sim advances again. In command lockstep a wait is reported again when
+  the number of command publishers changed and the wait went on as long once more (a
+  controller connected and does not answer, or went away).
 """
 
 from __future__ import annotations
@@ -110,6 +112,7 @@ class Handshake:
         self.gate = CommandGate()
         self.watch = WaitWatch(now_s)
         self.lost_commands = 0
+        self._publishers = PublisherCount()
         self._logger = logger
         self._waiting_for = {COMMAND_MODE: (f"a command on {command_topic}", "answering"),
                              SERVICE_MODE: (f"a call of {step_service}", "at")}
@@ -118,10 +121,13 @@ class Handshake:
         """Lockstep (re)starts now: a wait counts from here."""
         self.watch.since_s, self.watch.warned = now_s, False
 
-    def published(self, stamp_ns: int, now_s: float) -> None:
-        """A sample stamped ``stamp_ns`` went out: the latest; one info line if the sim had
-        been reported waiting."""
+    def published(self, stamp_ns: int, now_s: float, advanced: bool = True) -> None:
+        """A sample stamped ``stamp_ns`` went out: the latest; with ``advanced`` (the sim
+        advanced to it, not the t = 0 sample just before the first period) one info line if
+        the sim had been reported waiting."""
         self.gate.published(stamp_ns)
+        if not advanced:
+            return
         waited_s = self.watch.advanced(now_s)
         if waited_s is not None:
             self._logger.info(f"lockstep runs again: {seconds_text(stamp_ns)} published "
@@ -157,11 +163,47 @@ class Handshake:
 
     def check(self, mode: str | None, now_s: float, warn_after_s: float,
               publishers: int) -> None:
-        """One warning line when the wait passes ``warn_after_s``."""
-        if mode is None or not self.watch.overdue(now_s, warn_after_s):
+        """One warning line when the wait passes ``warn_after_s``; one more each time the
+        number of command ``publishers`` changed and the wait went on ``warn_after_s`` after
+        that (a controller that connected and does not answer, or one that went away)."""
+        if mode is None:
             return
+        first = self.watch.overdue(now_s, warn_after_s)
+        if first or (mode == COMMAND_MODE and self.watch.warned
+                     and self._publishers.changed(publishers, now_s, warn_after_s)):
+            self._report(mode, now_s, publishers)
+
+    def _report(self, mode: str, now_s: float, publishers: int) -> None:
+        self._publishers.reported(publishers)
         waiting = self.waiting(mode, now_s)
-        hint = f"{publishers} command publisher(s) matched; a controller answers every sample " \
-               "it receives (docs/control-loop.md)" if mode == COMMAND_MODE else \
-               "each call advances one period"
+        if mode == SERVICE_MODE:
+            hint = "each call advances one period"
+        elif publishers == 0:
+            hint = "0 command publishers matched: no controller runs (docs/control-loop.md)"
+        else:
+            hint = (f"{publishers} command publisher(s) matched and none answered: a "
+                    "controller answers every sample it receives, and subscribes to the "
+                    "samples reliable + transient local to get the one published before it "
+                    "connected (docs/control-loop.md)")
         self._logger.warning(f"{waiting.text}; {hint}")
+
+
+class PublisherCount:
+    """The number of command publishers last reported, and since when (monotonic seconds)
+    it has differed from the number matched now."""
+
+    def __init__(self) -> None:
+        self.last: int | None = None
+        self.differs_since_s: float | None = None
+
+    def reported(self, publishers: int) -> None:
+        self.last, self.differs_since_s = publishers, None
+
+    def changed(self, publishers: int, now_s: float, settle_s: float) -> bool:
+        """True once ``publishers`` has differed from the last report for ``settle_s``."""
+        if publishers == self.last:
+            self.differs_since_s = None
+            return False
+        if self.differs_since_s is None:
+            self.differs_since_s = now_s
+        return now_s - self.differs_since_s >= settle_s

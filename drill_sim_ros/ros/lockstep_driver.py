@@ -61,7 +61,7 @@ def telemetry_sample(raw: bytes) -> tuple[np.ndarray, int]:
 
 
 def measured_sample(raw: bytes) -> tuple[SurfaceMeasurement, int]:
-    """A drill/surface/measured payload (joints top_drive, quill, hook, wob_estimate:
+    """A drill/surface/measured payload (joints top_drive, quill, hook_load, wob_estimate:
     MEASURED_JOINTS): (measurement, stamp ns)."""
     msg = deserialize_message(raw, JointState)
     time_ns = stamp_ns(msg.header.stamp)

@@ -248,10 +248,13 @@ class SimNode(Node):
         rig = self._diagnostics.source.hardware_id
         self._sinks.typed = TypedTelemetry(pubs[topics.TYPED_TELEMETRY],
                                            typed.TelemetryPacker(rig))
-        sub = self.create_subscription(typed.TopDriveCommand,
-                                       topics.node_relative(topics.TYPED_CMD_TOP_DRIVE),
-                                       self._on_typed_top_drive, COMMAND_QOS, raw=True)
-        self._command_names[topics.TYPED_CMD_TOP_DRIVE] = sub.topic_name
+        topic = topics.TYPED_CMD_TOP_DRIVE
+        sub = self.create_subscription(
+            typed.TopDriveCommand, topics.node_relative(topic), self._on_typed_top_drive,
+            COMMAND_QOS, raw=True, event_callbacks=SubscriptionEventCallbacks(
+                message_lost=self._on_commands_lost(topic)))
+        self._command_names[topic] = sub.topic_name
+        self._command_subs[topic] = sub
         return pubs
 
     # ---- start -------------------------------------------------------------------------
@@ -423,7 +426,7 @@ class SimNode(Node):
         """Simulate ``periods`` and hand the block to the sinks; False on a numerical fault
         (call with the lock held)."""
         try:
-            self._emit_initial()
+            self._emit_initial(then_advance=True)
             block = self._session.run(periods)
         except NumericalFault as exc:
             self._on_fault(exc)
@@ -431,21 +434,23 @@ class SimNode(Node):
         self._emit(block)
         return True
 
-    def _emit_initial(self) -> None:
+    def _emit_initial(self, then_advance: bool = False) -> None:
         """The state at t = 0, what a controller first reacts to, once: just before the first
-        period or the first command, whichever comes first (lock held)."""
+        period or the first command, whichever comes first; ``then_advance``: periods follow
+        at once, so the sim has not advanced yet (lock held)."""
         if self._initial_pending:
             self._initial_pending = False
-            self._emit(self._session.current())
+            self._emit(self._session.current(), advanced=not then_advance)
 
-    def _emit(self, block: Block) -> None:
-        """Hand ``block`` to the sinks (call with the lock held)."""
+    def _emit(self, block: Block, advanced: bool = True) -> None:
+        """Hand ``block`` to the sinks; ``advanced``: the sim advanced to its last sample
+        (call with the lock held)."""
         self._sinks.emit(block, self._values["publish_clock"])
         if block.strings:
             self._string_sink.emit(block.strings)
         if len(block):
             self._last_row = block.rows[-1]
-            self._handshake.published(int(block.stamps_ns[-1]), time.monotonic())
+            self._handshake.published(int(block.stamps_ns[-1]), time.monotonic(), advanced)
 
     def _on_tick_error(self, exc: Exception) -> bool:
         """An unexpected error on the ticker: quiet at shutdown, else a fault until reset."""
@@ -611,10 +616,16 @@ class SimNode(Node):
         """One warning when lockstep has waited longer than lockstep.warn_after_s."""
         if self._session is None:
             return
-        publishers = self._command_subs[topics.CMD_TOP_DRIVE].get_publisher_count()
+        publishers = self._top_drive_publishers()
         with self._lock.urgent():
             self._handshake.check(self._lockstep_mode(), time.monotonic(),
                                   self._values["lockstep.warn_after_s"], publishers)
+
+    def _top_drive_publishers(self) -> int:
+        """Publishers matched on drill/cmd/top_drive and on its typed twin."""
+        return sum(self._command_subs[topic].get_publisher_count()
+                   for topic in (topics.CMD_TOP_DRIVE, topics.TYPED_CMD_TOP_DRIVE)
+                   if topic in self._command_subs)
 
     def _publish_diagnostics(self) -> None:
         """/diagnostics: the figures are copied under the lock, the message is built and
@@ -655,8 +666,7 @@ class SimNode(Node):
         waiting = self._handshake.waiting(self._lockstep_mode(), time.monotonic())
         return {"stale": self._handshake.gate.stale,
                 "lost_commands": self._handshake.lost_commands,
-                "command_publishers":
-                    self._command_subs[topics.CMD_TOP_DRIVE].get_publisher_count(),
+                "command_publishers": self._top_drive_publishers(),
                 "waiting": None if waiting is None else waiting.text,
                 "waits": self._handshake.watch.waits}
 

@@ -159,9 +159,12 @@ def test_a_late_starter_sending_a_command_at_start_up_gets_the_latest_sample(tmp
             # and was stale
             last = watch.until(lambda d: d.get("stale_commands") in ("0", "1"), "stale")
             rows = finish(sim, log, record, [late])
+    lines = [line for line in log.read_text().splitlines()
+             if "waiting for a command on /drill/cmd/top_drive answering t = 0.000 s" in line]
+    # once with no publisher; once more if it connected and took longer than
+    # QUICK_WARN_S to answer
+    assert len(lines) in (1, 2) and "0 command publishers matched" in lines[0], lines
     text = log.read_text()
-    assert text.count("waiting for a command on /drill/cmd/top_drive answering t = 0.000 s") \
-        == 1
     assert "lockstep runs again: t = 0.010 s published after" in text
     assert last["lockstep_waits"] in ("1", "2")     # 2: once more after its last answer
     assert_same_as_bench(rows)
@@ -206,7 +209,9 @@ def test_a_controller_killed_mid_run_and_restarted_resumes_from_the_latest_sampl
             rows = finish(sim, log, record, [restarted])
     assert last["lockstep_waits"] == waits and last["lost_commands"] == "0"
     text = log.read_text()
-    assert text.count("answering t = 10.000 s") == 1
+    # reported once, and again each time the publishers matched changed for QUICK_WARN_S
+    # (the killed one's went away when DDS noticed; the restarted one's came)
+    assert 1 <= text.count("answering t = 10.000 s") <= 3
     assert "lockstep runs again: t = 10.010 s" in text
     assert "stamped t = 0.000 s, which is not the latest sample (t = 10.0" in text
     assert_same_as_bench(rows)       # no gap, no jump: the law answers the same samples

@@ -100,3 +100,21 @@ def test_templates_zero_their_padding():
     payload = frame.pack(rows, np.zeros(1, dtype=np.int64))[0][
         frame.topics.index(topics.BIT_JOINT_STATES)]
     assert payload[17:20] == b"\x00\x00\x00"  # frame_id "": length 1 + NUL, then 3 pad bytes
+
+
+def test_hook_means_the_applied_wob_on_every_topic_it_is_on():
+    """A controller reads drill/surface/measured and writes drill/cmd/top_drive, whose
+    ``hook`` effort is the applied WOB: wherever a state topic names a ``hook`` joint, its
+    effort is the applied WOB too (true, or the measured estimate), never the hook load
+    (issue 26). Read from the packed messages of a row whose fields all differ."""
+    rows = random_rows(1, seed=11)
+    frame = SampleFrame(with_clock=False)
+    payloads = dict(zip(frame.topics, frame.pack(rows, TIMES_NS[:1])[0], strict=True))
+    row = rows[0]
+    applied_wob = {row[F["applied_wob_n"]], row[F["applied_wob_estimate_n"]]}
+    assert "hook" in topics.COMMAND_JOINTS
+    for topic in (topics.SURFACE_JOINT_STATES, topics.SURFACE_MEASURED):
+        msg = deserialize_message(payloads[topic], JointState)
+        for joint, effort in zip(msg.name, msg.effort, strict=True):
+            if joint == "hook":
+                assert effort in applied_wob, (topic, joint)

@@ -3,7 +3,13 @@ one report per wait."""
 
 from __future__ import annotations
 
-from drill_sim_ros.ros.handshake import CommandGate, WaitWatch
+from drill_sim_ros.ros.handshake import (
+    COMMAND_MODE,
+    SERVICE_MODE,
+    CommandGate,
+    Handshake,
+    WaitWatch,
+)
 
 PERIOD_NS = 10_000_000
 
@@ -31,3 +37,42 @@ def test_a_wait_is_reported_once_and_its_end_once():
     assert watch.advanced(160.5) is None                 # an ordinary step: nothing to say
     assert not watch.overdue(1e6, warn_after_s=0.0)      # 0: never
     assert watch.waits == 1
+
+
+class Lines:
+    """A logger that keeps its warning lines."""
+
+    def __init__(self) -> None:
+        self.warnings: list[str] = []
+
+    def warning(self, text: str, **_: object) -> None:
+        self.warnings.append(text)
+
+    def info(self, text: str, **_: object) -> None:
+        pass
+
+
+def test_a_wait_is_reported_again_when_a_controller_connects_and_does_not_answer():
+    """A controller whose sample subscription is volatile connects after t = 0 went out
+    and never gets it: the first report (no publisher) is not the last word."""
+    lines = Lines()
+    handshake = Handshake(lines, "/drill/cmd/top_drive", "/drill_sim/step", now_s=0.0)
+    handshake.published(0, now_s=0.0)
+    for now_s, publishers in ((1.9, 0), (2.0, 0), (3.0, 1), (4.9, 1), (5.0, 1), (9.0, 1)):
+        handshake.check(COMMAND_MODE, now_s, 2.0, publishers)
+    assert len(lines.warnings) == 2
+    assert "answering t = 0.000 s, 2.0 s; 0 command publishers matched" in lines.warnings[0]
+    assert "answering t = 0.000 s, 5.0 s; 1 command publisher(s) matched and none " \
+           "answered" in lines.warnings[1]
+    assert "transient local" in lines.warnings[1]
+    handshake.check(COMMAND_MODE, 9.5, 2.0, 0)       # it went away: 2 s later, once more
+    handshake.check(COMMAND_MODE, 11.5, 2.0, 0)
+    handshake.check(COMMAND_MODE, 20.0, 2.0, 0)
+    assert len(lines.warnings) == 3 and "0 command publishers" in lines.warnings[2]
+    # a controller that connects and answers at once: no second report for the next wait
+    handshake.published(10_000_000, now_s=21.0)
+    handshake.check(COMMAND_MODE, 23.0, 2.0, 1)
+    assert len(lines.warnings) == 4 and "1 command publisher(s)" in lines.warnings[3]
+    handshake.check(SERVICE_MODE, 40.0, 2.0, 3)      # step lockstep: publishers do not count
+    assert len(lines.warnings) == 4
+    assert handshake.watch.waits == 2

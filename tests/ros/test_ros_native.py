@@ -214,3 +214,16 @@ def test_typed_topics_carry_the_standard_ones_values_and_take_commands(ros) -> N
     run_info = info.got[ns + topics.TYPED_RUN_INFO][0]
     assert run_info.preset == "field_8p5in_shale" and run_info.lockstep
     assert run_info.publish_rate_hz == 100.0 and '"period_ns": 10000000' in run_info.json
+    # the typed command goes through the same handshake: a second answer to t = 0 is stale;
+    # and its publisher is a command publisher on /diagnostics (the only one here)
+    diagnostics = Collector(ros, {topics.DIAGNOSTICS: DiagnosticArray})
+    stale = typed.TopDriveCommand(speed_rad_s=9.0, motor_torque_nm=math.nan, wob_n=math.nan)
+    stale.header.stamp = stamp(0)
+    pub.publish(stale)
+
+    def simulation() -> dict[str, str]:
+        found = statuses(diagnostics, ": simulation")
+        return values(found[-1]) if found else {}
+    assert ros.spin_until(lambda: simulation().get("stale_commands") == "1", 10), simulation()
+    assert simulation()["command_publishers"] == "1"
+    assert len(probe.got[standard_name]) == 6            # nothing advanced
