@@ -390,6 +390,10 @@ def _cmd_run(args: argparse.Namespace) -> int:
 
 def _cmd_sweep(args: argparse.Namespace) -> int:
     values = _sweep_values(args.values)
+    fractional = [v for v in values if args.vary == "n" and v != round(v)]
+    if fractional:
+        raise DrillSimError(f"--values {args.values!r}: n = {fractional[0]:g} is not a whole "
+                            "number (n counts the blades; it is never rounded)")
     progress = args.progress or sys.stderr.isatty()
     for value in values:
         setattr(args, args.vary, int(value) if args.vary == "n" else value)

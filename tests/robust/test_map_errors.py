@@ -30,7 +30,10 @@ MAP = ("map", "--tau-end", "1", "--workers", "1")
 @pytest.mark.parametrize(("vary", "names"), [
     ("omega0=-5:-1:3", ("omega0=-5", "'omega0' = -5.0", "[0, 10000]")),
     ("psi=0,-1", ("psi=0", "'psi' = 0.0", "(0, 1e+07]")),
-    ("n=0.2,1e9", ("n=0.2", "'n' = 0", "[1, 64]")),
+    ("n=0.2,1e9", ("n:", "0.2", "not a whole number")),      # never rounded (to 0)
+    ("n=2.5,3", ("n:", "2.5", "not a whole number")),        # never rounded (to 2)
+    ("n=1:6:4", ("n:", "2.66667", "not a whole number")),    # 1, 2.67, 4.33, 6
+    ("n=1,1e9", ("n=1e+09", "'n' = 1000000000", "[1, 64]")),
     ("beta=1e308,2", ("beta=1e+308", "[0, 10]")),
 ])
 def test_axis_values_out_of_range_are_refused_on_the_client(capsys, tmp_path: Path,
