@@ -35,15 +35,18 @@ def test_a_plot_in_a_missing_directory_creates_it(capsys, tmp_path: Path) -> Non
 
 @pytest.mark.parametrize(("where", "names"), [
     ("a_dir.png", ("a_dir.png", "is a directory")),
+    ("a_dir", ("a_dir", "is a directory")),         # the issue's --plot /some/dir
     ("x.jpg", ("x.jpg", "unknown suffix", ".png")),
     ("/proc/drill_sim_test.png", ("/proc/drill_sim_test.png", "cannot write")),
 ])
 def test_a_plot_path_that_cannot_be_written_stops_before_the_run(
         capsys, tmp_path: Path, where: str, names: tuple[str, ...]) -> None:
     (tmp_path / "a_dir.png").mkdir()
+    (tmp_path / "a_dir").mkdir()
     path = where if where.startswith("/") else str(tmp_path / where)
     rc, out, err = run_cli(capsys, *SHORT, "--plot", path)
     one_error_line(rc, err, *names)
     assert out == ""                           # checked before the run, not after it
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["a_dir.png"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a_dir", "a_dir.png"]  # no .png
     assert not any((tmp_path / "a_dir.png").iterdir())
+    assert not any((tmp_path / "a_dir").iterdir())
