@@ -12,6 +12,8 @@ import argparse
 import csv
 import json
 import math
+import os
+import signal
 import sys
 import time
 from collections.abc import Iterator, Sequence
@@ -442,6 +444,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         print(f"drill_sim {args.command}: interrupted", file=sys.stderr)
         return 130
+    except BrokenPipeError:        # the reader went away (`drill_sim params | head`)
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())   # no flush error
+        return 128 + signal.SIGPIPE
 
 
 if __name__ == "__main__":

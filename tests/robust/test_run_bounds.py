@@ -3,6 +3,7 @@ fractional number of blades are one line before any work; Ctrl-C in a run is a c
 
 from __future__ import annotations
 
+import os
 import signal
 import subprocess
 import sys
@@ -45,3 +46,17 @@ def test_ctrl_c_in_a_run_is_one_line_and_exit_130() -> None:
     assert process.returncode == 130, err
     assert err.strip().splitlines() == ["drill_sim run: interrupted"] and out == ""
     assert time.monotonic() - start < 30              # the kernel hears it between chunks
+
+
+def test_output_into_a_closed_pipe_is_no_traceback() -> None:
+    """`drill_sim params | head -1`: the reader is gone before the output ends."""
+    read_end, write_end = os.pipe()
+    os.close(read_end)                                # a reader that has already gone
+    try:
+        done = subprocess.run([sys.executable, "-m", "drill_sim_ros.cli", "presets"],
+                              cwd=ROOT, stdout=write_end, stderr=subprocess.PIPE, text=True,
+                              timeout=60)
+    finally:
+        os.close(write_end)
+    assert done.returncode == 128 + signal.SIGPIPE, done.stderr
+    assert done.stderr == ""
