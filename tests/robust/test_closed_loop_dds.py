@@ -87,6 +87,6 @@ def test_sim_node_refuses_a_misspelt_params_file(tmp_path) -> None:
                            "--params-file", str(params)], capture_output=True, text=True,
                           timeout=60, env=os.environ.copy())
     lines = [line for line in (done.stdout + done.stderr).splitlines() if line.strip()]
-    assert done.returncode != 0
+    assert done.returncode == 2, lines
     assert len(lines) == 1 and "[FATAL]" in lines[0], lines
     assert "publish_rate_hzz" in lines[0] and "did you mean publish_rate_hz" in lines[0]
