@@ -97,7 +97,9 @@ class MapSpec:
         if self.control is not None:
             validate_control(self)
         if self.size > MAX_POINTS:
-            raise ParameterError(f"the map has {self.size:,} points; at most {MAX_POINTS:,}")
+            shape = " x ".join(f"{n:,}" for n in self.shape)
+            raise ParameterError(f"--vary: the map has {self.size:,} points ({shape}); at "
+                                 f"most {MAX_POINTS:,} (every point is held in memory)")
         validate_corners(self)
 
     @property

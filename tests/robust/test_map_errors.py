@@ -53,6 +53,16 @@ def test_a_corner_of_two_axes_is_checked(capsys, tmp_path: Path) -> None:
     assert not out.exists()
 
 
+def test_a_map_larger_than_the_bound_is_refused_before_any_work(capsys,
+                                                                 tmp_path: Path) -> None:
+    out = tmp_path / "map.nc"
+    rc, _, err = run_cli(capsys, *MAP, "--vary", "beta=0.1:0.5:1001", "--vary",
+                         "psi=10:100:1000", "--out", str(out))
+    one_error_line(rc, err, "--vary", "1,001,000 points", "1,001 x 1,000",
+                   "at most 1,000,000")
+    assert not out.exists()
+
+
 @pytest.mark.parametrize(("scheduler", "names"), [
     ("bogus", ("'bogus'", "tcp://HOST:PORT")),
     ("http://127.0.0.1:8787/status", ("http://", "web address")),
