@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import csv
+import io
 import json
 import math
 import os
@@ -22,6 +23,7 @@ from pathlib import Path
 from typing import Any, TextIO
 
 from drill_sim_ros import string_cli
+from drill_sim_ros.archive.output import open_output
 from drill_sim_ros.control import closed_loop_cli
 from drill_sim_ros.model import analysis, telemetry
 from drill_sim_ros.model import kernel as k
@@ -113,7 +115,8 @@ def build_parser() -> argparse.ArgumentParser:
     run = sub.add_parser("run", help="one run; summary or --json")
     _add_model_args(run)
     run.add_argument("--json", action="store_true", help="print one JSON object")
-    run.add_argument("--trace", type=Path, help="write samples to this CSV file")
+    run.add_argument("--trace", type=Path, help="write samples to this CSV file (a new file)")
+    run.add_argument("--overwrite", action="store_true", help="replace an existing --trace file")
     run.add_argument("--trace-every", type=int, default=100, help="a trace row every K steps")
     sweep = sub.add_parser("sweep", help="repeat a run over values of one group; JSON lines")
     _add_model_args(sweep)
@@ -382,7 +385,8 @@ def _cmd_run(args: argparse.Namespace) -> int:
     spec = _resolve(args)
     progress = args.progress or sys.stderr.isatty()
     if args.trace:
-        with args.trace.open("w", newline="") as stream:
+        trace = open_output(args.trace, args.overwrite)      # refused before the run
+        with io.TextIOWrapper(trace, encoding="utf-8", newline="") as stream:
             result = simulate(spec, stream, args.trace_every, progress)
     else:
         result = simulate(spec, progress=progress)
