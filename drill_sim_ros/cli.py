@@ -10,8 +10,11 @@ from __future__ import annotations
 
 import argparse
 import csv
+import io
 import json
 import math
+import os
+import signal
 import sys
 import time
 from collections.abc import Iterator, Sequence
@@ -20,6 +23,7 @@ from pathlib import Path
 from typing import Any, TextIO
 
 from drill_sim_ros import string_cli
+from drill_sim_ros.archive.output import open_output
 from drill_sim_ros.control import closed_loop_cli
 from drill_sim_ros.model import analysis, telemetry
 from drill_sim_ros.model import kernel as k
@@ -111,7 +115,8 @@ def build_parser() -> argparse.ArgumentParser:
     run = sub.add_parser("run", help="one run; summary or --json")
     _add_model_args(run)
     run.add_argument("--json", action="store_true", help="print one JSON object")
-    run.add_argument("--trace", type=Path, help="write samples to this CSV file")
+    run.add_argument("--trace", type=Path, help="write samples to this CSV file (a new file)")
+    run.add_argument("--overwrite", action="store_true", help="replace an existing --trace file")
     run.add_argument("--trace-every", type=int, default=100, help="a trace row every K steps")
     sweep = sub.add_parser("sweep", help="repeat a run over values of one group; JSON lines")
     _add_model_args(sweep)
@@ -380,7 +385,8 @@ def _cmd_run(args: argparse.Namespace) -> int:
     spec = _resolve(args)
     progress = args.progress or sys.stderr.isatty()
     if args.trace:
-        with args.trace.open("w", newline="") as stream:
+        trace = open_output(args.trace, args.overwrite)      # refused before the run
+        with io.TextIOWrapper(trace, encoding="utf-8", newline="") as stream:
             result = simulate(spec, stream, args.trace_every, progress)
     else:
         result = simulate(spec, progress=progress)
@@ -390,6 +396,10 @@ def _cmd_run(args: argparse.Namespace) -> int:
 
 def _cmd_sweep(args: argparse.Namespace) -> int:
     values = _sweep_values(args.values)
+    fractional = [v for v in values if args.vary == "n" and v != round(v)]
+    if fractional:
+        raise DrillSimError(f"--values {args.values!r}: n = {fractional[0]:g} is not a whole "
+                            "number (n counts the blades; it is never rounded)")
     progress = args.progress or sys.stderr.isatty()
     for value in values:
         setattr(args, args.vary, int(value) if args.vary == "n" else value)
@@ -438,6 +448,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         print(f"drill_sim {args.command}: interrupted", file=sys.stderr)
         return 130
+    except BrokenPipeError:        # the reader went away (`drill_sim params | head`)
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())   # no flush error
+        return 128 + signal.SIGPIPE
 
 
 if __name__ == "__main__":

@@ -206,6 +206,9 @@ def test_config_comments_point_to_what_exists() -> None:
     for path in sorted((ROOT / "config").rglob("*.yaml")):
         problems += [f"{path.name}: {p}"
                      for p in broken_repo_paths(yaml_comments(path.read_text("utf-8")))]
+    for path in sorted((ROOT / "config").rglob("*.xml")):         # the Fast DDS profile
+        comments = "\n".join(re.findall(r"<!--(.*?)-->", path.read_text("utf-8"), re.DOTALL))
+        problems += [f"{path.name}: {p}" for p in broken_repo_paths(comments)]
     assert problems == []
 
 

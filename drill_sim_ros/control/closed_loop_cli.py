@@ -114,6 +114,9 @@ def _plot_target(path: Path | None, overwrite: bool) -> Path | None:
     """A writable temporary file beside ``--plot`` (checked before the run), or None."""
     if path is None:
         return None
+    if path.is_dir():
+        raise DrillSimError(f"--plot {path} is a directory; give a file name such as "
+                            f"{path / 'run.png'}")
     if path.suffix.lower() not in PLOT_SUFFIXES:
         raise DrillSimError(f"--plot {path}: unknown suffix {path.suffix!r}; use one of "
                             f"{', '.join(PLOT_SUFFIXES)}")

@@ -213,12 +213,16 @@ def check_speed_loop(drive: TopDrive, dtau: float, scales: Scales) -> None:
     if a < 2.0 and 2.0 * a + b < 4.0:
         return
     si = drive.physical(scales)
-    kp_max = min(2.0, (4.0 - b) / 2.0) * drive.inertia_ratio / dtau * scales.torque_nm \
-        * scales.time_s
+    if b < 4.0:       # a smaller kp is stable at this ki
+        kp_max = min(2.0, (4.0 - b) / 2.0) * drive.inertia_ratio / dtau * scales.torque_nm \
+            * scales.time_s
+        bound = f"kp_nm_s < {kp_max:.6g} holds at this ki_nm"
+    else:             # no kp is: ki alone breaks the second condition
+        bound = f"ki_nm < {4.0 * drive.inertia_ratio / dtau**2 * scales.torque_nm:.6g} is needed"
     raise ParameterError(
         f"top_drive.kp_nm_s = {si.kp_nm_s:.6g} (ki_nm = {si.ki_nm:.6g}) makes the drive's "
         f"speed loop unstable at this time step: kp dt / J = {a:.3g} must be < 2 and "
-        f"2 kp dt / J + ki dt^2 / J = {2 * a + b:.3g} < 4; kp_nm_s < {kp_max:.6g} holds")
+        f"2 kp dt / J + ki dt^2 / J = {2 * a + b:.3g} must be < 4; {bound}")
 
 
 def _from_dict(cls: type, values: dict[str, Any]) -> Any:

@@ -722,9 +722,9 @@ def main(args: list[str] | None = None) -> int:
     """Console script ``sim_node`` (``ros2 run drill_sim_ros sim_node``)."""
     try:
         init_ros(args)
-    except ParameterError as exc:
+    except ParameterError as exc:               # a user's mistake: one line, exit 2
         rclpy.logging.get_logger(topics.NODE_NAME).fatal(str(exc))
-        return 1
+        return 2
     # A closed terminal (SIGHUP) stops the node like Ctrl-C or SIGTERM, so the recording is
     # finished instead of cut off without its summary.
     signal.signal(signal.SIGHUP, lambda *_: rclpy.try_shutdown())
@@ -746,9 +746,9 @@ def main(args: list[str] | None = None) -> int:
         if rclpy.ok():
             raise
         # SIGTERM shut the context down while the executor built its wait set: a clean stop.
-    except (DrillSimError, ValueError) as exc:
+    except (DrillSimError, ValueError) as exc:  # refused at start (record.path, preset, ...)
         rclpy.logging.get_logger(topics.NODE_NAME).fatal(str(exc))
-        return 1
+        return 2
     finally:
         if node is not None:
             node.destroy_node()

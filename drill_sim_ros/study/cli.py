@@ -9,6 +9,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from drill_sim_ros.archive.output import check_output, commit, temporary_beside
 from drill_sim_ros.model.errors import DrillSimError
 from drill_sim_ros.study.progress import MapProgress
 
@@ -43,6 +44,7 @@ def add_parsers(sub: Any, add_model_args: Callable[[argparse.ArgumentParser], No
     p = sub.add_parser("map-plot", help="draw a map file (regime map or one variable)")
     p.add_argument("map", type=Path, help="NetCDF file written by drill_sim map")
     p.add_argument("-o", "--output", type=Path, default=None, help="PNG (default: MAP.png)")
+    p.add_argument("--overwrite", action="store_true", help="replace an existing --output")
     p.add_argument("--var", default="regime", help="variable to draw (default regime)")
     p.add_argument("--at", action="append", default=[], metavar="NAME=VALUE",
                    help="for maps of more than two axes: the value of an extra axis "
@@ -107,9 +109,14 @@ def cmd_map(args: argparse.Namespace, resolve: Callable[[argparse.Namespace], An
 def cmd_map_plot(args: argparse.Namespace) -> int:
     from drill_sim_ros.study import plot, store
     ds = store.load(args.map)
-    out = args.output or args.map.with_suffix(".png")
+    out = check_output(args.output or args.map.with_suffix(".png"), args.overwrite)
     at = dict(_parse_at(text) for text in args.at)
-    plot.plot_file(ds, args.var, out, at)
+    temporary = temporary_beside(out, args.overwrite, keep_suffix=True)
+    try:
+        plot.plot_file(ds, args.var, temporary, at)
+        commit(temporary, out, args.overwrite)
+    finally:
+        temporary.unlink(missing_ok=True)
     print(f"drill_sim map-plot: wrote {out}")
     return 0
 

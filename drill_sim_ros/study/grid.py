@@ -97,7 +97,9 @@ class MapSpec:
         if self.control is not None:
             validate_control(self)
         if self.size > MAX_POINTS:
-            raise ParameterError(f"the map has {self.size:,} points; at most {MAX_POINTS:,}")
+            shape = " x ".join(f"{n:,}" for n in self.shape)
+            raise ParameterError(f"--vary: the map has {self.size:,} points ({shape}); at "
+                                 f"most {MAX_POINTS:,} (every point is held in memory)")
         validate_corners(self)
 
     @property
@@ -126,7 +128,8 @@ class MapSpec:
 
 
 def validate_axes(axes: tuple[Axis, ...], physical: bool) -> None:
-    """Known names, no repeats, at most one W0 and one omega0 axis, finite values."""
+    """Known names, no repeats, at most one W0 and one omega0 axis, finite values, whole
+    numbers of blades."""
     allowed = DIMENSIONLESS_AXES + (PHYSICAL_AXES if physical else ())
     names = [a.name for a in axes]
     if not axes:
@@ -138,6 +141,10 @@ def validate_axes(axes: tuple[Axis, ...], physical: bool) -> None:
                                  f"{', '.join(allowed)}{extra}")
         if not a.values or not all(math.isfinite(v) for v in a.values):
             raise ParameterError(f"--vary {a.name}: values must be finite, at least one")
+        fractional = [v for v in a.values if a.name == "n" and v != round(v)]
+        if fractional:
+            raise ParameterError(f"--vary n: {fractional[0]:g} is not a whole number (n counts "
+                                 "the blades; it is never rounded), e.g. n=2:8:7 or n=4,6")
     for group in (_W_AXES, _OMEGA_AXES, names):
         chosen = [n for n in names if n in group]
         if len(chosen) > 1 and group is not names:
@@ -190,7 +197,7 @@ def point_params(base: DimensionlessParams, values: dict[str, float],
     """``base`` with the axis ``values`` applied (lambda before W0 = ratio * lambda)."""
     changes: dict[str, float | int] = {g: values[g] for g in GROUPS if g in values}
     if "n" in changes:
-        changes["n"] = round(changes["n"])
+        changes["n"] = int(changes["n"])          # a whole number (validate_axes)
     lam = float(changes.get("lam", base.lam))
     if "w0_ratio" in values:
         changes["w0"] = values["w0_ratio"] * lam

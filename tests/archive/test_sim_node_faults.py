@@ -33,7 +33,7 @@ def _sim(*ros_args: str, timeout_s: float = 60) -> subprocess.CompletedProcess:
 
 def _one_fatal_line(done: subprocess.CompletedProcess) -> str:
     lines = [line for line in (done.stdout + done.stderr).splitlines() if line.strip()]
-    assert done.returncode == 1, done.stdout + done.stderr
+    assert done.returncode == 2, done.stdout + done.stderr          # a user's mistake
     assert len(lines) == 1 and "[FATAL]" in lines[0], lines
     return lines[0]
 

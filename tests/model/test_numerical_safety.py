@@ -37,10 +37,29 @@ def test_a_run_away_state_ends_as_a_fault() -> None:
     assert sim.fault is not None
 
 
-def test_the_stiff_drive_of_the_issue_is_one_line() -> None:
-    result = drill_sim("run", "--params", "field_8p5in_shale_lumped", "--t-end", "1",
-                       "--drive-kp", "1e6", "--drive-max-torque", "inf", "--top-drive",
-                       "speed", timeout=120)
+@pytest.mark.parametrize("preset", [
+    ("field_8p5in_shale",),                            # the issue's command exactly
+    ("field_8p5in_shale_lumped", "--top-drive", "speed"),
+])
+def test_the_stiff_drive_of_the_issue_is_one_line(preset: tuple[str, ...]) -> None:
+    result = drill_sim("run", "--params", *preset, "--t-end", "1", "--drive-kp", "1e6",
+                       "--drive-max-torque", "inf", timeout=120)
     assert result.returncode == 2, result.stderr
     lines = result.stderr.strip().splitlines()
     assert len(lines) == 1 and "kp dt / J" in lines[0] and "Traceback" not in result.stderr
+    assert result.stdout == ""
+
+
+def test_an_integral_gain_too_large_for_any_kp_names_the_ki_bound() -> None:
+    """With b = ki dt^2 / J >= 4 no kp is stable; the bound is then on ki: in SI,
+    ki_nm < 4 J / dt^2 (J the drive's inertia in kg m^2, dt the step in s)."""
+    dtau = 1e-4
+    j = PRESET.top_drive.inertia_ratio
+    drive = PRESET.top_drive.with_(kp=0.1 * j / dtau, ki=4.1 * j / dtau**2)
+    with pytest.raises(ParameterError) as caught:
+        Simulator(PRESET.params, SimConfig(dtau=dtau), top_drive=drive, scales=PRESET.scales)
+    si = PRESET.top_drive.physical(PRESET.scales)
+    dt_s = dtau * PRESET.scales.time_s
+    bound = 4.0 * si.inertia_kg_m2 / dt_s**2
+    message = str(caught.value)
+    assert f"ki_nm < {bound:.6g}" in message and "kp_nm_s <" not in message, message

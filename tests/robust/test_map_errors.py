@@ -30,7 +30,10 @@ MAP = ("map", "--tau-end", "1", "--workers", "1")
 @pytest.mark.parametrize(("vary", "names"), [
     ("omega0=-5:-1:3", ("omega0=-5", "'omega0' = -5.0", "[0, 10000]")),
     ("psi=0,-1", ("psi=0", "'psi' = 0.0", "(0, 1e+07]")),
-    ("n=0.2,1e9", ("n=0.2", "'n' = 0", "[1, 64]")),
+    ("n=0.2,1e9", ("n:", "0.2", "not a whole number")),      # never rounded (to 0)
+    ("n=2.5,3", ("n:", "2.5", "not a whole number")),        # never rounded (to 2)
+    ("n=1:6:4", ("n:", "2.66667", "not a whole number")),    # 1, 2.67, 4.33, 6
+    ("n=1,1e9", ("n=1e+09", "'n' = 1000000000", "[1, 64]")),
     ("beta=1e308,2", ("beta=1e+308", "[0, 10]")),
 ])
 def test_axis_values_out_of_range_are_refused_on_the_client(capsys, tmp_path: Path,
@@ -47,6 +50,16 @@ def test_a_corner_of_two_axes_is_checked(capsys, tmp_path: Path) -> None:
     rc, _, err = run_cli(capsys, *MAP, "--vary", "lam=1,100", "--vary", "w0_ratio=1,300",
                          "--out", str(out))
     one_error_line(rc, err, "lam=100, w0_ratio=300", "'w0' = 30000")
+    assert not out.exists()
+
+
+def test_a_map_larger_than_the_bound_is_refused_before_any_work(capsys,
+                                                                 tmp_path: Path) -> None:
+    out = tmp_path / "map.nc"
+    rc, _, err = run_cli(capsys, *MAP, "--vary", "beta=0.1:0.5:1001", "--vary",
+                         "psi=10:100:1000", "--out", str(out))
+    one_error_line(rc, err, "--vary", "1,001,000 points", "1,001 x 1,000",
+                   "at most 1,000,000")
     assert not out.exists()
 
 
