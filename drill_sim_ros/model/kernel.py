@@ -200,14 +200,14 @@ def _distributed_ends(prm: np.ndarray, wave: np.ndarray, wave_i: np.ndarray,
     hook's speeds."""
     dt = prm[P_DT]
     parts_t, parts = int(prm[P_PARTS_T]), wave_i.shape[1]
-    z = wave_f[sg.W_Z]
+    z = sg.W_Z                                # (in place: no row view, see sg.scatter)
     b_top_t, a_bot_t = sg.arriving(wave, wave_i, 0, parts_t)
     b_top_a, a_bot_a = sg.arriving(wave, wave_i, parts_t, parts)
-    v0, kick_v, f_ext = sg.bottom_end(a_bot_a, z[parts - 1], 0.0, v, dt)
-    omega0, kick_w, t_ext = sg.bottom_end(a_bot_t, z[parts_t - 1], prm[P_BIT_INERTIA],
-                                          omega, dt)
-    return (v0, kick_v, f_ext, omega0, kick_w, t_ext, b_top_t + z[0] * omega_s,
-            b_top_a + z[parts_t] * v_hook)
+    v0, kick_v, f_ext = sg.bottom_end(a_bot_a, wave_f[z, parts - 1], 0.0, v, dt)
+    omega0, kick_w, t_ext = sg.bottom_end(a_bot_t, wave_f[z, parts_t - 1],
+                                          prm[P_BIT_INERTIA], omega, dt)
+    return (v0, kick_v, f_ext, omega0, kick_w, t_ext, b_top_t + wave_f[z, 0] * omega_s,
+            b_top_a + wave_f[z, parts_t] * v_hook)
 
 
 @njit(cache=True, inline="always")
@@ -221,14 +221,15 @@ def _distributed_move(prm: np.ndarray, wave: np.ndarray, wave_i: np.ndarray,
     the step and its loop integral."""
     v_hook, hook_int = _hook(prm, w_app, f_top, hook_int)
     parts_t, parts = int(prm[P_PARTS_T]), wave_i.shape[1]
-    z = wave_f[sg.W_Z]
+    z = sg.W_Z                                # (in place: no row view, see sg.scatter)
     b_top_t, a_bot_t = sg.arriving(wave, wave_i, 0, parts_t)
     b_top_a, a_bot_a = sg.arriving(wave, wave_i, parts_t, parts)
     anechoic = prm[P_OFF_BOTTOM] == 2.0       # nothing comes back from below
-    sg.scatter(wave, wave_i, wave_f, 0, parts_t, b_top_t + 2.0 * z[0] * omega_s_next,
-               0.0 if anechoic else a_bot_t - 2.0 * z[parts_t - 1] * omega_new)
-    sg.scatter(wave, wave_i, wave_f, parts_t, parts, b_top_a + 2.0 * z[parts_t] * v_hook,
-               a_bot_a - 2.0 * z[parts - 1] * v_new)
+    sg.scatter(wave, wave_i, wave_f, 0, parts_t, b_top_t + 2.0 * wave_f[z, 0] * omega_s_next,
+               0.0 if anechoic else a_bot_t - 2.0 * wave_f[z, parts_t - 1] * omega_new)
+    sg.scatter(wave, wave_i, wave_f, parts_t, parts,
+               b_top_a + 2.0 * wave_f[z, parts_t] * v_hook,
+               a_bot_a - 2.0 * wave_f[z, parts - 1] * v_new)
     return v_hook, hook_int
 
 
@@ -318,8 +319,8 @@ def advance(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarra
         probe += w_f + tob + motor
         stats, n_rows, countdown = _book(stats, out, n_rows, countdown, every, step * dt, tau_avg,(
             u, v, phi, omega, phi_s, omega_s, w_app, wob, tob, doc, w_f, t_top, mode, motor,
-            omega_ref, f_top, omega if wave is None else sg.speed_at_top_of(wave, wave_i,
-                                                                            wave_f, bha)))
+            omega_ref, f_top, omega if wave is None or countdown != 0 else
+            sg.speed_at_top_of(wave, wave_i, wave_f, bha)))   # (read for a row only)
         if wave is None:    # kinematic: the angle moves at the step's starting speed
             phi_s += (omega_s if td_mode == TD_KINEMATIC else omega_s_next) * dt
         else:
