@@ -289,6 +289,18 @@ def advance(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarra
             wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray,
             n_steps: int, every: int, exact: bool) -> tuple[int, int]:
     """Up to ``n_steps`` of bit law, drive and string (module doc). Returns (status, rows)."""
+    return _steps(st, prm, tgt, profile, hist, meta, acc, out, wave, wave_i, wave_f, n_steps,
+                  every, exact, False)
+
+
+@njit(cache=True)
+def _steps(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarray,
+           hist: np.ndarray, meta: np.ndarray, acc: np.ndarray, out: np.ndarray,
+           wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray,
+           n_steps: int, every: int, exact: bool, dry: bool) -> tuple[int, int]:
+    """:func:`advance`; ``dry``: the first step only as far as its sample row (the state at
+    its start, with the forces of the law), then back with nothing moved: the state, the
+    profile or history, the string and the statistics are read, never written."""
     u, v, phi, omega, phi_s, omega_s, w_app, stuck, node, frac, h_old, step, omega_ref, \
         integral, motor, v_hook, hook_int, head, count, cursor = _unpack(st, meta)
     dt, tau_avg, beta, lam, n_blades, psi, off_bottom, layer_u, cut_factor, sector, tgt_w, \
@@ -321,6 +333,8 @@ def advance(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarra
             u, v, phi, omega, phi_s, omega_s, w_app, wob, tob, doc, w_f, t_top, mode, motor,
             omega_ref, f_top, omega if wave is None or countdown != 0 else
             sg.speed_at_top_of(wave, wave_i, wave_f, bha)))   # (read for a row only)
+        if dry:
+            return STATUS_OK, n_rows
         if wave is None:    # kinematic: the angle moves at the step's starting speed
             phi_s += (omega_s if td_mode == TD_KINEMATIC else omega_s_next) * dt
         else:
@@ -417,11 +431,10 @@ def advance_and_sample(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile
                        n_steps: int, every: int, exact: bool) -> tuple[int, int]:
     """:func:`advance`, then the sample of the state it ended in, in the next row of ``out``.
 
-    That sample is what the next step records at its start: it is read from one step taken
-    on copies of the state, the rock profile (or history), the string and the statistics,
-    so the simulation itself does not move. ``n_steps = 0`` gives the sample of the current
-    state. Returns ``(status, rows_written)`` with the end sample counted; on a failed or
-    early-stopped status the end sample is not taken.
+    That sample is what the next step records at its start: the row of a dry step
+    (:func:`_steps`), so the simulation itself does not move. ``n_steps = 0`` gives the
+    sample of the current state. Returns ``(status, rows_written)`` with the end sample
+    counted; on a failed or early-stopped status the end sample is not taken.
     """
     status, rows = STATUS_OK, 0
     if n_steps > 0:
@@ -429,18 +442,9 @@ def advance_and_sample(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile
                                wave_f, n_steps, every, exact)
     if status != STATUS_OK or rows >= out.shape[0]:
         return status, rows
-    one = np.int64(1)               # not the literal 1: that would compile advance twice
-    if wave is None:
-        advance(st.copy(), prm, tgt, profile if exact else profile.copy(),
-                hist.copy() if exact else hist, meta.copy(), acc.copy(), out[rows:rows + 1],
-                wave, wave_i, wave_f, one, one, exact)
-    else:                           # one step undone: the slots it writes, the positions
-        slots = sg.step_slots(wave_i)
-        saved = wave[slots]
-        advance(st.copy(), prm, tgt, profile if exact else profile.copy(),
-                hist.copy() if exact else hist, meta.copy(), acc.copy(), out[rows:rows + 1],
-                wave, wave_i.copy(), wave_f, one, one, exact)
-        wave[slots] = saved
+    one = np.int64(1)               # not the literal 1: that would compile _steps twice
+    _steps(st, prm, tgt, profile, hist, meta, acc, out[rows:rows + 1], wave, wave_i, wave_f,
+           one, one, exact, True)
     return status, rows + 1
 
 

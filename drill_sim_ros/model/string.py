@@ -348,18 +348,6 @@ def scatter(wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray, lo: int, h
         wave_i[W_POS, j] = pos if pos < wave_i[W_LEN, j] else 0
 
 
-@njit(cache=True)
-def step_slots(wave_i: np.ndarray) -> np.ndarray:
-    """The buffer slots the next step writes (a and b of every part): saving and restoring
-    them undoes a step (with the positions), without copying the whole buffer."""
-    parts = wave_i.shape[1]
-    slots = np.empty(2 * parts, dtype=np.int64)
-    for j in range(parts):
-        slots[2 * j] = wave_i[W_OFF, j] + wave_i[W_POS, j]
-        slots[2 * j + 1] = wave_i[W_OFF, j] + wave_i[W_LEN, j] + wave_i[W_POS, j]
-    return slots
-
-
 @njit(cache=True, inline="always")
 def speed_at_top_of(wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray,
                     j: int) -> float:
