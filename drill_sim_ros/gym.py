@@ -57,11 +57,7 @@ from drill_sim_ros.model.telemetry import TELEMETRY_INDEX as F
 ENV_ID = "DrillStickSlip-v0"
 OBSERVATION = ("drive_speed_rad_s", "motor_torque_nm", "string_torque_nm", "hook_load_n",
                "applied_wob_estimate_n", "speed_setpoint_rad_s", "wob_setpoint_n")
-_MEASURED = np.array([F["drive_speed_measured_rad_s"], F["motor_torque_measured_nm"],
-                      F["string_torque_measured_nm"], F["hook_load_measured_n"],
-                      F["applied_wob_estimate_n"]])
-_BIT_RPM, _MOTOR, _ROP, _TIME = F["bit_rpm"], F["motor_torque_nm"], F["rop_m_s"], \
-    F["sim_time_s"]
+_BIT_RPM, _MOTOR, _ROP = F["bit_rpm"], F["motor_torque_nm"], F["rop_m_s"]
 
 
 def resolve_scenario(scenario: str | Path | Scenario | None, preset: str | None = None,
@@ -117,23 +113,22 @@ class DrillStickSlipEnv(gymnasium.Env):
         row = self.bench.row
         self._rop0 = max(float(row[_ROP]), 1e-12)
         self._last_torque = float(row[_MOTOR])
-        return self._observation(), self._info()
+        return self._observe()
 
     def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
         value = float(np.asarray(action, dtype=np.float64).reshape(-1)[0])
-        command = self._command(value)
         try:
-            row = self.bench.step(command)
+            row = self.bench.step(self._command(value))
         except NumericalFault as exc:
-            info = self._info()
+            obs, info = self._observe()
             info["fault"] = str(exc)
-            return self._observation(), 0.0, True, False, info
-        reward = self._reward(row)
-        return self._observation(), reward, False, self.bench.done, self._info()
+            return obs, 0.0, True, False, info
+        obs, info = self._observe()
+        return obs, self._reward(row), False, self.bench.done, info
 
     def _command(self, value: float) -> Command:
-        time_s = self.bench.stamp_ns / 1e9
-        wob_n = self.bench.schedule.wob_at(time_s)
+        """The action as the command of the newest sample (the WOB from the schedule)."""
+        wob_n = self._wob_setpoint_n
         if math.isnan(value):
             return Command(wob_n=wob_n)
         if self.scenario.mode == "speed":
@@ -141,8 +136,9 @@ class DrillStickSlipEnv(gymnasium.Env):
         return Command(motor_torque_nm=value, wob_n=wob_n)
 
     def _reward(self, row: np.ndarray) -> float:
-        """The module doc's reward of the sample ``row`` at the end of a step."""
-        omega0_rpm = self.bench.schedule.rpm_at(float(row[_TIME]))
+        """The module doc's reward of the sample ``row`` at the end of a step (the newest;
+        omega_0 is the setpoint :meth:`_observe` read at its time)."""
+        omega0_rpm = self._rpm_setpoint
         speed = (float(row[_BIT_RPM]) - omega0_rpm) / omega0_rpm if omega0_rpm > 0 else 0.0
         torque = float(row[_MOTOR])
         rate = (torque - self._last_torque) / self.torque_ref_nm
@@ -150,18 +146,18 @@ class DrillStickSlipEnv(gymnasium.Env):
         return -speed * speed - self.torque_rate_weight * rate * rate + \
             self.rop_weight * float(row[_ROP]) / self._rop0
 
-    def _observation(self) -> np.ndarray:
+    def _observe(self) -> tuple[np.ndarray, dict[str, Any]]:
+        """The newest sample's observation and info (its SurfaceMeasurement, what a
+        controller reads); the operator's setpoints at its time, kept for the step."""
         bench = self.bench
         time_s = bench.stamp_ns / 1e9
-        out = np.empty(len(OBSERVATION))
-        out[:5] = bench.row[_MEASURED]
-        out[5] = bench.schedule.rpm_at(time_s) / RPM_PER_RAD_S
-        out[6] = bench.schedule.wob_at(time_s)
-        return out
-
-    def _info(self) -> dict[str, Any]:
-        """The step's measurement (a SurfaceMeasurement, what a controller reads)."""
-        return {"measurement": self.bench.measurement(), "period": self.bench.period}
+        self._rpm_setpoint = bench.schedule.rpm_at(time_s)
+        self._wob_setpoint_n = bench.schedule.wob_at(time_s)
+        m = bench.measurement()
+        obs = np.array((m.drive_speed_rad_s, m.motor_torque_nm, m.string_torque_nm,
+                        m.hook_load_n, m.applied_wob_estimate_n,
+                        self._rpm_setpoint / RPM_PER_RAD_S, self._wob_setpoint_n))
+        return obs, {"measurement": m, "period": bench.period}
 
 
 if ENV_ID not in gymnasium.registry:

@@ -42,15 +42,16 @@ class SurfaceMeasurement:
     applied_wob_estimate_n: float = math.nan   # submerged string weight - hook load
 
 
+# the telemetry fields of a SurfaceMeasurement's values, in its order after time_s
+SURFACE_FIELDS = np.array([F["drive_speed_measured_rad_s"], F["motor_torque_measured_nm"],
+                           F["string_torque_measured_nm"], F["hook_load_measured_n"],
+                           F["applied_wob_estimate_n"]])
+
+
 def measurement_of_row(row: np.ndarray, time_ns: int) -> SurfaceMeasurement:
     """The surface measurement in a telemetry row (``TELEMETRY_FIELDS`` order) stamped
     ``time_ns``; the time is ``time_ns / 1e9`` as a subscriber computes it from the stamp."""
-    return SurfaceMeasurement(time_s=time_ns / 1e9,
-                              drive_speed_rad_s=float(row[F["drive_speed_measured_rad_s"]]),
-                              motor_torque_nm=float(row[F["motor_torque_measured_nm"]]),
-                              string_torque_nm=float(row[F["string_torque_measured_nm"]]),
-                              hook_load_n=float(row[F["hook_load_measured_n"]]),
-                              applied_wob_estimate_n=float(row[F["applied_wob_estimate_n"]]))
+    return SurfaceMeasurement(time_ns / 1e9, *row[SURFACE_FIELDS].tolist())
 
 
 @dataclass(frozen=True)

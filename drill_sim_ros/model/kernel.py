@@ -192,56 +192,43 @@ def _lumped_ends(psi: float, dt: float, phi_s: float, phi: float, v: float, omeg
 
 
 @njit(cache=True, inline="always")
-def _distributed_ends(prm: np.ndarray, wave: np.ndarray, wave_i: np.ndarray,
-                      wave_f: np.ndarray, omega_s: float, v: float, omega: float,
+def _string_params(prm: np.ndarray, wave_i: np.ndarray | None) -> tuple:
+    """The distributed string's parameters for a run, read once (like :func:`_law_params`):
+    the torsional parts, all parts, the bit's lumped inertia, the hook's WOB loop gains, a
+    fixed hook (off bottom) and an anechoic bottom."""
+    return (int(prm[P_PARTS_T]), 0 if wave_i is None else wave_i.shape[1], prm[P_BIT_INERTIA],
+            prm[P_HOOK_KP], prm[P_HOOK_KI], prm[P_OFF_BOTTOM] != 0.0, prm[P_OFF_BOTTOM] == 2.0)
+
+
+@njit(cache=True, inline="always")
+def _distributed_ends(wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray,
+                      parts_t: int, parts: int, bit_inertia: float, dt: float,
+                      omega_s: float, v: float, omega: float,
                       v_hook: float) -> tuple[float, ...]:
     """The same for a distributed string (module string): the arriving waves and the end
     impedances, with the bit's lumped inertia; at the top b + Z w with the drive's and the
     hook's speeds."""
-    dt = prm[P_DT]
-    parts_t, parts = int(prm[P_PARTS_T]), wave_i.shape[1]
-    z = wave_f[sg.W_Z]
+    z = sg.W_Z                                # (in place: no row view, see sg.scatter)
     b_top_t, a_bot_t = sg.arriving(wave, wave_i, 0, parts_t)
     b_top_a, a_bot_a = sg.arriving(wave, wave_i, parts_t, parts)
-    v0, kick_v, f_ext = sg.bottom_end(a_bot_a, z[parts - 1], 0.0, v, dt)
-    omega0, kick_w, t_ext = sg.bottom_end(a_bot_t, z[parts_t - 1], prm[P_BIT_INERTIA],
+    v0, kick_v, f_ext = sg.bottom_end(a_bot_a, wave_f[z, parts - 1], 0.0, v, dt)
+    omega0, kick_w, t_ext = sg.bottom_end(a_bot_t, wave_f[z, parts_t - 1], bit_inertia,
                                           omega, dt)
-    return (v0, kick_v, f_ext, omega0, kick_w, t_ext, b_top_t + z[0] * omega_s,
-            b_top_a + z[parts_t] * v_hook)
+    return (v0, kick_v, f_ext, omega0, kick_w, t_ext, b_top_t + wave_f[z, 0] * omega_s,
+            b_top_a + wave_f[z, parts_t] * v_hook)
 
 
 @njit(cache=True, inline="always")
-def _distributed_move(prm: np.ndarray, wave: np.ndarray, wave_i: np.ndarray,
-                      wave_f: np.ndarray, w_app: float, f_top: float, hook_int: float,
-                      omega_s_next: float, v_new: float, omega_new: float
-                      ) -> tuple[float, float]:
-    """The distributed string moves on by one step: both lines take what the drive, the
-    hook (its WOB loop on ``f_top``, :func:`_hook`) and the bit send into them
-    (a = b + 2 Z w at the top, b = a - 2 Z w at the bottom). Returns the hook's speed over
-    the step and its loop integral."""
-    v_hook, hook_int = _hook(prm, w_app, f_top, hook_int)
-    parts_t, parts = int(prm[P_PARTS_T]), wave_i.shape[1]
-    z = wave_f[sg.W_Z]
-    b_top_t, a_bot_t = sg.arriving(wave, wave_i, 0, parts_t)
-    b_top_a, a_bot_a = sg.arriving(wave, wave_i, parts_t, parts)
-    anechoic = prm[P_OFF_BOTTOM] == 2.0       # nothing comes back from below
-    sg.scatter(wave, wave_i, wave_f, 0, parts_t, b_top_t + 2.0 * z[0] * omega_s_next,
-               0.0 if anechoic else a_bot_t - 2.0 * z[parts_t - 1] * omega_new)
-    sg.scatter(wave, wave_i, wave_f, parts_t, parts, b_top_a + 2.0 * z[parts_t] * v_hook,
-               a_bot_a - 2.0 * z[parts - 1] * v_new)
-    return v_hook, hook_int
-
-
-@njit(cache=True, inline="always")
-def _hook(prm: np.ndarray, w_app: float, f_top: float, integral: float) -> tuple[float, float]:
-    """The hook's speed over the step: a PI loop on the applied-WOB error, so the string
-    force at the top (the applied WOB the rig infers from the hook load) follows W_APP;
-    zero (a fixed hook) off bottom. Returns ``(speed, integral)``."""
-    if prm[P_OFF_BOTTOM] != 0.0:
+def _hook(kp: float, ki: float, fixed: bool, dt: float, w_app: float, f_top: float,
+          integral: float) -> tuple[float, float]:
+    """The hook's speed over the step: a PI loop (gains ``kp``, ``ki``) on the applied-WOB
+    error, so the string force at the top (the applied WOB the rig infers from the hook
+    load) follows W_APP; zero when ``fixed`` (off bottom). Returns ``(speed, integral)``."""
+    if fixed:
         return 0.0, integral
     err = w_app - f_top
-    integral += prm[P_HOOK_KI] * err * prm[P_DT]
-    return prm[P_HOOK_KP] * err + integral, integral
+    integral += ki * err * dt
+    return kp * err + integral, integral
 
 
 @njit(cache=True, inline="always")
@@ -251,21 +238,6 @@ def _cutting(cut_factor: float, off_bottom: bool, doc: float) -> float:
     if off_bottom:
         return -1.0
     return doc if cut_factor == 1.0 else cut_factor * doc
-
-
-@njit(cache=True, inline="always")
-def _book(stats: tuple, out: np.ndarray, n_rows: int, countdown: int, every: int, tau: float,
-          tau_avg: float, x: tuple) -> tuple:
-    """The step's statistics, and its sample row when one is due (``x``: the columns of
-    :func:`_write_row` after tau). Returns (stats, rows written, countdown)."""
-    u, v, phi, omega, phi_s, omega_s, w_app, wob, tob, doc, w_f, t_top, mode, motor, \
-        omega_ref, f_top, omega_bha = x
-    stats = _accumulate(stats, tau, tau_avg, mode, w_f, tob, doc, wob, omega, t_top, v)
-    if countdown == 0 and n_rows < out.shape[0]:
-        _write_row(out[n_rows], tau, u, v, phi, omega, phi_s, omega_s, w_app, wob, tob, doc,
-                   w_f, t_top, mode, motor, omega_ref, f_top, omega_bha)
-        n_rows += 1
-    return stats, n_rows, every - 1 if countdown == 0 else countdown - 1
 
 
 @njit(cache=True, inline="always")
@@ -288,6 +260,18 @@ def advance(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarra
             wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray,
             n_steps: int, every: int, exact: bool) -> tuple[int, int]:
     """Up to ``n_steps`` of bit law, drive and string (module doc). Returns (status, rows)."""
+    return _steps(st, prm, tgt, profile, hist, meta, acc, out, wave, wave_i, wave_f, n_steps,
+                  every, exact, False)
+
+
+@njit(cache=True)
+def _steps(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarray,
+           hist: np.ndarray, meta: np.ndarray, acc: np.ndarray, out: np.ndarray,
+           wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray,
+           n_steps: int, every: int, exact: bool, dry: bool) -> tuple[int, int]:
+    """:func:`advance`; ``dry``: the first step only as far as its sample row (the state at
+    its start, with the forces of the law), then back with nothing moved: the state, the
+    profile or history, the string and the statistics are read, never written."""
     u, v, phi, omega, phi_s, omega_s, w_app, stuck, node, frac, h_old, step, omega_ref, \
         integral, motor, v_hook, hook_int, head, count, cursor = _unpack(st, meta)
     dt, tau_avg, beta, lam, n_blades, psi, off_bottom, layer_u, cut_factor, sector, tgt_w, \
@@ -295,6 +279,8 @@ def advance(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarra
     td_mode, tgt_omega, tgt_torque, omega_rate, td_j, td_kp, td_ki, td_max, td_lag, _ = \
         _drive_params(prm, tgt)
     inv_spacing, bha = profile.shape[0] / sector, int(prm[P_BHA_PART])
+    parts_t, parts, bit_inertia, hook_kp, hook_ki, hook_fixed, anechoic = \
+        _string_params(prm, wave_i)
     stats, countdown, n_rows, status, probe = _stats(acc), _first_countdown(step, every), 0, \
         STATUS_OK, 0.0                       # (a NaN probe survives the contact logic)
     for _ in range(n_steps):
@@ -308,7 +294,8 @@ def advance(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarra
                 psi, dt, phi_s, phi, v, omega, w_app)
         else:
             v0, kick_v, f_ext, omega0, kick_w, t_ext, t_top, f_top = _distributed_ends(
-                prm, wave, wave_i, wave_f, omega_s, v, omega, v_hook)
+                wave, wave_i, wave_f, parts_t, parts, bit_inertia, dt, omega_s, v, omega,
+                v_hook)
         v_new, omega_new, w_f, wob, tob, mode, stuck = br.bit_response(
             v0, kick_v, f_ext, omega0, kick_w, t_ext, _cutting(cut_factor, off_bottom, doc),
             stuck, beta, lam)
@@ -316,15 +303,35 @@ def advance(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarra
             td_mode, omega_s, omega_ref, integral, motor, t_top, tgt_omega, tgt_torque,
             omega_rate, td_j, td_kp, td_ki, td_max, td_lag, dt)
         probe += w_f + tob + motor
-        stats, n_rows, countdown = _book(stats, out, n_rows, countdown, every, step * dt, tau_avg,(
-            u, v, phi, omega, phi_s, omega_s, w_app, wob, tob, doc, w_f, t_top, mode, motor,
-            omega_ref, f_top, omega if wave is None else sg.speed_at_top_of(wave, wave_i,
-                                                                            wave_f, bha)))
+        stats = _accumulate(stats, step * dt, tau_avg, mode, w_f, tob, doc, wob, omega, t_top,
+                            v)
+        if countdown == 0 and n_rows < out.shape[0]:    # the sample row of the step's start
+            _write_row(out[n_rows], step * dt, u, v, phi, omega, phi_s, omega_s, w_app, wob,
+                       tob, doc, w_f, t_top, mode, motor, omega_ref, f_top,
+                       omega if wave is None else sg.speed_at_top_of(wave, wave_i, wave_f, bha))
+            n_rows += 1
+        countdown = every - 1 if countdown == 0 else countdown - 1
+        if dry:
+            return STATUS_OK, n_rows
         if wave is None:    # kinematic: the angle moves at the step's starting speed
             phi_s += (omega_s if td_mode == TD_KINEMATIC else omega_s_next) * dt
         else:
-            v_hook, hook_int = _distributed_move(prm, wave, wave_i, wave_f, w_app, f_top,
-                                                 hook_int, omega_s_next, v_new, omega_new)
+            # the string moves on by one step: both lines take what the drive, the hook (its
+            # WOB loop on f_top) and the bit send into them (a = b + 2 Z w at the top,
+            # b = a - 2 Z w at the bottom). Written here, branches first, not in a function
+            # of its own: the arrays handed to an inlined function with branches or loops
+            # are reference-counted every step (about a third of the step, measured).
+            v_hook, hook_int = _hook(hook_kp, hook_ki, hook_fixed, dt, w_app, f_top, hook_int)
+            z = sg.W_Z
+            b_top_t, a_bot_t = sg.arriving(wave, wave_i, 0, parts_t)
+            b_top_a, a_bot_a = sg.arriving(wave, wave_i, parts_t, parts)
+            b_bottom_t = 0.0 if anechoic else \
+                a_bot_t - 2.0 * wave_f[z, parts_t - 1] * omega_new
+            sg.scatter(wave, wave_i, wave_f, 0, parts_t,
+                       b_top_t + 2.0 * wave_f[z, 0] * omega_s_next, b_bottom_t)
+            sg.scatter(wave, wave_i, wave_f, parts_t, parts,
+                       b_top_a + 2.0 * wave_f[z, parts_t] * v_hook,
+                       a_bot_a - 2.0 * wave_f[z, parts - 1] * v_new)
             phi_s += omega_s_next * dt
         omega_s = omega_s_next
         u_new, phi_new = u + v_new * dt, phi + omega_new * dt     # symplectic Euler, eq. C.1
@@ -416,11 +423,10 @@ def advance_and_sample(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile
                        n_steps: int, every: int, exact: bool) -> tuple[int, int]:
     """:func:`advance`, then the sample of the state it ended in, in the next row of ``out``.
 
-    That sample is what the next step records at its start: it is read from one step taken
-    on copies of the state, the rock profile (or history), the string and the statistics,
-    so the simulation itself does not move. ``n_steps = 0`` gives the sample of the current
-    state. Returns ``(status, rows_written)`` with the end sample counted; on a failed or
-    early-stopped status the end sample is not taken.
+    That sample is what the next step records at its start: the row of a dry step
+    (:func:`_steps`), so the simulation itself does not move. ``n_steps = 0`` gives the
+    sample of the current state. Returns ``(status, rows_written)`` with the end sample
+    counted; on a failed or early-stopped status the end sample is not taken.
     """
     status, rows = STATUS_OK, 0
     if n_steps > 0:
@@ -428,18 +434,9 @@ def advance_and_sample(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile
                                wave_f, n_steps, every, exact)
     if status != STATUS_OK or rows >= out.shape[0]:
         return status, rows
-    one = np.int64(1)               # not the literal 1: that would compile advance twice
-    if wave is None:
-        advance(st.copy(), prm, tgt, profile if exact else profile.copy(),
-                hist.copy() if exact else hist, meta.copy(), acc.copy(), out[rows:rows + 1],
-                wave, wave_i, wave_f, one, one, exact)
-    else:                           # one step undone: the slots it writes, the positions
-        slots = sg.step_slots(wave_i)
-        saved = wave[slots]
-        advance(st.copy(), prm, tgt, profile if exact else profile.copy(),
-                hist.copy() if exact else hist, meta.copy(), acc.copy(), out[rows:rows + 1],
-                wave, wave_i.copy(), wave_f, one, one, exact)
-        wave[slots] = saved
+    one = np.int64(1)               # not the literal 1: that would compile _steps twice
+    _steps(st, prm, tgt, profile, hist, meta, acc, out[rows:rows + 1], wave, wave_i, wave_f,
+           one, one, exact, True)
     return status, rows + 1
 
 

@@ -450,7 +450,7 @@ class Simulator:
     def sample_into(self, out: np.ndarray) -> None:
         """The sample of the current state into ``out`` (one row of ``kernel.C_*`` columns,
         depth and angles less :attr:`offsets`): what the next step records at its start,
-        read from one step of copies of the state, so the simulator itself does not move."""
+        read from a dry step (``kernel._steps``), so the simulator itself does not move."""
         if self.fault is not None:
             raise NumericalFault(f"simulator faulted ({self.fault}); call reset()")
         k.advance_and_sample(*self._kernel_arrays(), out.reshape(1, k.N_COLS),
