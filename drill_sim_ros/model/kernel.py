@@ -254,32 +254,21 @@ def _cutting(cut_factor: float, off_bottom: bool, doc: float) -> float:
 
 
 @njit(cache=True, inline="always")
-def _book(stats: tuple, out: np.ndarray, n_rows: int, countdown: int, every: int, tau: float,
-          tau_avg: float, x: tuple) -> tuple:
-    """The step's statistics, and its sample row when one is due (``x``: the columns of
-    :func:`_write_row` after tau). Returns (stats, rows written, countdown)."""
+def _write_row(out: np.ndarray, n_rows: int, tau: float, x: tuple) -> int:
+    """Sample row ``n_rows`` of ``out`` (columns C_*: tau, then ``x`` in column order), the
+    state at the start of the step; returns the rows written. Called only when a row is due:
+    an array handed to an inlined function costs a reference count (two calls, around which
+    every register spills), so ``out`` stays out of the per-step path."""
     u, v, phi, omega, phi_s, omega_s, w_app, wob, tob, doc, w_f, t_top, mode, motor, \
         omega_ref, f_top, omega_bha = x
-    stats = _accumulate(stats, tau, tau_avg, mode, w_f, tob, doc, wob, omega, t_top, v)
-    if countdown == 0 and n_rows < out.shape[0]:
-        _write_row(out[n_rows], tau, u, v, phi, omega, phi_s, omega_s, w_app, wob, tob, doc,
-                   w_f, t_top, mode, motor, omega_ref, f_top, omega_bha)
-        n_rows += 1
-    return stats, n_rows, every - 1 if countdown == 0 else countdown - 1
-
-
-@njit(cache=True, inline="always")
-def _write_row(r: np.ndarray, tau: float, u: float, v: float, phi: float, omega: float,
-               phi_s: float, omega_s: float, w_app: float, wob: float, tob: float,
-               doc: float, w_f: float, t_top: float, mode: int, motor: float,
-               omega_ref: float, f_top: float, omega_bha: float) -> None:
-    """One sample row (columns C_*), the state at the start of the step."""
+    r = out[n_rows]
     r[C_TAU], r[C_U], r[C_V], r[C_PHI], r[C_OMEGA] = tau, u, v, phi, omega
     r[C_PHI_S], r[C_OMEGA_S], r[C_W_APP] = phi_s, omega_s, w_app
     r[C_WOB], r[C_TOB], r[C_DOC], r[C_WF] = wob, tob, doc, w_f
     r[C_T_PIPE], r[C_MODE] = t_top, mode
     r[C_MOTOR_TORQUE], r[C_OMEGA_REF] = motor, omega_ref
     r[C_F_TOP], r[C_OMEGA_BHA] = f_top, omega_bha
+    return n_rows + 1
 
 
 @njit(cache=True)
@@ -316,16 +305,16 @@ def advance(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarra
             td_mode, omega_s, omega_ref, integral, motor, t_top, tgt_omega, tgt_torque,
             omega_rate, td_j, td_kp, td_ki, td_max, td_lag, dt)
         probe += w_f + tob + motor
-        stats, n_rows, countdown = _book(stats, out, n_rows, countdown, every, step * dt, tau_avg,(
-            u, v, phi, omega, phi_s, omega_s, w_app, wob, tob, doc, w_f, t_top, mode, motor,
-            omega_ref, f_top, omega if wave is None else sg.speed_at_top_of(wave, wave_i,
-                                                                            wave_f, bha)))
-        if wave is None:    # kinematic: the angle moves at the step's starting speed
-            phi_s += (omega_s if td_mode == TD_KINEMATIC else omega_s_next) * dt
-        else:
+        stats = _accumulate(stats, step * dt, tau_avg, mode, w_f, tob, doc, wob, omega, t_top, v)
+        if countdown == 0 and n_rows < out.shape[0]:      # the sample at the step's start
+            n_rows = _write_row(out, n_rows, step * dt, (u, v, phi, omega, phi_s, omega_s, w_app,
+                wob, tob, doc, w_f, t_top, mode, motor, omega_ref, f_top,
+                omega if wave is None else sg.speed_at_top_of(wave, wave_i, wave_f, bha)))
+        countdown = every - 1 if countdown == 0 else countdown - 1
+        if wave is not None:          # (lumped kinematic: phi_s turns at the starting speed)
             v_hook, hook_int = _distributed_move(prm, wave, wave_i, wave_f, w_app, f_top,
                                                  hook_int, omega_s_next, v_new, omega_new)
-            phi_s += omega_s_next * dt
+        phi_s += (omega_s if wave is None and td_mode == TD_KINEMATIC else omega_s_next) * dt
         omega_s = omega_s_next
         u_new, phi_new = u + v_new * dt, phi + omega_new * dt     # symplectic Euler, eq. C.1
         if exact:
