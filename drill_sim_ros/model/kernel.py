@@ -164,20 +164,30 @@ def _first_countdown(step: int, every: int) -> int:
 
 
 @njit(cache=True, inline="always")
-def _accumulate(a: tuple, tau: float, tau_avg: float, mode: int, w_f: float, tob: float,
-                doc: float, wob: float, omega: float, t_pipe: float, v: float) -> tuple:
-    """The statistics (a tuple in ``A_*`` order) after one step: first stick and bounce
-    times always, the window sums for tau >= tau_avg."""
-    first_stick = tau if mode == MODE_STUCK and a[A_FIRST_STICK] != a[A_FIRST_STICK] \
-        else a[A_FIRST_STICK]
-    first_bounce = tau if mode == MODE_OFF_BOTTOM and a[A_FIRST_BOUNCE] != a[A_FIRST_BOUNCE] \
-        else a[A_FIRST_BOUNCE]
+def _accumulate(acc: np.ndarray, tau: float, tau_avg: float, mode: int, w_f: float,
+                tob: float, doc: float, wob: float, omega: float, t_pipe: float,
+                v: float) -> None:
+    """One step into the statistics ``acc`` (``A_*``), in place: first stick and bounce
+    times always, the window sums for tau >= tau_avg. (In place, not a tuple of locals:
+    thirteen loop-carried values fewer for the register allocator.)"""
+    if mode == MODE_STUCK and acc[A_FIRST_STICK] != acc[A_FIRST_STICK]:
+        acc[A_FIRST_STICK] = tau
+    if mode == MODE_OFF_BOTTOM and acc[A_FIRST_BOUNCE] != acc[A_FIRST_BOUNCE]:
+        acc[A_FIRST_BOUNCE] = tau
     if tau < tau_avg:
-        return a[:A_FIRST_STICK] + (first_stick, first_bounce)  # noqa: RUF005 (numba)
-    return (a[A_COUNT] + 1.0, a[A_WF] + w_f, a[A_TOB] + tob, a[A_DOC] + doc,
-            a[A_WOB] + wob, a[A_OMEGA] + omega, a[A_T_PIPE] + t_pipe, a[A_V] + v,
-            min(a[A_OMEGA_MIN], omega), max(a[A_OMEGA_MAX], omega),
-            a[A_STUCK] + 1.0 if mode == MODE_STUCK else a[A_STUCK], first_stick, first_bounce)
+        return
+    acc[A_COUNT] += 1.0
+    acc[A_WF] += w_f
+    acc[A_TOB] += tob
+    acc[A_DOC] += doc
+    acc[A_WOB] += wob
+    acc[A_OMEGA] += omega
+    acc[A_T_PIPE] += t_pipe
+    acc[A_V] += v
+    acc[A_OMEGA_MIN] = min(acc[A_OMEGA_MIN], omega)
+    acc[A_OMEGA_MAX] = max(acc[A_OMEGA_MAX], omega)
+    if mode == MODE_STUCK:
+        acc[A_STUCK] += 1.0
 
 
 @njit(cache=True, inline="always")
@@ -284,7 +294,7 @@ def advance(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarra
     td_mode, tgt_omega, tgt_torque, omega_rate, td_j, td_kp, td_ki, td_max, td_lag, _ = \
         _drive_params(prm, tgt)
     inv_spacing, bha = profile.shape[0] / sector, int(prm[P_BHA_PART])
-    stats, countdown, n_rows, status, probe = _stats(acc), _first_countdown(step, every), 0, \
+    countdown, n_rows, status, probe = _first_countdown(step, every), 0, \
         STATUS_OK, 0.0                       # (a NaN probe survives the contact logic)
     for _ in range(n_steps):
         if exact:                     # the delay: U(tau - tau_n), eqs. 6-7, 26-28
@@ -305,7 +315,7 @@ def advance(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarra
             td_mode, omega_s, omega_ref, integral, motor, t_top, tgt_omega, tgt_torque,
             omega_rate, td_j, td_kp, td_ki, td_max, td_lag, dt)
         probe += w_f + tob + motor
-        stats = _accumulate(stats, step * dt, tau_avg, mode, w_f, tob, doc, wob, omega, t_top, v)
+        _accumulate(acc, step * dt, tau_avg, mode, w_f, tob, doc, wob, omega, t_top, v)
         if countdown == 0 and n_rows < out.shape[0]:      # the sample at the step's start
             n_rows = _write_row(out, n_rows, step * dt, (u, v, phi, omega, phi_s, omega_s, w_app,
                 wob, tob, doc, w_f, t_top, mode, motor, omega_ref, f_top,
@@ -331,7 +341,7 @@ def advance(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarra
             break
     _pack(st, meta, u, v, phi, omega, phi_s, omega_s, w_app, stuck, node, frac, h_old, step,
           omega_ref, integral, motor, v_hook, hook_int, dt, head, count, cursor)
-    return _finish(acc, stats, status, (u, v, phi, omega, omega_s, probe)), n_rows
+    return _finish(status, (u, v, phi, omega, omega_s, probe)), n_rows
 
 
 @njit(cache=True, inline="always")
@@ -345,18 +355,8 @@ def _law_params(prm: np.ndarray, tgt: np.ndarray) -> tuple:
 
 
 @njit(cache=True, inline="always")
-def _stats(acc: np.ndarray) -> tuple:
-    """The statistics as a tuple of locals (``A_*`` order)."""
-    return (acc[0], acc[1], acc[2], acc[3], acc[4], acc[5], acc[6], acc[7], acc[8], acc[9],
-            acc[10], acc[11], acc[12])
-
-
-@njit(cache=True, inline="always")
-def _finish(acc: np.ndarray, stats: tuple, status: int, values: tuple) -> int:
-    """The statistics back into ``acc``; a clean stop whose state is not finite becomes
-    STATUS_NONFINITE."""
-    for i in range(N_ACC):
-        acc[i] = stats[i]
+def _finish(status: int, values: tuple) -> int:
+    """The status: a clean stop whose state is not finite becomes STATUS_NONFINITE."""
     if status in (STATUS_OK, STATUS_LAYER):
         for x in values:
             if not math.isfinite(x):
