@@ -311,9 +311,10 @@ def advance(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarra
         v_new, omega_new, w_f, wob, tob, mode, stuck = br.bit_response(
             v0, kick_v, f_ext, omega0, kick_w, t_ext, _cutting(cut_factor, off_bottom, doc),
             stuck, beta, lam)
-        omega_s_next, omega_ref, integral, motor = drive_step(
-            td_mode, omega_s, omega_ref, integral, motor, t_top, tgt_omega, tgt_torque,
-            omega_rate, td_j, td_kp, td_ki, td_max, td_lag, dt)
+        omega_s_next, omega_ref, integral, motor = drive_step(   # the lag's last torque is
+            td_mode, omega_s, omega_ref, integral, st[S_MOTOR_TORQUE], t_top, tgt_omega,
+            tgt_torque, omega_rate, td_j, td_kp, td_ki, td_max, td_lag, dt)
+        st[S_MOTOR_TORQUE] = motor    # read back from st: no register held through the bit law
         probe += w_f + tob + motor
         _accumulate(acc, step * dt, tau_avg, mode, w_f, tob, doc, wob, omega, t_top, v)
         if countdown == 0 and n_rows < out.shape[0]:      # the sample at the step's start
@@ -334,8 +335,7 @@ def advance(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarra
             node, frac, h_old, ok = br.profile_recut(profile, node, frac, h_old, u, u_new,
                                                      (phi_new - phi) * inv_spacing)
         u, v, phi, omega = u_new, v_new, phi_new, omega_new
-        w_app = ramp(w_app, tgt_w, w_rate, dt)
-        step += 1
+        w_app, step = ramp(w_app, tgt_w, w_rate, dt), step + 1
         if not ok or u >= layer_u:
             status = STATUS_LAYER if ok else (STATUS_HISTORY_FULL if exact else STATUS_RUNAWAY)
             break
