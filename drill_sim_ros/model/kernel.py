@@ -164,20 +164,30 @@ def _first_countdown(step: int, every: int) -> int:
 
 
 @njit(cache=True, inline="always")
-def _accumulate(a: tuple, tau: float, tau_avg: float, mode: int, w_f: float, tob: float,
-                doc: float, wob: float, omega: float, t_pipe: float, v: float) -> tuple:
-    """The statistics (a tuple in ``A_*`` order) after one step: first stick and bounce
-    times always, the window sums for tau >= tau_avg."""
-    first_stick = tau if mode == MODE_STUCK and a[A_FIRST_STICK] != a[A_FIRST_STICK] \
-        else a[A_FIRST_STICK]
-    first_bounce = tau if mode == MODE_OFF_BOTTOM and a[A_FIRST_BOUNCE] != a[A_FIRST_BOUNCE] \
-        else a[A_FIRST_BOUNCE]
+def _accumulate(acc: np.ndarray, tau: float, tau_avg: float, mode: int, w_f: float,
+                tob: float, doc: float, wob: float, omega: float, t_pipe: float,
+                v: float) -> None:
+    """One step into the statistics ``acc`` (``A_*``), in place: first stick and bounce
+    times always, the window sums for tau >= tau_avg. (In place, not a tuple of locals:
+    thirteen loop-carried values fewer for the register allocator.)"""
+    if mode == MODE_STUCK and acc[A_FIRST_STICK] != acc[A_FIRST_STICK]:
+        acc[A_FIRST_STICK] = tau
+    if mode == MODE_OFF_BOTTOM and acc[A_FIRST_BOUNCE] != acc[A_FIRST_BOUNCE]:
+        acc[A_FIRST_BOUNCE] = tau
     if tau < tau_avg:
-        return a[:A_FIRST_STICK] + (first_stick, first_bounce)  # noqa: RUF005 (numba)
-    return (a[A_COUNT] + 1.0, a[A_WF] + w_f, a[A_TOB] + tob, a[A_DOC] + doc,
-            a[A_WOB] + wob, a[A_OMEGA] + omega, a[A_T_PIPE] + t_pipe, a[A_V] + v,
-            min(a[A_OMEGA_MIN], omega), max(a[A_OMEGA_MAX], omega),
-            a[A_STUCK] + 1.0 if mode == MODE_STUCK else a[A_STUCK], first_stick, first_bounce)
+        return
+    acc[A_COUNT] += 1.0
+    acc[A_WF] += w_f
+    acc[A_TOB] += tob
+    acc[A_DOC] += doc
+    acc[A_WOB] += wob
+    acc[A_OMEGA] += omega
+    acc[A_T_PIPE] += t_pipe
+    acc[A_V] += v
+    acc[A_OMEGA_MIN] = min(acc[A_OMEGA_MIN], omega)
+    acc[A_OMEGA_MAX] = max(acc[A_OMEGA_MAX], omega)
+    if mode == MODE_STUCK:
+        acc[A_STUCK] += 1.0
 
 
 @njit(cache=True, inline="always")
@@ -241,17 +251,21 @@ def _cutting(cut_factor: float, off_bottom: bool, doc: float) -> float:
 
 
 @njit(cache=True, inline="always")
-def _write_row(r: np.ndarray, tau: float, u: float, v: float, phi: float, omega: float,
-               phi_s: float, omega_s: float, w_app: float, wob: float, tob: float,
-               doc: float, w_f: float, t_top: float, mode: int, motor: float,
-               omega_ref: float, f_top: float, omega_bha: float) -> None:
-    """One sample row (columns C_*), the state at the start of the step."""
+def _write_row(out: np.ndarray, n_rows: int, tau: float, x: tuple) -> int:
+    """Sample row ``n_rows`` of ``out`` (columns C_*: tau, then ``x`` in column order), the
+    state at the start of the step; returns the rows written. Called only when a row is due:
+    an array handed to an inlined function costs a reference count (two calls, around which
+    every register spills), so ``out`` stays out of the per-step path."""
+    u, v, phi, omega, phi_s, omega_s, w_app, wob, tob, doc, w_f, t_top, mode, motor, \
+        omega_ref, f_top, omega_bha = x
+    r = out[n_rows]
     r[C_TAU], r[C_U], r[C_V], r[C_PHI], r[C_OMEGA] = tau, u, v, phi, omega
     r[C_PHI_S], r[C_OMEGA_S], r[C_W_APP] = phi_s, omega_s, w_app
     r[C_WOB], r[C_TOB], r[C_DOC], r[C_WF] = wob, tob, doc, w_f
     r[C_T_PIPE], r[C_MODE] = t_top, mode
     r[C_MOTOR_TORQUE], r[C_OMEGA_REF] = motor, omega_ref
     r[C_F_TOP], r[C_OMEGA_BHA] = f_top, omega_bha
+    return n_rows + 1
 
 
 @njit(cache=True)
@@ -281,7 +295,7 @@ def _steps(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarray
     inv_spacing, bha = profile.shape[0] / sector, int(prm[P_BHA_PART])
     parts_t, parts, bit_inertia, hook_kp, hook_ki, hook_fixed, anechoic = \
         _string_params(prm, wave_i)
-    stats, countdown, n_rows, status, probe = _stats(acc), _first_countdown(step, every), 0, \
+    countdown, n_rows, status, probe = _first_countdown(step, every), 0, \
         STATUS_OK, 0.0                       # (a NaN probe survives the contact logic)
     for _ in range(n_steps):
         if exact:                     # the delay: U(tau - tau_n), eqs. 6-7, 26-28
@@ -299,40 +313,24 @@ def _steps(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarray
         v_new, omega_new, w_f, wob, tob, mode, stuck = br.bit_response(
             v0, kick_v, f_ext, omega0, kick_w, t_ext, _cutting(cut_factor, off_bottom, doc),
             stuck, beta, lam)
-        omega_s_next, omega_ref, integral, motor = drive_step(
-            td_mode, omega_s, omega_ref, integral, motor, t_top, tgt_omega, tgt_torque,
-            omega_rate, td_j, td_kp, td_ki, td_max, td_lag, dt)
+        omega_s_next, omega_ref, integral, motor = drive_step(   # the lag's last torque is
+            td_mode, omega_s, omega_ref, integral, st[S_MOTOR_TORQUE], t_top, tgt_omega,
+            tgt_torque, omega_rate, td_j, td_kp, td_ki, td_max, td_lag, dt)
         probe += w_f + tob + motor
-        stats = _accumulate(stats, step * dt, tau_avg, mode, w_f, tob, doc, wob, omega, t_top,
-                            v)
-        if countdown == 0 and n_rows < out.shape[0]:    # the sample row of the step's start
-            _write_row(out[n_rows], step * dt, u, v, phi, omega, phi_s, omega_s, w_app, wob,
-                       tob, doc, w_f, t_top, mode, motor, omega_ref, f_top,
-                       omega if wave is None else sg.speed_at_top_of(wave, wave_i, wave_f, bha))
-            n_rows += 1
+        if countdown == 0 and n_rows < out.shape[0]:      # the sample at the step's start
+            n_rows = _write_row(out, n_rows, step * dt, (u, v, phi, omega, phi_s, omega_s, w_app,
+                wob, tob, doc, w_f, t_top, mode, motor, omega_ref, f_top,
+                omega if wave is None else sg.speed_at_top_of(wave, wave_i, wave_f, bha)))
         countdown = every - 1 if countdown == 0 else countdown - 1
-        if dry:
+        if dry:                       # (nothing written before this line but the row)
             return STATUS_OK, n_rows
-        if wave is None:    # kinematic: the angle moves at the step's starting speed
-            phi_s += (omega_s if td_mode == TD_KINEMATIC else omega_s_next) * dt
-        else:
-            # the string moves on by one step: both lines take what the drive, the hook (its
-            # WOB loop on f_top) and the bit send into them (a = b + 2 Z w at the top,
-            # b = a - 2 Z w at the bottom). Written here, branches first, not in a function
-            # of its own: the arrays handed to an inlined function with branches or loops
-            # are reference-counted every step (about a third of the step, measured).
+        st[S_MOTOR_TORQUE] = motor    # read back from st: no register held through the bit law
+        _accumulate(acc, step * dt, tau_avg, mode, w_f, tob, doc, wob, omega, t_top, v)
+        if wave is not None:          # the hook's WOB loop, then the string one step on
             v_hook, hook_int = _hook(hook_kp, hook_ki, hook_fixed, dt, w_app, f_top, hook_int)
-            z = sg.W_Z
-            b_top_t, a_bot_t = sg.arriving(wave, wave_i, 0, parts_t)
-            b_top_a, a_bot_a = sg.arriving(wave, wave_i, parts_t, parts)
-            b_bottom_t = 0.0 if anechoic else \
-                a_bot_t - 2.0 * wave_f[z, parts_t - 1] * omega_new
-            sg.scatter(wave, wave_i, wave_f, 0, parts_t,
-                       b_top_t + 2.0 * wave_f[z, 0] * omega_s_next, b_bottom_t)
-            sg.scatter(wave, wave_i, wave_f, parts_t, parts,
-                       b_top_a + 2.0 * wave_f[z, parts_t] * v_hook,
-                       a_bot_a - 2.0 * wave_f[z, parts - 1] * v_new)
-            phi_s += omega_s_next * dt
+            sg.move_on(wave, wave_i, wave_f, parts_t, anechoic, omega_s_next, omega_new, v_hook,
+                       v_new)
+        phi_s += (omega_s if wave is None and td_mode == TD_KINEMATIC else omega_s_next) * dt
         omega_s = omega_s_next
         u_new, phi_new = u + v_new * dt, phi + omega_new * dt     # symplectic Euler, eq. C.1
         if exact:
@@ -342,14 +340,13 @@ def _steps(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarray
             node, frac, h_old, ok = br.profile_recut(profile, node, frac, h_old, u, u_new,
                                                      (phi_new - phi) * inv_spacing)
         u, v, phi, omega = u_new, v_new, phi_new, omega_new
-        w_app = ramp(w_app, tgt_w, w_rate, dt)
-        step += 1
+        w_app, step = ramp(w_app, tgt_w, w_rate, dt), step + 1
         if not ok or u >= layer_u:
             status = STATUS_LAYER if ok else (STATUS_HISTORY_FULL if exact else STATUS_RUNAWAY)
             break
     _pack(st, meta, u, v, phi, omega, phi_s, omega_s, w_app, stuck, node, frac, h_old, step,
           omega_ref, integral, motor, v_hook, hook_int, dt, head, count, cursor)
-    return _finish(acc, stats, status, (u, v, phi, omega, omega_s, probe)), n_rows
+    return _finish(status, (u, v, phi, omega, omega_s, probe)), n_rows
 
 
 @njit(cache=True, inline="always")
@@ -363,18 +360,8 @@ def _law_params(prm: np.ndarray, tgt: np.ndarray) -> tuple:
 
 
 @njit(cache=True, inline="always")
-def _stats(acc: np.ndarray) -> tuple:
-    """The statistics as a tuple of locals (``A_*`` order)."""
-    return (acc[0], acc[1], acc[2], acc[3], acc[4], acc[5], acc[6], acc[7], acc[8], acc[9],
-            acc[10], acc[11], acc[12])
-
-
-@njit(cache=True, inline="always")
-def _finish(acc: np.ndarray, stats: tuple, status: int, values: tuple) -> int:
-    """The statistics back into ``acc``; a clean stop whose state is not finite becomes
-    STATUS_NONFINITE."""
-    for i in range(N_ACC):
-        acc[i] = stats[i]
+def _finish(status: int, values: tuple) -> int:
+    """The status: a clean stop whose state is not finite becomes STATUS_NONFINITE."""
     if status in (STATUS_OK, STATUS_LAYER):
         for x in values:
             if not math.isfinite(x):
