@@ -205,9 +205,10 @@ def _lumped_ends(psi: float, dt: float, phi_s: float, phi: float, v: float, omeg
 def _string_params(prm: np.ndarray, wave_i: np.ndarray | None) -> tuple:
     """The distributed string's parameters for a run, read once (like :func:`_law_params`):
     the torsional parts, all parts, the bit's lumped inertia, the hook's WOB loop gains, a
-    fixed hook (off bottom) and an anechoic bottom."""
+    fixed hook (off bottom) and the torsional bottom's echo (0: anechoic, 1: the bit's)."""
     return (int(prm[P_PARTS_T]), 0 if wave_i is None else wave_i.shape[1], prm[P_BIT_INERTIA],
-            prm[P_HOOK_KP], prm[P_HOOK_KI], prm[P_OFF_BOTTOM] != 0.0, prm[P_OFF_BOTTOM] == 2.0)
+            prm[P_HOOK_KP], prm[P_HOOK_KI], prm[P_OFF_BOTTOM] != 0.0,
+            0.0 if prm[P_OFF_BOTTOM] == 2.0 else 1.0)
 
 
 @njit(cache=True, inline="always")
@@ -226,6 +227,19 @@ def _distributed_ends(wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray,
                                           omega, dt)
     return (v0, kick_v, f_ext, omega0, kick_w, t_ext, b_top_t + wave_f[z, 0] * omega_s,
             b_top_a + wave_f[z, parts_t] * v_hook)
+
+
+@njit(cache=True, inline="always")
+def _string_ends(wave: np.ndarray | None, wave_i: np.ndarray | None, wave_f: np.ndarray | None,
+                 parts_t: int, parts: int, bit_inertia: float, psi: float, dt: float,
+                 phi_s: float, phi: float, v: float, omega: float, w_app: float,
+                 omega_s: float, v_hook: float) -> tuple[float, ...]:
+    """What the string presents over this step: lumped (``wave`` None, compiled apart) or
+    distributed."""
+    if wave is None:
+        return _lumped_ends(psi, dt, phi_s, phi, v, omega, w_app)
+    return _distributed_ends(wave, wave_i, wave_f, parts_t, parts, bit_inertia, dt, omega_s,
+                             v, omega, v_hook)
 
 
 @njit(cache=True, inline="always")
@@ -283,40 +297,32 @@ def _steps(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarray
            hist: np.ndarray, meta: np.ndarray, acc: np.ndarray, out: np.ndarray,
            wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray,
            n_steps: int, every: int, exact: bool, dry: bool) -> tuple[int, int]:
-    """:func:`advance`; ``dry``: the first step only as far as its sample row (the state at
-    its start, with the forces of the law), then back with nothing moved: the state, the
+    """:func:`advance`; ``dry``: only the first step's sample row, then back: the state, the
     profile or history, the string and the statistics are read, never written."""
     u, v, phi, omega, phi_s, omega_s, w_app, stuck, node, frac, h_old, step, omega_ref, \
         integral, motor, v_hook, hook_int, head, count, cursor = _unpack(st, meta)
     dt, tau_avg, beta, lam, n_blades, psi, off_bottom, layer_u, cut_factor, sector, tgt_w, \
-        w_rate = _law_params(prm, tgt)
+        w_rate, inv_spacing, bha = _law_params(prm, tgt, profile)
     td_mode, tgt_omega, tgt_torque, omega_rate, td_j, td_kp, td_ki, td_max, td_lag, _ = \
         _drive_params(prm, tgt)
-    inv_spacing, bha = profile.shape[0] / sector, int(prm[P_BHA_PART])
-    parts_t, parts, bit_inertia, hook_kp, hook_ki, hook_fixed, anechoic = \
-        _string_params(prm, wave_i)
-    countdown, n_rows, status, probe = _first_countdown(step, every), 0, \
-        STATUS_OK, 0.0                       # (a NaN probe survives the contact logic)
+    parts_t, parts, bit_inertia, hook_kp, hook_ki, hook_fixed, echo = _string_params(prm, wave_i)
+    countdown, n_rows, status, probe = _first_countdown(step, every), 0, STATUS_OK, 0.0
     for _ in range(n_steps):
         if exact:                     # the delay: U(tau - tau_n), eqs. 6-7, 26-28
             surface, cursor = br.delayed_depth(hist[0], hist[1], head, count, cursor, phi - sector)
         else:
             surface = br.profile_surface(profile, node, frac, h_old)
         doc = n_blades * (u - surface)          # delta = n (U - U(tau - tau_n)), eq. 8
-        if wave is None:                      # the lumped string (compiled apart)
-            v0, kick_v, f_ext, omega0, kick_w, t_ext, t_top, f_top = _lumped_ends(
-                psi, dt, phi_s, phi, v, omega, w_app)
-        else:
-            v0, kick_v, f_ext, omega0, kick_w, t_ext, t_top, f_top = _distributed_ends(
-                wave, wave_i, wave_f, parts_t, parts, bit_inertia, dt, omega_s, v, omega,
-                v_hook)
+        v0, kick_v, f_ext, omega0, kick_w, t_ext, t_top, f_top = _string_ends(
+            wave, wave_i, wave_f, parts_t, parts, bit_inertia, psi, dt, phi_s, phi, v, omega,
+            w_app, omega_s, v_hook)
         v_new, omega_new, w_f, wob, tob, mode, stuck = br.bit_response(
             v0, kick_v, f_ext, omega0, kick_w, t_ext, _cutting(cut_factor, off_bottom, doc),
             stuck, beta, lam)
         omega_s_next, omega_ref, integral, motor = drive_step(   # the lag's last torque is
             td_mode, omega_s, omega_ref, integral, st[S_MOTOR_TORQUE], t_top, tgt_omega,
             tgt_torque, omega_rate, td_j, td_kp, td_ki, td_max, td_lag, dt)
-        probe += w_f + tob + motor
+        probe += w_f + tob + motor              # (a NaN survives the contact logic)
         if countdown == 0 and n_rows < out.shape[0]:      # the sample at the step's start
             n_rows = _write_row(out, n_rows, step * dt, (u, v, phi, omega, phi_s, omega_s, w_app,
                 wob, tob, doc, w_f, t_top, mode, motor, omega_ref, f_top,
@@ -328,8 +334,8 @@ def _steps(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarray
         _accumulate(acc, step * dt, tau_avg, mode, w_f, tob, doc, wob, omega, t_top, v)
         if wave is not None:          # the hook's WOB loop, then the string one step on
             v_hook, hook_int = _hook(hook_kp, hook_ki, hook_fixed, dt, w_app, f_top, hook_int)
-            sg.move_on(wave, wave_i, wave_f, parts_t, anechoic, omega_s_next, omega_new, v_hook,
-                       v_new)
+            sg.drive_line(wave, wave_i, wave_f, 0, parts_t, omega_s_next, omega_new, echo)
+            sg.drive_line(wave, wave_i, wave_f, parts_t, parts, v_hook, v_new, 1.0)
         phi_s += (omega_s if wave is None and td_mode == TD_KINEMATIC else omega_s_next) * dt
         omega_s = omega_s_next
         u_new, phi_new = u + v_new * dt, phi + omega_new * dt     # symplectic Euler, eq. C.1
@@ -350,13 +356,15 @@ def _steps(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarray
 
 
 @njit(cache=True, inline="always")
-def _law_params(prm: np.ndarray, tgt: np.ndarray) -> tuple:
+def _law_params(prm: np.ndarray, tgt: np.ndarray, profile: np.ndarray) -> tuple:
     """dtau, the statistics window start, beta, lambda, n, psi, off bottom, the next layer's
     top, the cutting factor, the blade sector 2 pi / n, the applied weight's target and its
-    ramp rate, read once for a run."""
+    ramp rate, the profile's nodes per radian and the part whose top is the BHA, read once
+    for a run."""
+    sector = 2.0 * math.pi / prm[P_N]
     return (prm[P_DT], prm[P_TAU_AVG], prm[P_BETA], prm[P_LAM], prm[P_N], prm[P_PSI],
-            prm[P_OFF_BOTTOM] != 0.0, prm[P_LAYER_U], prm[P_CUT], 2.0 * math.pi / prm[P_N],
-            tgt[I_W_APP], prm[P_W_RATE])
+            prm[P_OFF_BOTTOM] != 0.0, prm[P_LAYER_U], prm[P_CUT], sector, tgt[I_W_APP],
+            prm[P_W_RATE], profile.shape[0] / sector, int(prm[P_BHA_PART]))
 
 
 @njit(cache=True, inline="always")

@@ -313,23 +313,15 @@ def _parts_of(spec: StringSpec, section: Section, axial: bool) -> int:
 
 
 # ---- compiled: one step of a line -------------------------------------------------------
-@njit(cache=True)
-def move_on(wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray, parts_t: int,
-            anechoic: bool, omega_top: float, omega_bit: float, v_top: float,
-            v_bit: float) -> None:
-    """Both lines one step on, driven at their ends by the speeds over the step: at the top
-    a = b + 2 Z w (the drive's speed on the torsional line, the hook's on the axial one), at
-    the bottom b = a - 2 Z w (the bit's). An ``anechoic`` torsional bottom sends nothing
-    back. Compiled apart, not inlined: the kernel's loop then holds no array references for
-    it (an inlined body with loops costs reference counting every step)."""
-    parts = wave_i.shape[1]
-    b_top_t, a_bot_t = arriving(wave, wave_i, 0, parts_t)
-    b_top_a, a_bot_a = arriving(wave, wave_i, parts_t, parts)
-    b_bottom_t = 0.0 if anechoic else a_bot_t - 2.0 * wave_f[W_Z, parts_t - 1] * omega_bit
-    scatter(wave, wave_i, wave_f, 0, parts_t, b_top_t + 2.0 * wave_f[W_Z, 0] * omega_top,
-            b_bottom_t)
-    scatter(wave, wave_i, wave_f, parts_t, parts, b_top_a + 2.0 * wave_f[W_Z, parts_t] * v_top,
-            a_bot_a - 2.0 * wave_f[W_Z, parts - 1] * v_bit)
+@njit(cache=True, inline="always")
+def drive_line(wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray, lo: int, hi: int,
+               w_top: float, w_bottom: float, echo: float) -> None:
+    """A line (parts ``lo`` .. ``hi``) one step on, driven at its ends by the speeds over the
+    step: a = b + 2 Z w_top enters at the top, b = (a - 2 Z w_bottom) x ``echo`` at the
+    bottom (``echo`` 1; 0: an anechoic bottom that sends nothing back)."""
+    b_top, a_bottom = arriving(wave, wave_i, lo, hi)
+    scatter(wave, wave_i, wave_f, lo, hi, b_top + 2.0 * wave_f[W_Z, lo] * w_top,
+            (a_bottom - 2.0 * wave_f[W_Z, hi - 1] * w_bottom) * echo)
 
 
 @njit(cache=True, inline="always")
