@@ -1,5 +1,7 @@
-"""Offline command line: ``drill_sim run | sweep | presets | params | info | closed-loop |
-suite | modes | reflection | map | map-plot | figures``.
+"""Offline command line ``drill_sim``: runs, maps, figures and closed-loop tests of the model.
+
+Subcommands: ``run | sweep | presets | params | info | closed-loop | suite | modes |
+reflection | map | map-plot | figures``.
 
 ``drill_sim run`` integrates the RGD07 model without ROS and prints a summary (or one JSON
 object with ``--json``). The run is dimensionless unless ``--params`` names a physical
