@@ -5,7 +5,7 @@ ROS-free. :func:`check_scenario_mapping` checks a scenario file's parsed mapping
 :func:`check_scenario_size` bounds the run whatever its source (file, command line):
 the control rate within sim_node's ``publish_rate_hz`` range and at most
 :data:`MAX_PERIODS` periods, so a run never asks for memory it cannot have (a period's row
-of telemetry is kept: 21 float64).
+of telemetry is kept: N_FIELDS = 24 float64).
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ from drill_sim_ros.model.measurement import MAX_DELAY_PERIODS, SIGNALS
 from drill_sim_ros.model.validate_input import as_number, check_known_keys
 
 CONTROL_RATE_RANGE_HZ = (1.0, 1000.0)      # sim_node's publish_rate_hz
-MAX_PERIODS = 2_000_000                    # 2e6 rows x 21 float64 = 336 MB per run
+MAX_PERIODS = 2_000_000                    # 2e6 rows x 24 float64 = 384 MB per run
 SIGNAL_KEYS = ("noise_std", "quantum", "delay_periods")
 _STRINGS = ("preset", "mode", "controller")
 _NUMBERS = ("duration_s", "control_rate_hz", "enable_at_s")
