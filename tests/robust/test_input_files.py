@@ -39,7 +39,7 @@ def test_a_wrong_scenario_value_is_one_line(capsys, tmp_path: Path, text: str,
 
 
 def test_a_run_too_long_to_hold_is_refused_before_it_starts(capsys) -> None:
-    # 1e7 s at 100 Hz: 1e9 rows of 21 float64 = 168 GB
+    # 1e7 s at 100 Hz: 1e9 rows of 24 float64 = 192 GB
     rc, _, err = run_cli(capsys, "closed-loop", "--t-end", "1e7", "--no-baseline")
     one_error_line(rc, err, "--t-end", "1e+07", "at most 2,000,000")
 
