@@ -1,4 +1,5 @@
-"""User errors of the study commands, map-plot output, and a core free of ROS."""
+"""User errors of the study commands and map-plot output (a core free of ROS:
+tests/model/test_purity.py)."""
 
 from __future__ import annotations
 
