@@ -32,11 +32,16 @@ from drill_sim_ros.control.controllers import CONTROL_MODES
 from drill_sim_ros.control.isolation import ControllerError
 from drill_sim_ros.control.registry import BUILTIN
 from drill_sim_ros.control.scenario import Scenario, load_scenario
-from drill_sim_ros.model.errors import DrillSimError
+from drill_sim_ros.model.errors import DrillSimError, ParameterError
 from drill_sim_ros.ros.lockstep_driver import LockstepDriver
+from drill_sim_ros.ros.parameters import check_parameter_rules, check_plain_args
 
 NODE_NAME = "top_drive_controller"
 CONTROLLER_ERROR_PREFIX = f"{NODE_NAME}: error: "
+CONTROLLER_USAGE = """usage: top_drive_controller [--ros-args -p controller:=NAME ...]
+
+A reference top-drive controller as a ROS 2 node, answering every sample of sim_node in
+lockstep (docs/closed-loop.md, docs/control-loop.md). Its settings are ROS parameters."""
 
 
 def _double(description: str, low: float = 0.0, high: float = 1e9) -> ParameterDescriptor:
@@ -116,7 +121,14 @@ def main(args: list[str] | None = None) -> int:
     """Console script ``top_drive_controller``; with ``periods`` > 0 it prints one JSON line
     (periods, wall_s, periods_per_s) when done and exits 0. A failure of the controller
     itself (an exception, a wrong type, a non-finite command: ``control.isolation``) is one
-    stderr line starting with CONTROLLER_ERROR_PREFIX, exit 2."""
+    stderr line starting with CONTROLLER_ERROR_PREFIX, exit 2; a user's mistake (a bad
+    argument, parameter or scenario) is one line, exit 2."""
+    try:
+        check_plain_args(sys.argv if args is None else args, CONTROLLER_USAGE)
+        check_parameter_rules(sys.argv if args is None else args)
+    except ParameterError as exc:
+        rclpy.logging.get_logger(NODE_NAME).fatal(str(exc))
+        return 2
     rclpy.init(args=args)
     node = None
     try:
@@ -132,9 +144,9 @@ def main(args: list[str] | None = None) -> int:
     except ControllerError as exc:       # the controller under test failed: one line, exit 2
         print(f"{CONTROLLER_ERROR_PREFIX}{exc}", file=sys.stderr, flush=True)
         return 2
-    except (DrillSimError, ValueError) as exc:
+    except (DrillSimError, ValueError) as exc:      # a user's mistake: one line, exit 2
         rclpy.logging.get_logger(NODE_NAME).fatal(str(exc))
-        return 1
+        return 2
     finally:
         if node is not None:
             node.destroy_node()

@@ -72,6 +72,8 @@ class Figures:
     stale: int = 0                 # commands that did not answer the latest sample
     lost_commands: int = 0         # commands DDS reports lost on their way
     command_publishers: int = 0    # publishers matched on drill/cmd/top_drive (and typed)
+    telemetry_subscribers: int = 0  # subscriptions matched on drill/telemetry (recorders,
+                                    # bridges, tools)
     waiting: str | None = None     # what lockstep waits for, past lockstep.warn_after_s
     waits: int = 0                 # waits that went past lockstep.warn_after_s
 
@@ -124,6 +126,7 @@ def node_status(f: Figures, source: Source, growing: bool = False) -> Diagnostic
         "stale_commands": str(f.stale),
         "lost_commands": str(f.lost_commands),
         "command_publishers": str(f.command_publishers),
+        "telemetry_subscribers": str(f.telemetry_subscribers),
         "lockstep_waits": str(f.waits),
         "waiting": f.waiting or "",
         "recorder_dropped": str(f.dropped),

@@ -22,6 +22,7 @@ import yaml
 from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
 from rclpy.exceptions import InvalidParameterTypeException, InvalidParameterValueException
 from rclpy.impl.implementation_singleton import rclpy_implementation
+from rclpy.utilities import remove_ros_args
 
 from drill_sim_ros.model import defaults
 from drill_sim_ros.model.errors import ParameterError
@@ -351,8 +352,29 @@ def check_parameter_rules(args: list[str]) -> None:
                                  "e.g. -p real_time_factor:=2.0")
 
 
-def init_ros(args: list[str] | None = None) -> None:
-    """``rclpy.init``; an unparsable ``--ros-args`` or params file raises one ParameterError."""
+SIM_NODE_USAGE = """usage: sim_node [--ros-args -p NAME:=VALUE ... --params-file FILE ...]
+
+The drill-string simulator as a ROS 2 node (docs/sim_node.md). Its settings are ROS
+parameters: `drill_sim params` lists each with its type, unit, range and default."""
+
+
+def check_plain_args(argv: list[str], usage: str) -> None:
+    """The arguments outside ``--ros-args``: ``-h``/``--help`` prints ``usage`` and exits 0;
+    anything else is one ParameterError (a node takes its settings as ROS parameters)."""
+    plain = remove_ros_args(argv)[1:]
+    if "-h" in plain or "--help" in plain:
+        print(usage)
+        raise SystemExit(0)
+    if plain:
+        raise ParameterError(f"unknown argument(s) {' '.join(plain)}: settings are ROS "
+                             "parameters, given after --ros-args (-p NAME:=VALUE, "
+                             "--params-file FILE); --help for more")
+
+
+def init_ros(args: list[str] | None = None, usage: str = SIM_NODE_USAGE) -> None:
+    """``rclpy.init``; ``--help`` prints ``usage``; an unknown plain argument, an unparsable
+    ``--ros-args`` or params file raises one ParameterError."""
+    check_plain_args(sys.argv if args is None else args, usage)
     check_params_files(sys.argv if args is None else args)
     check_parameter_rules(sys.argv if args is None else args)
     try:

@@ -662,11 +662,13 @@ class SimNode(Node):
             **self._handshake_figures())
 
     def _handshake_figures(self) -> dict[str, Any]:
-        """The lockstep handshake's part of the figures (lock held)."""
+        """The lockstep handshake's part of the figures, and who hears the telemetry (lock
+        held)."""
         waiting = self._handshake.waiting(self._lockstep_mode(), time.monotonic())
         return {"stale": self._handshake.gate.stale,
                 "lost_commands": self._handshake.lost_commands,
                 "command_publishers": self._top_drive_publishers(),
+                "telemetry_subscribers": self._pubs[topics.TELEMETRY].get_subscription_count(),
                 "waiting": None if waiting is None else waiting.text,
                 "waits": self._handshake.watch.waits}
 

@@ -66,6 +66,24 @@ def mcap_messages(path: Path) -> list[tuple[str, int, object]]:
                 for _, channel, message, decoded in reader.iter_decoded_messages()]
 
 
+def wait_heard_by(ros, node: Node, rig: str, count: int, timeout_s: float = 30.0) -> None:
+    """Until the rig's sim reports ``count`` subscriptions matched on its drill/telemetry
+    (its /diagnostics, 1 Hz): the recorder and the bridge will hear every sample to come.
+    (The graph seen from here can list them before the sim has matched them.)"""
+    latest: dict[str, str] = {}
+
+    def on_diagnostics(msg: DiagnosticArray) -> None:
+        for status in msg.status:
+            if status.hardware_id == rig and status.name.endswith("simulation"):
+                latest.update({kv.key: kv.value for kv in status.values})
+
+    sub = node.create_subscription(DiagnosticArray, topics.DIAGNOSTICS, on_diagnostics, 10)
+    heard = ros.spin_until(lambda: int(latest.get("telemetry_subscribers", 0)) >= count,
+                           timeout_s)
+    node.destroy_subscription(sub)
+    assert heard, f"/{rig}'s sim: telemetry_subscribers {latest.get('telemetry_subscribers')}"
+
+
 def step_all(node: Node, ros, service: str, count: int) -> None:
     client = node.create_client(Trigger, service)
     assert ros.spin_until(client.service_is_ready, 30), f"{service} never appeared"
@@ -101,10 +119,8 @@ def test_two_rigs_in_two_namespaces_each_recorded_and_bridged(tmp_path) -> None:
                             in log.read_text(), 60), log.read_text()
         with ros_context() as ros:
             node = ros.add(Node("stepper", context=ros.context))
-            for rig in rigs:                     # each sim hears its recorder and bridge
-                name = f"/{rig}{topics.TELEMETRY}"  # before the steps (20 take ~1 s)
-                assert ros.spin_until(lambda name=name: node.count_subscribers(name) >= 2, 30)
-            ros.spin_for(1.0)
+            for rig in rigs:       # each sim has matched its recorder and bridge before
+                wait_heard_by(ros, node, rig, 2)   # the steps (20 take well under a second)
             for rig in rigs:
                 step_all(node, ros, f"/{rig}/drill_sim/step", STEPS)
             for rig in rigs:
@@ -169,10 +185,7 @@ def test_every_node_runs_on_use_sim_time(tmp_path) -> None:
             assert wait_for(lambda: f"recording /{rig}/drill/telemetry"
                             in (tmp_path / "rec.log").read_text(), 60)
             with ros_context() as ros:           # the sim hears both before the first sample
-                graph = ros.add(Node("graph", context=ros.context))
-                name = f"/{rig}{topics.TELEMETRY}"
-                assert ros.spin_until(lambda: graph.count_subscribers(name) >= 2, 30)
-                ros.spin_for(1.0)
+                wait_heard_by(ros, ros.add(Node("graph", context=ros.context)), rig, 2)
             done = subprocess.run(controller, capture_output=True, text=True, timeout=120)
             assert done.returncode == 0, done.stdout + done.stderr
             summary = json.loads(done.stdout.strip().splitlines()[-1])

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import subprocess
+
 import pytest
 
 from drill_sim_ros.control.command import clamp_command
@@ -9,9 +11,11 @@ from drill_sim_ros.model.errors import ParameterError
 from drill_sim_ros.ros.parameters import (
     check_parameter_rules,
     check_params_files,
+    check_plain_args,
     recording_options,
     yaml_defaults,
 )
+from tests.archive.helpers import BIN
 
 
 def test_a_saturated_command_shows_its_value_exactly() -> None:
@@ -50,3 +54,27 @@ def test_malformed_parameter_overrides_are_one_line_before_rcl() -> None:
                  ["--ros-args", "--param"]):
         with pytest.raises(ParameterError, match="NAME:=VALUE"):
             check_parameter_rules(args)
+
+
+def test_plain_arguments_are_help_or_one_line(capsys) -> None:
+    """A node takes its settings as ROS parameters: outside --ros-args only --help."""
+    check_plain_args(["sim_node", "--ros-args", "-p", "lockstep:=true"], "USAGE")
+    with pytest.raises(ParameterError, match=r"unknown argument\(s\) -p foo: .*--ros-args"):
+        check_plain_args(["sim_node", "-p", "foo"], "USAGE")
+    with pytest.raises(SystemExit) as stop:
+        check_plain_args(["sim_node", "-h", "--ros-args", "-p", "a:=1"], "USAGE")
+    assert stop.value.code == 0
+    assert capsys.readouterr().out == "USAGE\n"
+
+
+@pytest.mark.parametrize("command", ["sim_node", "top_drive_controller"])
+def test_a_node_given_help_or_a_stray_argument_does_not_start(command: str) -> None:
+    shown = subprocess.run([str(BIN / command), "--help"], capture_output=True, text=True,
+                           timeout=60)
+    assert shown.returncode == 0, shown.stderr
+    assert shown.stdout.startswith(f"usage: {command} [--ros-args"), shown.stdout
+    refused = subprocess.run([str(BIN / command), "--bogus"], capture_output=True, text=True,
+                             timeout=60)
+    assert refused.returncode == 2, refused.stdout + refused.stderr
+    lines = (refused.stdout + refused.stderr).strip().splitlines()
+    assert len(lines) == 1 and "unknown argument(s) --bogus" in lines[0], lines
