@@ -124,8 +124,8 @@ def main(args: list[str] | None = None) -> int:
     stderr line starting with CONTROLLER_ERROR_PREFIX, exit 2; a user's mistake (a bad
     argument, parameter or scenario) is one line, exit 2."""
     try:
-        check_plain_args(sys.argv if args is None else args, CONTROLLER_USAGE)
         check_parameter_rules(sys.argv if args is None else args)
+        check_plain_args(sys.argv if args is None else args, CONTROLLER_USAGE)
     except ParameterError as exc:
         rclpy.logging.get_logger(NODE_NAME).fatal(str(exc))
         return 2

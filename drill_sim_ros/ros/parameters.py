@@ -361,7 +361,11 @@ parameters: `drill_sim params` lists each with its type, unit, range and default
 def check_plain_args(argv: list[str], usage: str) -> None:
     """The arguments outside ``--ros-args``: ``-h``/``--help`` prints ``usage`` and exits 0;
     anything else is one ParameterError (a node takes its settings as ROS parameters)."""
-    plain = remove_ros_args(argv)[1:]
+    try:
+        plain = remove_ros_args(argv)[1:]
+    except RCLError as exc:                  # rcl parses the ROS arguments to find the rest
+        text = _SOURCE_LOCATION.sub("", str(exc))
+        raise ParameterError(f"bad ROS arguments: {text.strip()}") from None
     if "-h" in plain or "--help" in plain:
         print(usage)
         raise SystemExit(0)
@@ -374,9 +378,9 @@ def check_plain_args(argv: list[str], usage: str) -> None:
 def init_ros(args: list[str] | None = None, usage: str = SIM_NODE_USAGE) -> None:
     """``rclpy.init``; ``--help`` prints ``usage``; an unknown plain argument, an unparsable
     ``--ros-args`` or params file raises one ParameterError."""
-    check_plain_args(sys.argv if args is None else args, usage)
     check_params_files(sys.argv if args is None else args)
     check_parameter_rules(sys.argv if args is None else args)
+    check_plain_args(sys.argv if args is None else args, usage)
     try:
         rclpy.init(args=args)
     except RCLError as exc:
