@@ -34,7 +34,7 @@ from drill_sim_ros.model.params import GROUPS, UNIT_SCALES, DimensionlessParams,
 from drill_sim_ros.model.presets import DEFAULT_PRESET, Preset, available_presets, load_preset
 from drill_sim_ros.model.simulator import SimConfig, Simulator
 from drill_sim_ros.model.top_drive import MODES, TopDrive
-from drill_sim_ros.model.validate_input import load_checked_preset
+from drill_sim_ros.model.validate_input import check_blade_counts, load_checked_preset
 from drill_sim_ros.study import cli as study_cli
 from drill_sim_ros.study import suite_cli
 from drill_sim_ros.terminal import StatusLine
@@ -398,10 +398,8 @@ def _cmd_run(args: argparse.Namespace) -> int:
 
 def _cmd_sweep(args: argparse.Namespace) -> int:
     values = _sweep_values(args.values)
-    fractional = [v for v in values if args.vary == "n" and v != round(v)]
-    if fractional:
-        raise DrillSimError(f"--values {args.values!r}: n = {fractional[0]:g} is not a whole "
-                            "number (n counts the blades; it is never rounded)")
+    if args.vary == "n":
+        check_blade_counts(values, f"--values {args.values!r}")
     progress = args.progress or sys.stderr.isatty()
     for value in values:
         setattr(args, args.vary, int(value) if args.vary == "n" else value)

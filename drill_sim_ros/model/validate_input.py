@@ -11,6 +11,7 @@ what is allowed; :func:`load_checked_preset` adds the file.
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 from dataclasses import fields
 from pathlib import Path
 from typing import Any
@@ -65,6 +66,14 @@ def check_value(where: str, key: str, value: Any) -> None:
         raise ParameterError(f"'{where}.{key}' = {value!r} must be a whole number")
     if not math.isfinite(number) and not (key.startswith("max_torque") and number > 0):
         raise ParameterError(f"'{where}.{key}' = {value!r} must be finite")
+
+
+def check_blade_counts(values: Iterable[float], where: str) -> None:
+    """Every value of n a whole number: n counts the blades and is never rounded."""
+    for value in values:
+        if not float(value).is_integer():
+            raise ParameterError(f"{where}: n = {value:g} is not a whole number (n counts the "
+                                 "blades; it is never rounded)")
 
 
 def check_known_keys(values: dict[Any, Any], known: tuple[str, ...], where: str = "") -> None:

@@ -364,8 +364,7 @@ def check_plain_args(argv: list[str], usage: str) -> None:
     try:
         plain = remove_ros_args(argv)[1:]
     except RCLError as exc:                  # rcl parses the ROS arguments to find the rest
-        text = _SOURCE_LOCATION.sub("", str(exc))
-        raise ParameterError(f"bad ROS arguments: {text.strip()}") from None
+        raise bad_ros_arguments(exc) from None
     if "-h" in plain or "--help" in plain:
         print(usage)
         raise SystemExit(0)
@@ -384,8 +383,13 @@ def init_ros(args: list[str] | None = None, usage: str = SIM_NODE_USAGE) -> None
     try:
         rclpy.init(args=args)
     except RCLError as exc:
-        text = _SOURCE_LOCATION.sub("", str(exc)).replace("failed to initialize rcl: ", "")
-        raise ParameterError(f"bad ROS arguments: {text.strip()}") from None
+        raise bad_ros_arguments(exc) from None
+
+
+def bad_ros_arguments(exc: Exception) -> ParameterError:
+    """rcl's complaint about the ROS arguments as one line, without its C source locations."""
+    text = _SOURCE_LOCATION.sub("", str(exc)).replace("failed to initialize rcl: ", "")
+    return ParameterError(f"bad ROS arguments: {text.strip()}")
 
 
 def recording_options(values: dict[str, Any]) -> dict[str, Any]:

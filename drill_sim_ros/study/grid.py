@@ -18,6 +18,7 @@ import numpy as np
 
 from drill_sim_ros.model.errors import ParameterError
 from drill_sim_ros.model.params import DimensionlessParams, Scales
+from drill_sim_ros.model.validate_input import check_blade_counts
 
 GROUPS = ("n", "psi", "beta", "lam", "w0", "omega0")
 DIMENSIONLESS_AXES = (*GROUPS, "w0_ratio")
@@ -141,10 +142,8 @@ def validate_axes(axes: tuple[Axis, ...], physical: bool) -> None:
                                  f"{', '.join(allowed)}{extra}")
         if not a.values or not all(math.isfinite(v) for v in a.values):
             raise ParameterError(f"--vary {a.name}: values must be finite, at least one")
-        fractional = [v for v in a.values if a.name == "n" and v != round(v)]
-        if fractional:
-            raise ParameterError(f"--vary n: {fractional[0]:g} is not a whole number (n counts "
-                                 "the blades; it is never rounded), e.g. n=2:8:7 or n=4,6")
+        if a.name == "n":
+            check_blade_counts(a.values, "--vary n")
     for group in (_W_AXES, _OMEGA_AXES, names):
         chosen = [n for n in names if n in group]
         if len(chosen) > 1 and group is not names:
