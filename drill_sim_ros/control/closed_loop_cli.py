@@ -50,7 +50,7 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--scenario", type=Path, help="scenario YAML (see "
                    "drill_sim_ros/control/scenario.py); the options above override it")
     p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
-                   help="a controller parameter, e.g. --set damping_ratio=0.3 (repeatable)")
+                   help="a controller parameter, e.g. --set impedance_factor=1.5 (repeatable)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--plot", type=Path, help="PNG of speeds with the setpoint, quill and "
                    "motor torque with its limit, WOB; stuck and saturated spans shaded; "

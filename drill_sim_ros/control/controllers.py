@@ -19,26 +19,21 @@ The references (Z, C, I, J, omega_1 from :mod:`drill_sim_ros.control.rig`):
 
 * ``stiff``: omega_ref = omega_0. With a stiff loop the top of the string is nearly a fixed
   speed end, which reflects torsional waves and lets stick-slip through (the baseline).
-* ``soft_torque`` (torque feedback, the SoftTorque/SoftSpeed family: Halsey, Kyllingstad &
-  Kylling 1988, SPE 18049; Kyllingstad & Nessjoen 2009, SPE/IADC 119660):
-  omega_ref = omega_0 - HP(T_sub) / c, the string torque of the torque sub high-pass
-  filtered (first order, corner ``highpass_rad_s``, default omega_1 / 5, so the mean torque
-  does not lower the mean speed and the phase at omega_1 is within 12 degrees). The top then
-  acts, near omega_1, as a damper c in series with the pipe; for the lumped mode (bit inertia
-  I on the spring C, RGD07 eq. 1) s^2 + (C/c) s + C/I = 0, so the damping ratio is
-  zeta = sqrt(C I) / (2 c) and c = sqrt(C I) / (2 zeta) (``damping_ratio``, default 0.5).
-* ``z_torque`` (impedance matching, the Z-Torque family: Dwars 2015, SPE/IADC-173037-MS):
-  the string torque is estimated from the drive alone, T_est = tau_motor - J d omega_s/dt
-  (backward difference of the encoder over one period), low-passed at ``estimate_rad_s``
-  (default 2 omega_1: in speed mode the motor torque is sampled at the end of a period while
-  the speed difference measures its mean over the period; the drive's loop makes the two
-  differ by about kp dw / 2, which feeds back through 1/Z with a gain of kp P / (2 Z) ~ 40
-  per period on the field drive and, filtered less, sets the drive oscillating against its
-  torque limit), and the speed reference follows it
-  through the pipe's characteristic impedance: omega_ref = omega_0 - (T_est - <T_est>) / Z,
-  Z = J_p sqrt(G rho) (``impedance_nm_s``), the mean <T_est> tracked by a first-order
-  low-pass at ``mean_rad_s`` (default omega_1 / 5). A top end moving at -T/Z absorbs an
-  arriving torsional wave without reflection.
+* ``soft_torque`` and ``z_torque`` (:class:`SoftDrive`) emulate a softer drive through the
+  setpoint: the torque sub's string torque T drives a virtual rotor J_v under a virtual PI
+  loop (kp_d, ki_d), and the setpoint makes the real drive move as that rotor, so the top
+  meets the string with the impedance J_v s + kp_d + ki_d / s. ki_d = J_v omega_1^2 cancels
+  the reactance at the first mode, where the top is then the damper kp_d, and
+  |r| = |Z - kp_d| / (Z + kp_d).
+  ``soft_torque`` (the SoftSpeed family: Kyllingstad & Nessjoen 2009, SPE/IADC 119660):
+  kp_d = 2 Z (``impedance_factor``), J_v = J / 10; ``z_torque`` (impedance matching, the
+  ZTorque family: Dwars 2015, SPE/IADC-173037-MS): kp_d = Z (``impedance_nm_s``),
+  J_v = J / 20 (``inertia_fraction``), a broader band.
+  Why this form (docs/closed-loop.md): a high-pass of T fed to the setpoint (the previous
+  designs) made the drive return up to 1.07 of every wave above 5 Hz (the zero-order hold
+  and the stiff loop's lag turn its phase), pumping the collars' ring until the motor hit
+  its limit; a low-pass made it worse. Emulating an impedance that keeps a real inertia at
+  high frequency stays within 1 % of passive there.
 """
 
 from __future__ import annotations
@@ -164,62 +159,101 @@ class Stiff(TopDriveController):
     name = "stiff"
 
 
-class SoftTorque(TopDriveController):
-    """Torque feedback through a high-pass filter, tuned to the lumped first mode."""
+class SoftDrive(TopDriveController):
+    """A softer drive emulated through the setpoint (the shared law of ``soft_torque`` and
+    ``z_torque``; module doc). The string torque of the torque sub drives a virtual rotor of
+    inertia J_v under a virtual PI loop (kp_d, ki_d) on the operator's setpoint:
+    J_v dw_v/dt = kp_d (w_0 - w_v) + I_d - T, dI_d/dt = ki_d (w_0 - w_v). The setpoint sent
+    is w_v plus the torque the real drive needs to move so, u = T + J dw_v/dt, through the
+    inverse of the drive's own PI loop K (kp e + ki int e = u, a first-order filter whose
+    steady state is 0), so the real drive under K moves as the virtual one: its admittance to the string torque is
+    1 / (J_v s + kp_d + ki_d / s). With J_v = J the emulated drive keeps the real inertia at
+    high frequency it is passive at every frequency; a lighter J_v widens the band it
+    absorbs, and the loop's zero-order hold (half a control period) then makes it return
+    slightly more than it receives above a few Hz (|r| - 1 below 0.01 for J_v >= J / 20 on
+    the field drive, docs/closed-loop.md). The virtual state
+    starts at the switch-on from the measured drive speed and torque (no bump)."""
+
+    PARAMS: ClassVar[dict[str, str]] = {**TopDriveController.PARAMS,
+              "inertia_fraction": "J_v / J, the emulated drive's inertia over the real one's",
+              "tuned_rad_s": "where the emulated drive's reactance vanishes, rad/s (default "
+                             "omega_1)"}
+
+    def defaults(self) -> dict[str, float]:
+        return {**super().defaults(), "inertia_fraction": 1.0,
+                "tuned_rad_s": self.rig.first_mode_rad_s}
+
+    def reset(self) -> None:
+        super().reset()
+        self._virtual: list[float] | None = None    # w_v, I_d, e, u
+
+    def virtual_gains(self) -> tuple[float, float, float]:
+        """(J_v kg m^2, kp_d N m s, ki_d N m) of the emulated drive."""
+        raise NotImplementedError
+
+    def inner_gains(self) -> tuple[float, float]:
+        """(kp, ki) of the loop that follows the setpoint: the drive's own in speed mode,
+        the controller's own in torque mode."""
+        if self.mode == "speed":
+            return self.rig.drive_kp_nm_s, self.rig.drive_ki_nm
+        w_c, j = self.params["loop_bandwidth_rad_s"], self.rig.drive_inertia_kg_m2
+        return 2.0 * j * w_c, j * w_c**2
+
+    def reference_rad_s(self, m: SurfaceMeasurement, nominal_rad_s: float) -> float:
+        if not self.active(m.time_s):
+            return nominal_rad_s
+        j_v, kp_d, ki_d = self.virtual_gains()
+        kp, ki = self.inner_gains()
+        if self._virtual is None:                  # start where the drive is, at rest
+            w0 = m.drive_speed_rad_s
+            self._virtual = [w0, m.string_torque_nm - kp_d * (nominal_rad_s - w0), 0.0,
+                             m.string_torque_nm]
+        w_v, i_d, e, u_old = self._virtual
+        p, t_nm = self.period_s, m.string_torque_nm
+        err = nominal_rad_s - w_v
+        i_d += ki_d * err * p
+        tau_v = min(max(kp_d * err + i_d, -self.rig.max_torque_nm), self.rig.max_torque_nm)
+        accel = (tau_v - t_nm) / j_v
+        w_v += accel * p
+        u = t_nm + self.rig.drive_inertia_kg_m2 * accel   # what the real drive must apply
+        e = (e + (u - u_old) / kp) / (1.0 + ki * p / kp)  # through the inverse of its loop
+        self._virtual = [w_v, i_d, e, u]
+        return w_v + e
+
+
+class SoftTorque(SoftDrive):
+    """SoftSpeed-class: the emulated drive is a damper of ``impedance_factor`` x Z at the
+    first mode, where its integral gain cancels the reactance of its inertia
+    (ki_d = J_v omega_1^2; Kyllingstad & Nessjoen 2009, SPE/IADC 119660), with a tenth of the
+    drive's inertia (a band of absorption about omega_1 / 3 .. 3 omega_1 wide)."""
 
     name = "soft_torque"
-    PARAMS: ClassVar[dict[str, str]] = {**TopDriveController.PARAMS,
-              "damping_ratio": "damping ratio of the lumped mode with an ideal speed loop; "
-                               "c = sqrt(C I) / (2 zeta) (default 0.5)",
-              "highpass_rad_s": "corner of the torque high-pass, rad/s (default omega_1 / 5)"}
+    PARAMS: ClassVar[dict[str, str]] = {**SoftDrive.PARAMS,
+              "impedance_factor": "the emulated drive's damping kp_d / Z (default 2: "
+                                  "|r| = 1/3 at the first mode)"}
 
     def defaults(self) -> dict[str, float]:
-        return {**super().defaults(), "damping_ratio": 0.5,
-                "highpass_rad_s": self.rig.first_mode_rad_s / 5.0}
+        return {**super().defaults(), "impedance_factor": 2.0, "inertia_fraction": 0.1}
 
-    def reset(self) -> None:
-        super().reset()
-        self._mean = LowPass(self.params["highpass_rad_s"], self.period_s)
-
-    @property
-    def damping_nm_s(self) -> float:
-        """c = sqrt(C I) / (2 zeta), N m s/rad."""
-        return self.rig.lumped_impedance_nm_s / (2.0 * self.params["damping_ratio"])
-
-    def reference_rad_s(self, m: SurfaceMeasurement, nominal_rad_s: float) -> float:
-        high_nm = m.string_torque_nm - self._mean.update(m.string_torque_nm)
-        return nominal_rad_s - high_nm / self.damping_nm_s
+    def virtual_gains(self) -> tuple[float, float, float]:
+        j_v = self.params["inertia_fraction"] * self.rig.drive_inertia_kg_m2
+        return (j_v, self.params["impedance_factor"] * self.rig.impedance_nm_s,
+                j_v * self.params["tuned_rad_s"] ** 2)
 
 
-class ZTorque(TopDriveController):
-    """Impedance matching on the string torque estimated from the drive."""
+class ZTorque(SoftDrive):
+    """ZTorque-class impedance matching (Dwars 2015, SPE/IADC-173037-MS): the emulated drive
+    is the pipe's characteristic impedance Z at the first mode (an arriving wave is absorbed,
+    nothing comes back), with a twentieth of the drive's inertia (a broader band)."""
 
     name = "z_torque"
-    PARAMS: ClassVar[dict[str, str]] = {**TopDriveController.PARAMS,
-              "impedance_nm_s": "Z, N m s/rad (default J_p sqrt(G rho) of the drill pipe)",
-              "mean_rad_s": "corner of the mean-torque tracker, rad/s (default omega_1 / 5)",
-              "estimate_rad_s": "corner of the low-pass on the torque estimate, rad/s "
-                                "(default 2 omega_1)"}
+    PARAMS: ClassVar[dict[str, str]] = {**SoftDrive.PARAMS,
+              "impedance_nm_s": "Z, N m s/rad (default J_p sqrt(G rho) of the drill pipe)"}
 
     def defaults(self) -> dict[str, float]:
-        w1 = self.rig.first_mode_rad_s
         return {**super().defaults(), "impedance_nm_s": self.rig.impedance_nm_s,
-                "mean_rad_s": w1 / 5.0, "estimate_rad_s": 2.0 * w1}
+                "inertia_fraction": 0.05}
 
-    def reset(self) -> None:
-        super().reset()
-        self._mean = LowPass(self.params["mean_rad_s"], self.period_s)
-        self._estimate = LowPass(self.params["estimate_rad_s"], self.period_s)
-        self._last_speed: float | None = None
-
-    def string_torque_estimate_nm(self, m: SurfaceMeasurement) -> float:
-        """T_est = tau_motor - J (omega_k - omega_k-1) / P (J omega_dot = tau_m - T)."""
-        last = m.drive_speed_rad_s if self._last_speed is None else self._last_speed
-        self._last_speed = m.drive_speed_rad_s
-        accel = (m.drive_speed_rad_s - last) / self.period_s
-        return m.motor_torque_nm - self.rig.drive_inertia_kg_m2 * accel
-
-    def reference_rad_s(self, m: SurfaceMeasurement, nominal_rad_s: float) -> float:
-        torque_nm = self._estimate.update(self.string_torque_estimate_nm(m))
-        high_nm = torque_nm - self._mean.update(torque_nm)
-        return nominal_rad_s - high_nm / self.params["impedance_nm_s"]
+    def virtual_gains(self) -> tuple[float, float, float]:
+        j_v = self.params["inertia_fraction"] * self.rig.drive_inertia_kg_m2
+        return j_v, self.params["impedance_nm_s"], j_v * self.params["tuned_rad_s"] ** 2

@@ -34,6 +34,8 @@ class RigPhysics:
     drive_inertia_kg_m2: float       # J
     impedance_nm_s: float            # Z = J_p sqrt(G rho)
     max_torque_nm: float             # the drive's motor torque limit (inf: none)
+    drive_kp_nm_s: float             # the drive's own speed loop: proportional gain
+    drive_ki_nm: float               # and integral gain
     bit_area_m2: float               # pi a^2, for the specific energy
     max_surface_rpm: float = MAX_SURFACE_RPM   # limits.max_surface_rpm's default
 
@@ -66,4 +68,5 @@ def rig_physics(preset: Preset) -> RigPhysics:
     return RigPhysics(
         stiffness_nm_rad=s.stiffness_nm_per_rad, bit_inertia_kg_m2=s.inertia_kg_m2,
         drive_inertia_kg_m2=drive.inertia_kg_m2, impedance_nm_s=impedance,
-        max_torque_nm=drive.max_torque_nm, bit_area_m2=math.pi * phys.bit_radius_m**2)
+        max_torque_nm=drive.max_torque_nm, drive_kp_nm_s=drive.kp_nm_s,
+        drive_ki_nm=drive.ki_nm, bit_area_m2=math.pi * phys.bit_radius_m**2)

@@ -9,7 +9,7 @@ does not give it)::
     mode: speed                   # speed: the controller sends the drive's speed setpoint;
                                   # torque: it closes its own speed loop, sends motor torque
     controller: soft_torque       # none | stiff | soft_torque | z_torque | package.module:Class
-    params: {damping_ratio: 0.5}  # the controller's parameters (defaults from the physics)
+    params: {impedance_factor: 2.0}  # the controller's parameters (defaults from the physics)
     enable_at_s: 60               # switch-on time; before it the drive runs on the setpoint
     schedule:                     # steps (ramp_s 0) and ramps of surface rpm and WOB
       - {t_s: 0, rpm: 60, wob_n: 60000}

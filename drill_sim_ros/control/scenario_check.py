@@ -46,7 +46,7 @@ def check_params(params: Any) -> dict[str, float]:
     """The controller's parameters: a mapping of names to finite numbers."""
     if not isinstance(params, dict):
         raise ParameterError(f"scenario: 'params' = {params!r} must be a mapping of "
-                             "parameter names to numbers, e.g. {damping_ratio: 0.5}")
+                             "parameter names to numbers, e.g. {impedance_factor: 2.0}")
     return {str(k): check_number(f"params.{k}", v) for k, v in params.items()}
 
 

@@ -164,9 +164,10 @@ class Reflection:
     r_analytic: list[float] | None
 
 
-def reflection_frequencies(count: int = 12, f_lo_hz: float = 0.05,
-                           f_hi_hz: float = 2.0) -> np.ndarray:
-    """Log-spaced frequencies between ``f_lo_hz`` and ``f_hi_hz``."""
+def reflection_frequencies(count: int = 16, f_lo_hz: float = 0.05,
+                           f_hi_hz: float = 20.0) -> np.ndarray:
+    """Log-spaced frequencies between ``f_lo_hz`` and ``f_hi_hz`` (up to the collars' ring:
+    a drive that returns more than it receives there pumps it)."""
     return np.geomspace(f_lo_hz, f_hi_hz, count)
 
 

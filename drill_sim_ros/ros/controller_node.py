@@ -8,7 +8,7 @@ pace: the loop of :class:`~drill_sim_ros.ros.lockstep_driver.LockstepDriver`, wi
 controller of :mod:`drill_sim_ros.control` as its policy.
 
     top_drive_controller --ros-args -p controller:=soft_torque -p enable_at_s:=60.0 \
-        -p soft_torque.damping_ratio:=0.4
+        -p soft_torque.impedance_factor:=1.5
     top_drive_controller --ros-args -p scenario:=my_scenario.yaml -p periods:=18000
 """
 

@@ -90,7 +90,7 @@ def test_user_controller_by_module_and_class(tmp_path: Path) -> None:
         (("--controller", "none", "--mode", "torque"), "none"),
         (("--params", "fig5_8a"), "fig5_8a"),
         (("--t-end", "10", "--enable-at", "20"), "enable_at_s"),
-        (("--set", "damping_ratio=x"), "damping_ratio"),
+        (("--set", "impedance_factor=x"), "impedance_factor"),
         (("--controller", "soft_torque", "--set", "gain=1"), "gain"),
     ],
 )

@@ -77,8 +77,8 @@ def test_a_controller_file_that_does_not_exist_is_one_line(capsys) -> None:
 
 def test_a_huge_controller_parameter_names_its_range(capsys) -> None:
     rc, _, err = run_cli(capsys, "closed-loop", "--controller", "soft_torque", "--set",
-                         "damping_ratio=1e308", *SHORT)
-    one_error_line(rc, err, "damping_ratio", "1e+308", "(0, 1e+09]")
+                         "impedance_factor=1e308", *SHORT)
+    one_error_line(rc, err, "impedance_factor", "1e+308", "(0, 1e+09]")
 
 
 def test_ctrl_c_in_a_run_is_a_clean_stop(tmp_path: Path) -> None:

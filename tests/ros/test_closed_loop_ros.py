@@ -75,7 +75,7 @@ def test_the_controller_node_subscribes_to_surface_measurements_only() -> None:
             ControllerNode(
                 context=ros.context,
                 parameter_overrides=overrides(
-                    controller="soft_torque", enable_at_s=5.0, soft_torque__damping_ratio=0.3
+                    controller="soft_torque", enable_at_s=5.0, soft_torque__impedance_factor=1.5
                 ),
             )
         )
@@ -83,5 +83,5 @@ def test_the_controller_node_subscribes_to_surface_measurements_only() -> None:
         assert [pub.topic_name for pub in node.publishers if "cmd" in pub.topic_name] == [
             topics.CMD_TOP_DRIVE
         ]
-        assert node.controller.params["damping_ratio"] == 0.3
+        assert node.controller.params["impedance_factor"] == 1.5
         assert node.scenario.enable_at_s == 5.0
