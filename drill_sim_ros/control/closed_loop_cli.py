@@ -33,7 +33,9 @@ LABELS = {"ssi_before_mean": "SSI before switch-on (mean)", "ssi_mean": "SSI aft
           "quill_torque_peak_nm": "quill torque peak [N m]",
           "quill_torque_rms_nm": "quill torque RMS [N m]",
           "motor_energy_mj": "motor energy [MJ]", "saturation_count": "saturated samples",
-          "status": "status", "stall_time_s": "stalled at [s]"}
+          "saturation_fraction": "at the torque limit", "period_s": "stick-slip period [s]",
+          "hfto_rms_rpm": "HFTO RMS [rpm]", "hfto_hz": "HFTO frequency [Hz]",
+          "cutoff_hz": "cut-off [Hz]", "status": "status", "stall_time_s": "stalled at [s]"}
 
 
 def add_parser(sub: Any) -> None:
