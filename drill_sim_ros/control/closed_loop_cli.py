@@ -188,8 +188,7 @@ def _closed_loop(args: argparse.Namespace, scenario: Scenario, preset: Preset,
                     (label, controlled.rows, scenario.mode == "speed")) if rows is not None]
         plot_runs(plot_tmp, runs, PlotContext(
             f"{preset.name}: {label}, switched on at {scenario.enable_at_s:g} s", schedule,
-            scenario.enable_at_s, rig.max_torque_nm, rig.max_surface_rpm,
-            schedule_events(schedule)))
+            scenario.enable_at_s, rig, schedule_events(schedule)))
         try:
             commit(plot_tmp, args.plot, args.overwrite)
         except OutputError as exc:

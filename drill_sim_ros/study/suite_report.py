@@ -176,10 +176,13 @@ def report_markdown(entries: Sequence[Entry], results: dict[str, EntryResult],
                     images: dict[str, Path], wall_s: float) -> str:
     lines = ["# drill_sim suite", "",
              f"{len(entries)} runs (controller x scenario), {wall_s:.0f} s of wall time for "
-             "those computed by the last call. Columns: SSI after the switch-on (mean of "
-             "whole 20 s windows), stick fraction after it, mean ROP, MSE at the bit, time "
-             "from the switch-on to the last stick (- while it still sticks in the last "
-             "20 s), share of samples with the drive saturated, status.", ""]
+             "those computed by the last call. Columns (of the bit speed low-passed at the "
+             "rig's cut-off, twice its third torsional mode, unless said): SSI after the "
+             "switch-on (mean of whole 20 s windows), stick fraction after it, the "
+             "stick-slip period, the RMS of the bit speed above the cut-off (the collars' "
+             "ringing, HFTO), mean ROP, MSE at the bit, time from the switch-on to the last "
+             "stick (- while it still sticks in the last 20 s), share of samples with the "
+             "motor torque at its limit, status.", ""]
     for name, group in _by_scenario(entries).items():
         scenario = group[0].scenario
         lines += [f"## {name}", "", scenario.description or "", "",
