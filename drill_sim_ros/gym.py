@@ -20,7 +20,9 @@ bit for bit.
   limit (10 x the steady bit torque if it has none) and ROP_0 the ROP of the t = 0 state.
   The first term is 0 when the bit turns at the setpoint, 1 when it is stuck.
 * An episode is the scenario's duration (truncated at its end); a numerical fault of the
-  model terminates it (``info["fault"]``).
+  model terminates it (``info["fault"]``). The info of the step that ends it carries the
+  episode's scorecard (``info["score"]``: :func:`~drill_sim_ros.control.scorecard.score`,
+  the keys of ``SCORE_FIELDS``, as ``drill_sim closed-loop --json`` gives them).
 
 Options (constructor or ``reset(options=...)``): ``scenario`` (a name of config/scenarios, a
 YAML path or a :class:`~drill_sim_ros.control.scenario.Scenario`), ``preset``, ``mode``.
@@ -49,6 +51,7 @@ from gymnasium import spaces
 from drill_sim_ros.control.bench import Bench
 from drill_sim_ros.control.command import Command
 from drill_sim_ros.control.scenario import Scenario, load_scenario, scenario_path
+from drill_sim_ros.control.scorecard import score
 from drill_sim_ros.model import analysis
 from drill_sim_ros.model.errors import NumericalFault, ParameterError
 from drill_sim_ros.model.params import RPM_PER_RAD_S
@@ -124,6 +127,10 @@ class DrillStickSlipEnv(gymnasium.Env):
             info["fault"] = str(exc)
             return obs, 0.0, True, False, info
         obs, info = self._observe()
+        if self.bench.done:
+            bench = self.bench
+            info["score"] = score(bench.rows, self.scenario.enable_at_s, bench.schedule,
+                                  bench.rig, self.scenario.period_s)
         return obs, self._reward(row), False, self.bench.done, info
 
     def _command(self, value: float) -> Command:

@@ -13,6 +13,8 @@ from gymnasium.utils.env_checker import check_env
 import drill_sim_ros.gym as drill_gym
 from drill_sim_ros.control.bench import build_controller, run_in_process
 from drill_sim_ros.control.command import Command
+from drill_sim_ros.control.rig import rig_physics
+from drill_sim_ros.control.scorecard import SCORE_FIELDS, score
 from drill_sim_ros.model.params import RPM_PER_RAD_S
 from drill_sim_ros.model.telemetry import TELEMETRY_INDEX as F
 
@@ -46,6 +48,11 @@ def test_a_policy_rollout_is_the_bench_run_bit_for_bit(controller: str, mode: st
     assert steps == scenario.periods and not terminated
     rows = run_in_process(scenario).rows
     assert np.array_equal(env.unwrapped.bench.rows, rows)
+    # the last step's info carries the episode's scorecard, the bench run's
+    preset = scenario.load_preset()
+    assert list(info["score"]) == list(SCORE_FIELDS)
+    assert info["score"] == score(rows, scenario.enable_at_s, scenario.setpoints(preset),
+                                  rig_physics(preset), scenario.period_s)
     # the observation is the last sample's surface measurement, not the truth
     assert obs[0] == rows[-1, F["drive_speed_measured_rad_s"]] != \
         rows[-1, F["surface_rpm"]] / RPM_PER_RAD_S

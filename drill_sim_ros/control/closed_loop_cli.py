@@ -33,7 +33,9 @@ LABELS = {"ssi_before_mean": "SSI before switch-on (mean)", "ssi_mean": "SSI aft
           "quill_torque_peak_nm": "quill torque peak [N m]",
           "quill_torque_rms_nm": "quill torque RMS [N m]",
           "motor_energy_mj": "motor energy [MJ]", "saturation_count": "saturated samples",
-          "status": "status", "stall_time_s": "stalled at [s]"}
+          "saturation_fraction": "at the torque limit", "period_s": "stick-slip period [s]",
+          "hfto_rms_rpm": "HFTO RMS [rpm]", "hfto_hz": "HFTO frequency [Hz]",
+          "cutoff_hz": "cut-off [Hz]", "status": "status", "stall_time_s": "stalled at [s]"}
 
 
 def add_parser(sub: Any) -> None:
@@ -186,8 +188,7 @@ def _closed_loop(args: argparse.Namespace, scenario: Scenario, preset: Preset,
                     (label, controlled.rows, scenario.mode == "speed")) if rows is not None]
         plot_runs(plot_tmp, runs, PlotContext(
             f"{preset.name}: {label}, switched on at {scenario.enable_at_s:g} s", schedule,
-            scenario.enable_at_s, rig.max_torque_nm, rig.max_surface_rpm,
-            schedule_events(schedule)))
+            scenario.enable_at_s, rig, schedule_events(schedule)))
         try:
             commit(plot_tmp, args.plot, args.overwrite)
         except OutputError as exc:

@@ -11,7 +11,11 @@ From a physical preset (RGD07 eq. 1 and the top drive of ``model.top_drive``):
   the torque a torsional wave carries per unit of angular speed, so a top end that turns at
   -T/Z absorbs an arriving wave without reflection (the principle of the impedance-matching
   soft-torque systems, Dwars 2015, SPE/IADC-173037-MS);
-* omega_1 = sqrt(C/I) = 1/t*, the string's first torsional mode on a fixed top (eq. 19).
+* omega_1 = sqrt(C/I) = 1/t*, the string's first torsional mode on a fixed top (eq. 19);
+* the first three torsional natural frequencies of the string as sections (fixed top, free
+  bit with its lumped inertia; ``string.analytic_modes_hz``; of a lumped preset: of the
+  two sections its ``pipe_*`` / ``bha_*`` keys describe), and the scorecard's cut-off
+  between stick-slip and the collars' ringing, twice the third (:func:`cutoff_of`).
 """
 
 from __future__ import annotations
@@ -21,8 +25,12 @@ from dataclasses import dataclass
 
 from drill_sim_ros.model.defaults import MAX_SURFACE_RPM
 from drill_sim_ros.model.errors import ParameterError
-from drill_sim_ros.model.params import structure
-from drill_sim_ros.model.presets import Preset
+from drill_sim_ros.model.params import PhysicalParams, structure
+from drill_sim_ros.model.presets import Preset, string_from_dict
+from drill_sim_ros.model.string import StringSpec, analytic_modes_hz
+
+MODE_COUNT = 3          # torsional modes kept on RigPhysics
+CUTOFF_PER_MODE = 2.0   # the cut-off, in units of the highest mode kept
 
 
 @dataclass(frozen=True)
@@ -37,6 +45,8 @@ class RigPhysics:
     drive_kp_nm_s: float             # the drive's own speed loop: proportional gain
     drive_ki_nm: float               # and integral gain
     bit_area_m2: float               # pi a^2, for the specific energy
+    torsional_modes_hz: tuple[float, ...]   # the first MODE_COUNT, fixed top, free bit
+    cutoff_hz: float                 # stick-slip below, the collars' ringing above
     max_surface_rpm: float = MAX_SURFACE_RPM   # limits.max_surface_rpm's default
 
     @property
@@ -65,8 +75,32 @@ def rig_physics(preset: Preset) -> RigPhysics:
                                          - phys.pipe_inner_radius_m**4)
         impedance = pipe_polar_m4 * math.sqrt(phys.shear_modulus_pa * phys.density_kg_m3)
     drive = preset.top_drive.physical(preset.scales)
+    modes_hz = tuple(analytic_modes_hz(sections_of(preset.string, phys), MODE_COUNT))
     return RigPhysics(
         stiffness_nm_rad=s.stiffness_nm_per_rad, bit_inertia_kg_m2=s.inertia_kg_m2,
         drive_inertia_kg_m2=drive.inertia_kg_m2, impedance_nm_s=impedance,
         max_torque_nm=drive.max_torque_nm, drive_kp_nm_s=drive.kp_nm_s,
-        drive_ki_nm=drive.ki_nm, bit_area_m2=math.pi * phys.bit_radius_m**2)
+        drive_ki_nm=drive.ki_nm, bit_area_m2=math.pi * phys.bit_radius_m**2,
+        torsional_modes_hz=modes_hz, cutoff_hz=cutoff_of(modes_hz))
+
+
+def sections_of(string: StringSpec, phys: PhysicalParams) -> StringSpec:
+    """A physical preset's string as sections: its own when distributed, else the
+    two-section shorthand of its ``pipe_*`` / ``bha_*`` keys (``presets.string_from_dict``,
+    the one reading of them)."""
+    if string.distributed:
+        return string
+    return string_from_dict({"model": "distributed"}, phys)
+
+
+def cutoff_of(modes_hz: tuple[float, ...]) -> float:
+    """The cut-off between the string's stick-slip and the collars' ringing (Hz): twice
+    the highest of the first MODE_COUNT torsional modes (inf when fewer were found).
+
+    Stick-slip has its fundamental at 1/(1 to 2.5 T1), T1 the first mode's period, and
+    needs about a dozen harmonics to keep the shape of its stick phases, which reach past
+    the third mode; the collars ring (high-frequency torsional oscillation) an order of
+    magnitude higher, 16 Hz on the field preset. Twice f3 lies between the two."""
+    if len(modes_hz) < MODE_COUNT:
+        return math.inf
+    return CUTOFF_PER_MODE * modes_hz[MODE_COUNT - 1]

@@ -2,18 +2,29 @@
 
 ROS-free; from telemetry rows (``TELEMETRY_FIELDS``, SI) of a run, after the switch-on:
 
+* stick-slip is judged on the bit speed low-passed at the rig's cut-off
+  (``RigPhysics.cutoff_hz``, twice the string's third torsional mode;
+  ``model.analysis.lowpass``, zero-phase): on a distributed string the collars ring at the
+  bit an order of magnitude faster (high-frequency torsional oscillation, HFTO), and a
+  ring that touches zero is no stick phase. A sample is stuck when the low-passed bit
+  speed is below ``STUCK_RPM``;
 * SSI over whole 20 s windows (``model.analysis.stick_slip_index``, the one SSI:
-  (max - min) / (2 mean) of bit rpm), mean and max, that of the last window (settled), and
-  the mean before the switch-on;
-* stick fraction (share of samples with the bit stuck), UTR = (omega_0 - min) / omega_0
-  (``model.analysis.severity_of``, omega_0 the mean setpoint of the schedule);
+  (max - min) / (2 mean) of the low-passed bit rpm), mean and max, that of the last window
+  (settled), and the mean before the switch-on;
+* stick fraction (share of samples stuck), UTR = (omega_0 - min) / omega_0 of the raw bit
+  speed (``model.analysis.severity_of``, omega_0 the mean setpoint of the schedule);
 * time to suppress: from the switch-on to the last stuck sample (0 if none; None when the
   bit still sticks in the last 20 s);
+* period: the dominant period of the low-passed bit speed (its spectral peak above
+  ``PERIOD_MIN_HZ``; None when it is flat: no spectral line of ``MIN_OSCILLATION_RMS_RPM``);
+* HFTO: the RMS of the bit speed above the cut-off (raw minus low-passed), its dominant
+  frequency (None below ``MIN_OSCILLATION_RMS_RPM``), and the cut-off used;
 * mean ROP (m/h); mechanical specific energy at the bit (Teale 1965: <WOB>/A +
   <TOB omega_bit>/(A <ROP>), MPa);
 * peak and RMS string torque at the quill (N m), motor energy (the motor's work
   sum tau_m omega_drive P, MJ), saturation count (samples at the motor torque limit or with
-  the speed setpoint at 0 or at the rpm limit);
+  the speed setpoint at 0 or at the rpm limit) and saturation fraction (share of samples
+  with the motor torque at its limit, alone);
 * status: ``stalled`` when the bit is stuck for good (stuck without a break for the last
   ``STALL_S`` seconds or more of the run; ``stall_time_s`` is when that span began),
   else ``stick-slip`` when the bit still sticks in the last 20 s, else ``ok``. (A run that
@@ -34,14 +45,18 @@ from drill_sim_ros.model.params import RPM_PER_RAD_S
 from drill_sim_ros.model.telemetry import TELEMETRY_INDEX
 
 F = TELEMETRY_INDEX
-STUCK = 2
+STUCK_RPM = 1.0           # low-passed bit speed below this: stuck (on the lumped twin the
+                          # raw stuck share 0.208 reads 0.211 by this rule)
+MIN_OSCILLATION_RMS_RPM = 0.1   # below this RMS a component has no frequency (flat)
+PERIOD_MIN_HZ = 0.02      # the slowest stick-slip the period looks for (50 s)
 WINDOW_S = defaults.WINDOW_S  # the severity window of sim_node's /diagnostics
 STALL_S = 10.0            # stuck this long at the end of a run: stalled (a stick phase of
                           # the field case's stick-slip lasts 2-4 s)
 SCORE_FIELDS = ("ssi_before_mean", "ssi_mean", "ssi_max", "ssi_last", "stick_fraction", "utr",
                 "time_to_suppress_s", "rop_m_h", "mse_mpa", "quill_torque_peak_nm",
-                "quill_torque_rms_nm", "motor_energy_mj", "saturation_count", "status",
-                "stall_time_s")
+                "quill_torque_rms_nm", "motor_energy_mj", "saturation_count",
+                "saturation_fraction", "period_s", "hfto_rms_rpm", "hfto_hz", "cutoff_hz",
+                "status", "stall_time_s")
 STATUSES = ("ok", "stick-slip", "stalled", "fault")
 
 
@@ -72,28 +87,20 @@ def score(rows: np.ndarray, enable_at_s: float, schedule: Schedule, rig: RigPhys
     rows = rows[rows[:, F["sim_time_s"]] > 0.0]          # the t = 0 sample is no period
     t = rows[:, F["sim_time_s"]]
     end_s = float(t[-1])
-    after = rows[t > enable_at_s]
+    slow_all = lowpassed_bit_rpm(rows, rig.cutoff_hz)
+    is_after = t > enable_at_s
+    after, slow = rows[is_after], slow_all[is_after]
     ta = after[:, F["sim_time_s"]]
     bit = after[:, F["bit_rpm"]]
-    stuck = after[:, F["mode"]] == STUCK
-    ssi = window_ssi(ta, bit, enable_at_s, end_s)
-    before = window_ssi(t, rows[:, F["bit_rpm"]], 0.0, enable_at_s) if enable_at_s >= \
-        WINDOW_S else np.array([])
+    stuck = slow < STUCK_RPM
+    ssi = window_ssi(ta, slow, enable_at_s, end_s)
+    before = window_ssi(t, slow_all, 0.0, enable_at_s) if enable_at_s >= WINDOW_S else \
+        np.array([])
     omega0_rpm = float(np.mean([schedule.rpm_at(x) for x in ta]))
     sev = analysis.severity_of(float(bit.min()), float(bit.max()), float(bit.mean()),
                                omega0_rpm)
-    rop = after[:, F["rop_m_s"]]
-    quill = after[:, F["surface_torque_nm"]]
-    motor = after[:, F["motor_torque_nm"]]
-    drive_rad_s = after[:, F["surface_rpm"]] / RPM_PER_RAD_S
-    bit_power_w = after[:, F["tob_nm"]] * bit / RPM_PER_RAD_S
-    mse_pa = (after[:, F["wob_n"]].mean() + bit_power_w.mean() / rop.mean()) / rig.bit_area_m2 \
-        if rop.mean() > 0 else math.nan
-    setpoint = after[:, F["speed_setpoint_rpm"]]
-    saturated = (np.abs(motor) >= rig.max_torque_nm * (1 - 1e-9)) | (setpoint <= 0.0) | \
-        (setpoint >= rig.max_surface_rpm)
     suppress_s = _time_to_suppress(ta, stuck, enable_at_s, end_s)
-    stall_s = stall_time_s(t, rows[:, F["mode"]] == STUCK)
+    stall_s = stall_time_s(t, slow_all < STUCK_RPM)
     status = "stalled" if stall_s is not None else "stick-slip" if suppress_s is None \
         else "ok"
     return {
@@ -102,14 +109,74 @@ def score(rows: np.ndarray, enable_at_s: float, schedule: Schedule, rig: RigPhys
         "ssi_last": float(ssi[-1]) if np.isfinite(ssi[-1]) else None,
         "stick_fraction": float(stuck.mean()), "utr": sev.utr,
         "time_to_suppress_s": suppress_s,
+        **_costs(after, rig, period_s),
+        "period_s": _period_s(slow, sample_period_s(rows)),
+        **_hfto(bit - slow, sample_period_s(rows), rig.cutoff_hz),
+        "status": status, "stall_time_s": stall_s,
+    }
+
+
+def _costs(after: np.ndarray, rig: RigPhysics, period_s: float) -> dict[str, Any]:
+    """ROP, specific energy, quill torque, motor energy and saturation of ``after``."""
+    rop = after[:, F["rop_m_s"]]
+    quill = after[:, F["surface_torque_nm"]]
+    motor = after[:, F["motor_torque_nm"]]
+    drive_rad_s = after[:, F["surface_rpm"]] / RPM_PER_RAD_S
+    bit_power_w = after[:, F["tob_nm"]] * after[:, F["bit_rpm"]] / RPM_PER_RAD_S
+    mse_pa = (after[:, F["wob_n"]].mean() + bit_power_w.mean() / rop.mean()) / rig.bit_area_m2 \
+        if rop.mean() > 0 else math.nan
+    return {
         "rop_m_h": float(rop.mean() * 3600.0),
         "mse_mpa": mse_pa * 1e-6 if math.isfinite(mse_pa) else None,
         "quill_torque_peak_nm": float(np.max(np.abs(quill))),
         "quill_torque_rms_nm": float(np.sqrt(np.mean(quill**2))),
         "motor_energy_mj": float(np.sum(motor * drive_rad_s) * period_s * 1e-6),
-        "saturation_count": int(saturated.sum()),
-        "status": status, "stall_time_s": stall_s,
+        "saturation_count": int(saturated(after, rig).sum()),
+        "saturation_fraction": float(at_torque_limit(after, rig).mean()),
     }
+
+
+def sample_period_s(rows: np.ndarray) -> float:
+    """The sampling period of ``rows`` (s): the median step of their time (1 if one row)."""
+    t = rows[:, F["sim_time_s"]]
+    return float(np.median(np.diff(t))) if t.size > 1 else 1.0
+
+
+def lowpassed_bit_rpm(rows: np.ndarray, cutoff_hz: float) -> np.ndarray:
+    """The bit speed of ``rows`` (uniformly sampled) below ``cutoff_hz``: what stick-slip is
+    judged on (rpm, shape (rows,))."""
+    return analysis.lowpass(rows[:, F["bit_rpm"]], sample_period_s(rows), cutoff_hz)
+
+
+def at_torque_limit(rows: np.ndarray, rig: RigPhysics) -> np.ndarray:
+    """Samples with the motor torque at the drive's limit (either sign)."""
+    return np.abs(rows[:, F["motor_torque_nm"]]) >= rig.max_torque_nm * (1 - 1e-9)
+
+
+def saturated(rows: np.ndarray, rig: RigPhysics) -> np.ndarray:
+    """Samples where the drive is saturated: the motor torque at its limit, or the speed
+    setpoint at 0 or at the rpm limit."""
+    setpoint = rows[:, F["speed_setpoint_rpm"]]
+    return at_torque_limit(rows, rig) | (setpoint <= 0.0) | (setpoint >= rig.max_surface_rpm)
+
+
+def _period_s(slow_rpm: np.ndarray, sample_period_s: float) -> float | None:
+    """The dominant period of the low-passed bit speed; None when it is flat: no line of
+    its spectrum above PERIOD_MIN_HZ is a sine of MIN_OSCILLATION_RMS_RPM (a transient at
+    the record's ends, where the low-pass is least sure, makes no line)."""
+    peak = analysis.spectral_peak(slow_rpm, sample_period_s, PERIOD_MIN_HZ)
+    if peak is None or peak[1] < math.sqrt(2.0) * MIN_OSCILLATION_RMS_RPM:
+        return None
+    return 1.0 / peak[0]
+
+
+def _hfto(fast_rpm: np.ndarray, sample_period_s: float, cutoff_hz: float) -> dict[str, Any]:
+    """RMS and dominant frequency of the bit speed above the cut-off, and the cut-off."""
+    rms = float(np.sqrt(np.mean(fast_rpm**2)))
+    peak = analysis.spectral_peak(fast_rpm, sample_period_s, cutoff_hz) \
+        if rms >= MIN_OSCILLATION_RMS_RPM else None
+    return {"hfto_rms_rpm": rms, "hfto_hz": None if peak is None else peak[0],
+            "cutoff_hz": cutoff_hz if math.isfinite(cutoff_hz) else None}
 
 
 def stall_time_s(time_s: np.ndarray, stuck: np.ndarray, stall_s: float = STALL_S

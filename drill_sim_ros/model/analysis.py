@@ -4,7 +4,9 @@
 * :func:`critical_delay`, :func:`rightmost_root` - linear stability, Appendix B (B.2, B.7);
 * :func:`cycle_averages` - kappa (42), eta (43), the identities (44)-(47), E and S (48);
 * :func:`kappa_from_depth` - kappa from the mean depth of cut (45a);
-* :func:`severity` - stick-slip severity index and under-torque ratio of bit rpm.
+* :func:`severity` - stick-slip severity index and under-torque ratio of bit rpm;
+* :func:`lowpass`, :func:`amplitude_spectrum`, :func:`spectral_peak` - a zero-phase
+  low-pass and the spectrum of a uniformly sampled record (numpy only).
 """
 
 from __future__ import annotations
@@ -231,3 +233,58 @@ def first_event_tau(acc: np.ndarray) -> tuple[float | None, float | None]:
     def _opt(x: float) -> float | None:
         return None if math.isnan(x) else float(x)
     return _opt(acc[k.A_FIRST_STICK]), _opt(acc[k.A_FIRST_BOUNCE])
+
+
+# ---- signals: one low-pass, one spectrum ---------------------------------------------------
+LOWPASS_ORDER = 4          # the Butterworth order whose forward-backward magnitude is used
+SPECTRUM_ZERO_PAD = 8      # zero padding of the spectrum: 8x the record's length
+
+
+def lowpass(signal: ArrayLike, sample_period_s: float, cutoff_hz: float) -> np.ndarray:
+    """``signal`` (uniform samples, shape (n,)) low-passed at ``cutoff_hz``, zero-phase.
+
+    Applied in the frequency domain with the magnitude of a 4th-order Butterworth run
+    forward and backward, |H(f)|^2 = 1 / (1 + (f / fc)^8): 1/2 at fc, no phase shift, so
+    a stick phase stays where it was. The mean is removed first and restored; the record is
+    padded by reflection at both ends (n - 1 samples each, mirrored about the end sample) so
+    that the circular convolution of the FFT does not wrap its end onto its start; within
+    about 1 / fc of an end, the mirror's kink in slope shows (a record that ends at rest,
+    e.g. a stuck bit, is exact there). An infinite ``cutoff_hz`` passes everything."""
+    x = np.asarray(signal, dtype=float)
+    if not cutoff_hz > 0.0:
+        raise ValueError(f"cutoff_hz = {cutoff_hz!r} must be positive")
+    if x.size < 2:
+        return x.copy()
+    mean = float(x.mean())
+    pad = x.size - 1
+    padded = np.pad(x - mean, pad, mode="reflect")
+    freq_hz = np.fft.rfftfreq(padded.size, sample_period_s)
+    gain = 1.0 / (1.0 + (freq_hz / cutoff_hz) ** (2 * LOWPASS_ORDER))
+    out = np.fft.irfft(np.fft.rfft(padded) * gain, n=padded.size)
+    return out[pad:pad + x.size] + mean
+
+
+def amplitude_spectrum(signal: ArrayLike, sample_period_s: float
+                       ) -> tuple[np.ndarray, np.ndarray]:
+    """(frequency Hz, amplitude) of ``signal`` (uniform samples), mean removed, through a
+    Hann window, zero-padded to ``SPECTRUM_ZERO_PAD`` times its length; scaled so that a
+    sine of amplitude A reads A at its peak (within the window's scalloping, under 1 %
+    with this padding). Its resolution is still 1 / (the record's duration)."""
+    x = np.asarray(signal, dtype=float)
+    window = np.hanning(x.size)
+    n_fft = SPECTRUM_ZERO_PAD * max(x.size, 1)
+    spectrum = np.fft.rfft((x - x.mean()) * window, n_fft) if x.size else np.zeros(1)
+    scale = 2.0 / window.sum() if window.sum() > 0 else 0.0
+    return np.fft.rfftfreq(n_fft, sample_period_s), np.abs(spectrum) * scale
+
+
+def spectral_peak(signal: ArrayLike, sample_period_s: float,
+                  low_hz: float = 0.0) -> tuple[float, float] | None:
+    """(frequency Hz, amplitude) of the peak of :func:`amplitude_spectrum` above
+    ``low_hz``; None when there is no spectrum above it or it is zero (a constant record)."""
+    freq_hz, amplitude = amplitude_spectrum(signal, sample_period_s)
+    above = freq_hz > low_hz
+    if not above.any() or not np.any(amplitude[above] > 0.0):
+        return None
+    peak = int(np.argmax(amplitude[above]))
+    return float(freq_hz[above][peak]), float(amplitude[above][peak])

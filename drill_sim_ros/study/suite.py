@@ -136,7 +136,6 @@ def run_entry(scenario_data: dict[str, Any], key: str) -> EntryResult:
                 "fault_time_s": float(rows[-1, F["sim_time_s"]])}
         return EntryResult(key, card, wall_s, trace)
     card = score(rows, scenario.enable_at_s, bench.schedule, bench.rig, scenario.period_s)
-    card["saturation_fraction"] = card["saturation_count"] / max(1, bench.periods)
     return EntryResult(key, card, wall_s, trace)
 
 

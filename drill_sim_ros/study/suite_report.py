@@ -20,14 +20,17 @@ from drill_sim_ros.study.suite import Entry, EntryResult
 
 # (card key, column head, format) of the table
 COLUMNS = (("ssi_mean", "SSI after", ".3f"), ("stick_fraction", "stick frac", ".3f"),
+           ("period_s", "period s", ".2f"), ("hfto_rms_rpm", "HFTO rpm", ".1f"),
            ("rop_m_h", "ROP m/h", ".2f"), ("mse_mpa", "MSE MPa", ".0f"),
            ("time_to_suppress_s", "suppress s", ".1f"),
-           ("saturation_fraction", "saturated", ".1%"))
+           ("saturation_fraction", "at limit", ".1%"))
 NUMERIC = ("ssi_mean", "ssi_max", "ssi_last", "stick_fraction", "utr", "time_to_suppress_s",
            "rop_m_h", "mse_mpa", "quill_torque_peak_nm", "quill_torque_rms_nm",
-           "motor_energy_mj", "saturation_fraction", "stall_time_s", "wall_s")
+           "motor_energy_mj", "saturation_count", "saturation_fraction", "period_s",
+           "hfto_rms_rpm", "hfto_hz", "cutoff_hz", "stall_time_s", "wall_s")
 UNITS = {"rop_m_h": "m/h", "mse_mpa": "MPa", "time_to_suppress_s": "s", "stall_time_s": "s",
          "quill_torque_peak_nm": "N m", "quill_torque_rms_nm": "N m", "motor_energy_mj": "MJ",
+         "period_s": "s", "hfto_rms_rpm": "rev/min", "hfto_hz": "Hz", "cutoff_hz": "Hz",
          "wall_s": "s"}
 
 
@@ -161,8 +164,7 @@ def draw_pictures(out: Path, entries: Sequence[Entry],
         preset = scenario.load_preset()
         rig, schedule = rig_physics(preset), scenario.setpoints(preset)
         ctx = PlotContext(f"{name}: {scenario.description}"[:150], schedule,
-                          scenario.enable_at_s, rig.max_torque_nm, rig.max_surface_rpm,
-                          schedule_events(schedule))
+                          scenario.enable_at_s, rig, schedule_events(schedule))
         path = out / f"{name}.png"
         plot_runs(path, [PlotRun(_label(e), r.rows(), e.scenario.mode == "speed",
                                  status_text(r.card)) for e, r in runs], ctx)
@@ -174,10 +176,13 @@ def report_markdown(entries: Sequence[Entry], results: dict[str, EntryResult],
                     images: dict[str, Path], wall_s: float) -> str:
     lines = ["# drill_sim suite", "",
              f"{len(entries)} runs (controller x scenario), {wall_s:.0f} s of wall time for "
-             "those computed by the last call. Columns: SSI after the switch-on (mean of "
-             "whole 20 s windows), stick fraction after it, mean ROP, MSE at the bit, time "
-             "from the switch-on to the last stick (- while it still sticks in the last "
-             "20 s), share of samples with the drive saturated, status.", ""]
+             "those computed by the last call. Columns (of the bit speed low-passed at the "
+             "rig's cut-off, twice its third torsional mode, unless said): SSI after the "
+             "switch-on (mean of whole 20 s windows), stick fraction after it, the "
+             "stick-slip period, the RMS of the bit speed above the cut-off (the collars' "
+             "ringing, HFTO), mean ROP, MSE at the bit, time from the switch-on to the last "
+             "stick (- while it still sticks in the last 20 s), share of samples with the "
+             "motor torque at its limit, status.", ""]
     for name, group in _by_scenario(entries).items():
         scenario = group[0].scenario
         lines += [f"## {name}", "", scenario.description or "", "",

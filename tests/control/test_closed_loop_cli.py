@@ -12,7 +12,9 @@ import numpy as np
 import pytest
 
 from drill_sim_ros.control.bench import run_in_process
+from drill_sim_ros.control.closed_loop_cli import LABELS
 from drill_sim_ros.control.scenario import Scenario
+from drill_sim_ros.control.scorecard import SCORE_FIELDS
 from drill_sim_ros.model.telemetry import TELEMETRY_INDEX
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -50,10 +52,12 @@ def test_json_table_and_plot(tmp_path: Path) -> None:
     out = json.loads(result.stdout)
     assert out["periods"] == 6000 and out["scenario"]["mode"] == "torque"
     assert out["score"]["stick_fraction"] < out["baseline"]["stick_fraction"]
+    assert list(out["score"]) == list(SCORE_FIELDS) == list(LABELS)
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and png.stat().st_size > 20_000
     table = drill_sim("--controller", "stiff", "--t-end", "30", "--enable-at", "10")
     assert table.returncode == 0, table.stderr
     assert "SSI after (mean)" in table.stdout and "no control" in table.stdout
+    assert all(LABELS[key] in table.stdout for key in SCORE_FIELDS)
 
 
 def test_user_controller_by_module_and_class(tmp_path: Path) -> None:

@@ -70,9 +70,13 @@ def test_the_table_and_its_files(league: tuple[Path, str, list[Path]]) -> None:
         card = score(run_in_process(scenario).rows, scenario.enable_at_s,
                      scenario.setpoints(preset), rig_physics(preset), scenario.period_s)
         got = by[(name, "soft_torque")]["score"]
-        for key in ("ssi_mean", "stick_fraction", "rop_m_h", "mse_mpa", "saturation_count"):
+        for key in ("ssi_mean", "stick_fraction", "rop_m_h", "mse_mpa", "saturation_count",
+                    "saturation_fraction", "period_s", "hfto_rms_rpm", "cutoff_hz"):
             assert got[key] == pytest.approx(card[key], rel=1e-12), key
     ds = xr.load_dataset(out / "suite.nc", engine="h5netcdf")
+    for key in ("hfto_rms_rpm", "period_s", "saturation_fraction", "cutoff_hz"):
+        assert ds[key].sel(scenario="field", controller="soft_torque (speed)").item() == \
+            pytest.approx(by[("field", "soft_torque")]["score"][key], rel=1e-12), key
     assert list(ds["scenario"].values) == ["field", "step", "streak"]
     assert ds["status"].sel(scenario="field").values.tolist() == ["stick-slip", "ok"]
     assert np.isfinite(ds["ssi_mean"].sel(scenario="streak")).all()
