@@ -166,13 +166,14 @@ class SoftDrive(TopDriveController):
     J_v dw_v/dt = kp_d (w_0 - w_v) + I_d - T, dI_d/dt = ki_d (w_0 - w_v). The setpoint sent
     is w_v plus the torque the real drive needs to move so, u = T + J dw_v/dt, through the
     inverse of the drive's own PI loop K (kp e + ki int e = u, a first-order filter whose
-    steady state is 0), so the real drive under K moves as the virtual one: its admittance to the string torque is
-    1 / (J_v s + kp_d + ki_d / s). With J_v = J the emulated drive keeps the real inertia at
-    high frequency it is passive at every frequency; a lighter J_v widens the band it
-    absorbs, and the loop's zero-order hold (half a control period) then makes it return
-    slightly more than it receives above a few Hz (|r| - 1 below 0.01 for J_v >= J / 20 on
-    the field drive, docs/closed-loop.md). The virtual state
-    starts at the switch-on from the measured drive speed and torque (no bump)."""
+    steady state is 0), so the real drive under K moves as the virtual one: its admittance
+    to the string torque is 1 / (J_v s + kp_d + ki_d / s). With J_v = J the emulated drive
+    keeps the real inertia at high frequency and is passive at every frequency; a lighter
+    J_v widens the band it absorbs, and the loop's zero-order hold (half a control period)
+    then makes it return slightly more than it receives above a few Hz (|r| up to 1.009
+    for J_v = J / 10 and 1.020 for J / 20 on the field drive, docs/closed-loop.md). The
+    virtual state starts at the switch-on from the measured drive speed and torque (no
+    bump)."""
 
     PARAMS: ClassVar[dict[str, str]] = {**TopDriveController.PARAMS,
               "inertia_fraction": "J_v / J, the emulated drive's inertia over the real one's",
