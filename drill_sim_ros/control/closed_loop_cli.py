@@ -55,8 +55,9 @@ def add_parser(sub: Any) -> None:
                    help="a controller parameter, e.g. --set impedance_factor=1.5 (repeatable)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--plot", type=Path, help="PNG of speeds with the setpoint, quill and "
-                   "motor torque with its limit, WOB; stuck and saturated spans shaded; "
-                   "beside the uncontrolled run; also .svg or .pdf; an existing file is kept "
+                   "motor torque with its limit, WOB; stuck and saturated spans shaded; the "
+                   "last 10 s and the bit speed's spectrum with the string's modes; beside "
+                   "the uncontrolled run; also .svg or .pdf; an existing file is kept "
                    "unless --overwrite")
     p.add_argument("--overwrite", action="store_true", help="replace an existing --plot file")
     p.add_argument("--no-baseline", action="store_true", help="skip the uncontrolled run "
