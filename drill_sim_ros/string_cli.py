@@ -18,8 +18,8 @@ from drill_sim_ros.model.presets import DEFAULT_PRESET, load_preset
 
 
 def add_parsers(sub: Any) -> None:
-    modes = sub.add_parser("modes", help="natural frequencies of the string from a simulated "
-                           "ring-down, beside the analytic ones")
+    modes = sub.add_parser("modes", help="natural frequencies and damping ratios of the "
+                           "string from simulated ring-downs, beside the analytic ones")
     modes.add_argument("--params", default=DEFAULT_PRESET, help="preset name or YAML path")
     modes.add_argument("--count", type=int, default=3, help="modes of each kind (1-6)")
     modes.add_argument("--json", action="store_true", help="print only the JSON line")
@@ -43,16 +43,35 @@ def cmd_modes(args: Any) -> int:
     if not 1 <= args.count <= 6:
         raise ParameterError(f"--count = {args.count} must be in [1, 6]")
     modes = si.identify_modes(load_preset(args.params), count=args.count).as_dict()
-    out = {kind: {key: [round(float(f), 6) for f in values] for key, values in d.items()}
+    out = {kind: {key: [_rounded(v) for v in values] for key, values in d.items()}
            for kind, d in modes.items()}
     if not args.json:
-        print("mode  kind        identified Hz  analytic Hz  error")
+        print("mode  kind        identified Hz  analytic Hz    error  identified zeta  "
+              "analytic zeta")
         for kind in ("torsional", "axial"):
-            for i, (a, b) in enumerate(zip(out[kind]["identified_hz"],
-                                           out[kind]["analytic_hz"], strict=False)):
-                print(f"{i + 1:4d}  {kind:10s}  {a:12.4f}  {b:11.4f}  {(a - b) / b:+.2%}")
+            for i in range(len(out[kind]["analytic_hz"])):
+                print(_modes_row(i, kind, out[kind]))
     print(json.dumps(out))
     return 0
+
+
+def _rounded(value: float | None) -> float | None:
+    """6 decimals, no negative zero; None stays None (JSON null)."""
+    return None if value is None else round(float(value), 6) + 0.0
+
+
+def _modes_row(i: int, kind: str, d: dict[str, list[float | None]]) -> str:
+    """One line of the modes table: mode i + 1 of ``kind`` (``n/a``: not identified)."""
+    def cell(key: str, width: int) -> str:
+        values = d[key]
+        value = values[i] if i < len(values) else None
+        return f"{value:{width}.4f}" if value is not None else f"{'n/a':>{width}s}"
+
+    found, analytic = d["identified_hz"], d["analytic_hz"][i]
+    error = f"{(found[i] - analytic) / analytic:+.2%}" if i < len(found) else "n/a"
+    return (f"{i + 1:4d}  {kind:10s}  {cell('identified_hz', 12)}  {cell('analytic_hz', 11)}"
+            f"  {error:>7s}  {cell('identified_damping_ratio', 15)}  "
+            f"{cell('analytic_damping_ratio', 13)}")
 
 
 def cmd_reflection(args: Any) -> int:

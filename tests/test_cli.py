@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import json
+import math
 import subprocess
 import sys
 from pathlib import Path
@@ -111,3 +112,40 @@ def test_run_and_info_at_the_low_end_of_omega0(omega0: str, tmp_path: Path) -> N
                       f"omega0: {omega0}}}\n")
     info = drill_sim("info", str(preset))
     assert info.returncode == 0 and "Traceback" not in info.stderr, info.stderr
+
+
+def test_modes_reports_damping_ratios(tmp_path: Path) -> None:
+    """``drill_sim modes`` on a damped string (one rate per kind): the table has the two
+    damping columns, and the JSON line gives per kind the analytic ratios rate / (2 omega_k)
+    of its analytic frequencies and identified ones within 10 % of them."""
+    rates = {"torsional": 0.9, "axial": 1.2}
+    preset = tmp_path / "damped.yaml"
+    preset.write_text(
+        "description: 1200 m of 5-in pipe on 150 m of collars, damped\n"
+        "physical: {density_kg_m3: 7850.0, shear_modulus_pa: 79.3e9,\n"
+        "  youngs_modulus_pa: 206.0e9, bit_radius_m: 0.108, n_blades: 6,\n"
+        "  intrinsic_specific_energy_pa: 230.0e6,\n"
+        "  zeta: 0.729, mu_gamma: 0.48, contact_stress_times_wearflat_n_per_m: 3.0e5,\n"
+        "  applied_wob_n: 60000.0, surface_rpm: 60.0}\n"
+        "string:\n"
+        "  model: distributed\n"
+        "  sections:\n"
+        "    - {outer_radius_m: 0.0635, inner_radius_m: 0.0543, length_m: 1200.0}\n"
+        "    - {outer_radius_m: 0.0857, inner_radius_m: 0.0357, length_m: 150.0}\n"
+        f"  torsional_damping_per_s: {rates['torsional']}\n"
+        f"  axial_damping_per_s: {rates['axial']}\n"
+        "top_drive: {mode: speed, inertia_kg_m2: 2900.0, kp_nm_s: 23200.0, ki_nm: 46400.0,\n"
+        "  max_torque_nm: 50000.0}\n")
+    result = drill_sim("modes", "--params", str(preset), "--count", "2")
+    assert result.returncode == 0, result.stderr
+    lines = result.stdout.splitlines()
+    assert "identified zeta" in lines[0] and "analytic zeta" in lines[0]
+    assert len(lines) == 1 + 4 + 1
+    out = json.loads(lines[-1])
+    for kind, rate in rates.items():
+        d = out[kind]
+        assert set(d) == {"identified_hz", "analytic_hz", "identified_damping_ratio",
+                          "analytic_damping_ratio"}
+        expected = [rate / (4 * math.pi * f) for f in d["analytic_hz"]]
+        assert d["analytic_damping_ratio"] == pytest.approx(expected, abs=2e-6)
+        assert d["identified_damping_ratio"] == pytest.approx(expected, rel=0.10)

@@ -25,6 +25,7 @@ zeta eps a L*, length L*; RGD07 eqs. 19-20).
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -153,20 +154,102 @@ def axial_compliance_m_per_n(spec: StringSpec) -> float:
 
 
 # ---- analytic modes (transfer matrices, fixed top, free or inertia-loaded bit) -------------
+@dataclass(frozen=True)
+class LineProperties:
+    """What one kind of wave (torsional or axial) sees in a section, SI: wave speed m/s,
+    stiffness (G J in N m^2, E A in N), inertia per metre (rho J in kg m, rho A in kg/m),
+    impedance (N m s or N s/m) and damping rate 1/s."""
+
+    speed_m_s: float
+    stiffness: float
+    inertia_per_m: float
+    impedance: float
+    damping_per_s: float
+
+
+@functools.lru_cache(maxsize=1024)
+def line_properties(s: Section, axial: bool) -> LineProperties:
+    """The properties of ``s`` for torsional or axial waves (cached: the mode searches ask
+    for them at every trial frequency)."""
+    if axial:
+        return LineProperties(s.axial_speed_m_s, s.axial_stiffness_n,
+                              s.density_kg_m3 * s.area_m2, s.axial_impedance_n_s_per_m,
+                              s.axial_damping_per_s)
+    return LineProperties(s.torsional_speed_m_s, s.torsional_stiffness_nm,
+                          s.density_kg_m3 * s.polar_moment_m4, s.torsional_impedance_nm_s,
+                          s.torsional_damping_per_s)
+
+
+def bit_inertia_of(spec: StringSpec, axial: bool) -> float:
+    """The lumped inertia at the bit end of a line: the bit's (torsion), none (axial)."""
+    return 0.0 if axial else spec.bit_inertia_kg_m2
+
+
+def _mode_tops(omega_rad_s: float, spec: StringSpec, axial: bool
+               ) -> list[tuple[float, float]]:
+    """(displacement, force) at the top of every section and, last, at the bit, for the
+    fixed-top string vibrating at ``omega`` with unit force at the top: the transfer of a
+    uniform section of wavenumber k = omega / c and stiffness S over its length L,
+    u(x) = u0 cos kx + F0 sin(kx) / (S k), F(x) = -u0 S k sin kx + F0 cos kx."""
+    tops = [(0.0, 1.0)]                        # fixed top: no displacement, unit force
+    for s in spec.sections:
+        line = line_properties(s, axial)
+        disp, force = tops[-1]
+        k = omega_rad_s / line.speed_m_s
+        kl = k * s.length_m
+        tops.append((disp * math.cos(kl) + force * math.sin(kl) / (line.stiffness * k),
+                     -disp * line.stiffness * k * math.sin(kl) + force * math.cos(kl)))
+    return tops
+
+
 def _mode_residual(omega_rad_s: float, spec: StringSpec, axial: bool) -> float:
     """End condition of the fixed-top string at ``omega``: the torque (force) at the bit
-    minus what the bit inertia needs, for unit slope at the top; zero at a natural
-    frequency. Transfer of (displacement, force) along each uniform section."""
-    disp, force = 0.0, 1.0                     # fixed top: no displacement, unit force
-    for s in spec.sections:
-        c = s.axial_speed_m_s if axial else s.torsional_speed_m_s
-        stiff = s.axial_stiffness_n if axial else s.torsional_stiffness_nm
-        k = omega_rad_s / c
-        kl = k * s.length_m
-        disp, force = (disp * math.cos(kl) + force * math.sin(kl) / (stiff * k),
-                       -disp * stiff * k * math.sin(kl) + force * math.cos(kl))
-    inertia = 0.0 if axial else spec.bit_inertia_kg_m2
-    return force - inertia * omega_rad_s**2 * disp
+    minus what the bit inertia needs, for unit force at the top; zero at a natural
+    frequency (:func:`_mode_tops`)."""
+    disp, force = _mode_tops(omega_rad_s, spec, axial)[-1]
+    return force - bit_inertia_of(spec, axial) * omega_rad_s**2 * disp
+
+
+def modal_inertias(omega_rad_s: float, spec: StringSpec, axial: bool) -> list[float]:
+    """Twice the kinetic energy over omega^2 of the mode shape of :func:`_mode_tops` in each
+    section, then at the bit: the section's inertia per metre times the integral of u(x)^2
+    over its length, and the bit inertia times u_bit^2 (kg m^2 or kg, for unit force at the
+    top)."""
+    tops = _mode_tops(omega_rad_s, spec, axial)
+    out = [line_properties(s, axial).inertia_per_m
+           * _squared_shape_integral(u0, f0, omega_rad_s, s, axial)
+           for s, (u0, f0) in zip(spec.sections, tops[:-1], strict=True)]
+    return [*out, bit_inertia_of(spec, axial) * tops[-1][0] ** 2]
+
+
+def _squared_shape_integral(u0: float, f0: float, omega_rad_s: float, s: Section,
+                            axial: bool) -> float:
+    """Integral over the section of u(x)^2 = (u0 cos kx + b sin kx)^2, b = F0 / (S k), in
+    closed form: u0^2 (L/2 + sin 2kL / 4k) + b^2 (L/2 - sin 2kL / 4k)
+    + u0 b (1 - cos 2kL) / 2k."""
+    line = line_properties(s, axial)
+    k = omega_rad_s / line.speed_m_s
+    b, half, two_kl = f0 / (line.stiffness * k), 0.5 * s.length_m, 2.0 * k * s.length_m
+    return (u0 * u0 * (half + math.sin(two_kl) / (4.0 * k))
+            + b * b * (half - math.sin(two_kl) / (4.0 * k))
+            + u0 * b * (1.0 - math.cos(two_kl)) / (2.0 * k))
+
+
+def analytic_damping_ratios(spec: StringSpec, modes_hz: list[float],
+                            axial: bool = False) -> list[float]:
+    """The damping ratio of each mode at ``modes_hz`` to first order in the damping:
+    zeta_k = sum_i gamma_i T_ik / (2 omega_k sum T_ik), T_ik the kinetic energy of mode k
+    in section i (:func:`modal_inertias`; the bit inertia counts in the sum, undamped).
+    For one rate gamma along a string without bit inertia it is gamma / (2 omega_k), the
+    exact value for mass-proportional damping."""
+    rates = [line_properties(s, axial).damping_per_s for s in spec.sections]
+    out = []
+    for f_hz in modes_hz:
+        omega = 2.0 * math.pi * f_hz
+        weights = modal_inertias(omega, spec, axial)
+        damped = sum(g * w for g, w in zip(rates, weights[:-1], strict=True))
+        out.append(damped / (2.0 * omega * sum(weights)))
+    return out
 
 
 def analytic_modes_hz(spec: StringSpec, count: int = 3, axial: bool = False,
@@ -214,11 +297,9 @@ def wave_line(spec: StringSpec, axial: bool, time_s: float, z_unit: float,
     halves around a point damper that carries the part's damping (rate x inertia)."""
     travel, z, damper, length = [], [], [], []
     for s in spec.sections:
-        c = s.axial_speed_m_s if axial else s.torsional_speed_m_s
-        zi = (s.axial_impedance_n_s_per_m if axial else s.torsional_impedance_nm_s) / z_unit
-        rate = s.axial_damping_per_s if axial else s.torsional_damping_per_s
-        per_length = (s.density_kg_m3 * (s.area_m2 if axial else s.polar_moment_m4))
-        t_tau = s.length_m / c / time_s
+        props = line_properties(s, axial)
+        zi, rate = props.impedance / z_unit, props.damping_per_s
+        t_tau = s.length_m / props.speed_m_s / time_s
         if rate <= 0.0:
             travel.append(t_tau)
             z.append(zi)
@@ -226,7 +307,7 @@ def wave_line(spec: StringSpec, axial: bool, time_s: float, z_unit: float,
             length.append(s.length_m)
             continue
         parts = spec.damping_points
-        d_part = rate * per_length * s.length_m / parts / mass_unit
+        d_part = rate * props.inertia_per_m * s.length_m / parts / mass_unit
         for _ in range(parts):
             travel += [0.5 * t_tau / parts, 0.5 * t_tau / parts]
             z += [zi, zi]
@@ -308,7 +389,7 @@ def kernel_string(spec: StringSpec, time_s: float, torque_nm: float, length_m: f
 
 
 def _parts_of(spec: StringSpec, section: Section, axial: bool) -> int:
-    rate = section.axial_damping_per_s if axial else section.torsional_damping_per_s
+    rate = line_properties(section, axial).damping_per_s
     return 2 * spec.damping_points if rate > 0.0 else 1
 
 

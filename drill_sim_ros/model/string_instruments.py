@@ -6,7 +6,11 @@ lines), off bottom with the hook fixed, after a short pulse sent up from the bit
 * :func:`identify_modes`: the ring-down of the bit's angular and axial speed under a
   kinematic top drive with no damping; the first natural frequencies are the spectral
   peaks (Hann window, zero padding, parabolic interpolation on the log magnitude), shown
-  beside the transfer-matrix ones (:func:`string.analytic_modes_hz`).
+  beside the transfer-matrix ones (:func:`string.analytic_modes_hz`). Then a second
+  ring-down of the string with its damping, after a twist near the bit is let go: the
+  modes' damping ratios are those of the poles the matrix pencil finds in it
+  (:mod:`poles`), shown beside the first-order ones
+  (:func:`string.analytic_damping_ratios`).
 * :func:`measure_reflection`: the waves meeting the top drive, separated exactly by the
   method of characteristics (b arriving, a = b + 2 Z w leaving), and the drive's
   reflection r(f) = A(f) / B(f) as the ratio of their spectra over a ring-down long enough
@@ -17,12 +21,13 @@ lines), off bottom with the hook fixed, after a short pulse sent up from the bit
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, replace
 
 import numpy as np
 
 from drill_sim_ros.model import kernel as k
+from drill_sim_ros.model import poles
 from drill_sim_ros.model import string as sg
 from drill_sim_ros.model.errors import ParameterError
 from drill_sim_ros.model.presets import Preset
@@ -31,22 +36,39 @@ from drill_sim_ros.model.top_drive import TopDrive
 
 PULSE_WIDTH_S = 0.05       # standard deviation of the Gaussian pulse sent from the bit
 SAMPLE_HZ = 200.0          # the ring-down is recorded at this rate (modes < 20 Hz)
+# the damped ring-down (identify_modes)
+TWIST_WIDTH_PERIODS = 0.25  # width of the released twist, s, x the highest mode's frequency
+DECAY_NEPERS = 10.0        # the record lasts until its slowest mode has decayed by e^-10,
+RECORD_PERIODS = 30.0      # at most 30 periods of mode 1
+FIT_SAMPLES = 600          # and at most this many samples after decimation
+FILTER_DECAY = 1.5         # the decimation filter lasts at most 1.5 / (largest rate / 2)
 
 
 @dataclass(frozen=True)
 class Modes:
-    """Natural frequencies, Hz: identified from the ring-down and analytic."""
+    """Natural frequencies, Hz, identified from the undamped ring-down and analytic; damping
+    ratios identified from the damped ring-down (None: no pole found near that mode) and
+    analytic (first order), mode by mode as the analytic frequencies."""
 
     torsional_identified_hz: list[float]
     torsional_analytic_hz: list[float]
     axial_identified_hz: list[float]
     axial_analytic_hz: list[float]
+    torsional_identified_damping_ratio: list[float | None]
+    torsional_analytic_damping_ratio: list[float]
+    axial_identified_damping_ratio: list[float | None]
+    axial_analytic_damping_ratio: list[float]
 
-    def as_dict(self) -> dict[str, dict[str, list[float]]]:
+    def as_dict(self) -> dict[str, dict[str, list[float | None]]]:
         return {"torsional": {"identified_hz": self.torsional_identified_hz,
-                              "analytic_hz": self.torsional_analytic_hz},
+                              "analytic_hz": self.torsional_analytic_hz,
+                              "identified_damping_ratio":
+                                  self.torsional_identified_damping_ratio,
+                              "analytic_damping_ratio": self.torsional_analytic_damping_ratio},
                 "axial": {"identified_hz": self.axial_identified_hz,
-                          "analytic_hz": self.axial_analytic_hz}}
+                          "analytic_hz": self.axial_analytic_hz,
+                          "identified_damping_ratio": self.axial_identified_damping_ratio,
+                          "analytic_damping_ratio": self.axial_analytic_damping_ratio}}
 
 
 def require_distributed(preset: Preset) -> None:
@@ -85,21 +107,66 @@ def off_bottom_simulator(preset: Preset, drive: TopDrive, dtau: float | None = N
     return sim
 
 
+def line_columns(sim: Simulator, axial: bool) -> tuple[int, int]:
+    """The parts ``lo .. hi - 1`` of the torsional or the axial line in the layout arrays."""
+    _, wave_i, _, parts = sim.string_arrays()
+    return (parts[0], wave_i.shape[1]) if axial else (0, parts[0])
+
+
+def _cells_above_bit(wave_i: np.ndarray, lo: int, hi: int
+                     ) -> Iterator[tuple[int, np.ndarray, np.ndarray, np.ndarray]]:
+    """Part by part from the bit up: (part, slots of its a, slots of its b, the height of
+    each of its cells above the bit in cells). The a in the cell h above the bottom of a
+    part reaches that bottom in h steps; the b there left it h + 1 steps ago (the layout
+    of :func:`string.line_state`)."""
+    below = 0
+    for j in range(hi - 1, lo - 1, -1):
+        n, off, pos = (int(wave_i[sg.W_LEN, j]), int(wave_i[sg.W_OFF, j]),
+                       int(wave_i[sg.W_POS, j]))
+        h = np.arange(n)
+        yield j, off + (pos + h) % n, off + n + (pos - 1 - h) % n, below + h
+        below += n
+
+
 def send_pulse_from_bit(sim: Simulator, axial: bool, amplitude: float,
                         width_steps: float) -> None:
     """An up-going Gaussian pulse centred at the bit at this instant: its upper half in the
     up-going wave above the bit and its lower half as a down-going image that the free bit
-    end reflects into the rest (b = -a). ``amplitude`` in the line's force units."""
-    wave, wave_i, _, parts = sim.string_arrays()
-    j = wave_i.shape[1] - 1 if axial else parts[0] - 1
-    n, off, pos = (int(wave_i[sg.W_LEN, j]), int(wave_i[sg.W_OFF, j]),
-                   int(wave_i[sg.W_POS, j]))
-    cells = np.arange(min(n, int(8 * width_steps) + 1))
+    end reflects into the rest (b = -a). ``amplitude`` in the line's force units; the pulse
+    stays in the bottom part (cut at its top)."""
+    wave, wave_i, _, _ = sim.string_arrays()
+    _, a_slots, b_slots, h = next(_cells_above_bit(wave_i, *line_columns(sim, axial)))
+    cells = h[:int(8 * width_steps) + 1]
     # b in the cell k above the bit left it k + 1 steps ago; a in the cell k above it
     # reaches it in k steps and leaves again as b = -a: the centre is at the bit now
-    wave[off + n + (pos - 1 - cells) % n] += amplitude * np.exp(
-        -0.5 * ((cells + 1) / width_steps) ** 2)
-    wave[off + (pos + cells) % n] -= amplitude * np.exp(-0.5 * (cells / width_steps) ** 2)
+    wave[b_slots[:cells.size]] += amplitude * np.exp(-0.5 * ((cells + 1) / width_steps) ** 2)
+    wave[a_slots[:cells.size]] -= amplitude * np.exp(-0.5 * (cells / width_steps) ** 2)
+
+
+def twist_for_steady_turning(sim: Simulator) -> None:
+    """The torsional line twisted as its point dampers need to keep it turning at the
+    drive's speed: each part carries the drag D w of every damper below it. Under a
+    kinematic top this is the steady state of the damped string off bottom (the untwisted
+    string of :meth:`Simulator.hang_off_bottom` would ring as it settles)."""
+    wave, wave_i, wave_f, parts = sim.string_arrays()
+    speed = float(sim.state[k.S_OMEGA_S])
+    drag_below = np.cumsum(wave_f[sg.W_D, :parts[0]][::-1])[::-1]
+    for j in range(parts[0]):
+        sg.fill_uniform(wave, wave_i, wave_f, j, j + 1, speed * float(drag_below[j]), speed)
+
+
+def release_twist(sim: Simulator, axial: bool, amplitude: float, width_steps: float) -> None:
+    """Add a torque (axially a force) T(h) = A (h / w) exp(-(h / w)^2 / 2) to the line at
+    the height h above the bit (in cells, w = ``width_steps``), the speeds unchanged: a
+    twist let go at this instant. It vanishes at the free bit and is continuous across every
+    point damper, so it agrees with the string's own junction conditions and excites its
+    modes up to about 1 / (2 pi w) smoothly. ``amplitude`` in the line's force units."""
+    wave, wave_i, _, _ = sim.string_arrays()
+    for _, a_slots, b_slots, h in _cells_above_bit(wave_i, *line_columns(sim, axial)):
+        x = (h + 0.5) / width_steps
+        torque = amplitude * x * np.exp(-0.5 * x * x)
+        wave[a_slots] += torque                     # T = (a + b) / 2, w = (a - b) / 2 Z
+        wave[b_slots] += torque
 
 
 def _peaks_hz(signal: np.ndarray, sample_hz: float, count: int, f_min_hz: float) -> list[float]:
@@ -127,20 +194,42 @@ def _peaks_hz(signal: np.ndarray, sample_hz: float, count: int, f_min_hz: float)
     return found
 
 
+def _sampling(sim: Simulator) -> tuple[int, float]:
+    """Steps between the ring-down's samples (about SAMPLE_HZ) and its rate, Hz."""
+    every = max(1, round(1.0 / (SAMPLE_HZ * sim.scales.time_s * sim.config.dtau)))
+    return every, 1.0 / (every * sim.config.dtau * sim.scales.time_s)
+
+
 def _ring_down(sim: Simulator, seconds: float, columns: tuple[int, ...]
                ) -> tuple[np.ndarray, float]:
     """Kernel sample columns over ``seconds`` of simulated time at about SAMPLE_HZ, and the
     sampling rate in Hz."""
-    every = max(1, round(1.0 / (SAMPLE_HZ * sim.scales.time_s * sim.config.dtau)))
+    every, sample_hz = _sampling(sim)
     steps = sim.steps_for(seconds / sim.scales.time_s)
     rows = sim.advance(steps, every=every).data
-    return rows[:, list(columns)], 1.0 / (every * sim.config.dtau * sim.scales.time_s)
+    return rows[:, list(columns)], sample_hz
 
 
 def identify_modes(preset: Preset, count: int = 3, seconds: float = 400.0) -> Modes:
-    """The first ``count`` torsional and axial natural frequencies of ``preset``'s string,
-    identified from a simulated ring-down (off bottom, kinematic top, no damping, a pulse
-    from the bit), with the analytic ones (fixed top, free bit)."""
+    """The first ``count`` torsional and axial modes of ``preset``'s string (off bottom,
+    kinematic top, hook fixed): the natural frequencies identified from an undamped
+    ring-down after a pulse from the bit, with the analytic ones (fixed top, free bit); the
+    damping ratios identified from a ring-down of the string with its damping
+    (:func:`identified_damping_ratios`), with the first-order ones."""
+    spec = preset.string
+    analytic = {axial: sg.analytic_modes_hz(spec, count, axial=axial) for axial in (False, True)}
+    zeta = {axial: sg.analytic_damping_ratios(spec, analytic[axial], axial)
+            for axial in (False, True)}
+    peaks = _undamped_peaks_hz(preset, count, seconds)
+    identified = identified_damping_ratios(preset, analytic, zeta, seconds)
+    return Modes(peaks[0], analytic[False], peaks[1], analytic[True],
+                 identified[False], zeta[False], identified[True], zeta[True])
+
+
+def _undamped_peaks_hz(preset: Preset, count: int, seconds: float
+                       ) -> tuple[list[float], list[float]]:
+    """The spectral peaks of the bit's (angular, axial) speed over ``seconds`` of the
+    undamped string's ring-down after a pulse from the bit."""
     drive = TopDrive(mode="kinematic", inertia_ratio=preset.top_drive.inertia_ratio)
     sim = off_bottom_simulator(preset, drive, undamped=True)
     width = PULSE_WIDTH_S / (preset.scales.time_s * sim.config.dtau)
@@ -148,11 +237,68 @@ def identify_modes(preset: Preset, count: int = 3, seconds: float = 400.0) -> Mo
         sg.W_Z, 0], width)
     send_pulse_from_bit(sim, True, 1.0, width)
     data, sample_hz = _ring_down(sim, seconds, (k.C_OMEGA, k.C_V))
-    spec = preset.string
-    return Modes(_peaks_hz(data[:, 0], sample_hz, count, 0.02),
-                 sg.analytic_modes_hz(spec, count, axial=False),
-                 _peaks_hz(data[:, 1], sample_hz, count, 0.02),
-                 sg.analytic_modes_hz(spec, count, axial=True))
+    return (_peaks_hz(data[:, 0], sample_hz, count, 0.02),
+            _peaks_hz(data[:, 1], sample_hz, count, 0.02))
+
+
+@dataclass(frozen=True)
+class DampedFit:
+    """How one kind of mode is read from the damped ring-down: the decimation, the record
+    length (s) and the number of modes below the decimated Nyquist frequency."""
+
+    decimation: poles.Decimation
+    record_s: float
+    modes_in_band: int
+
+
+def damped_fit(spec: sg.StringSpec, axial: bool, modes_hz: list[float],
+               zetas: list[float], sample_hz: float, seconds: float) -> DampedFit:
+    """The record lasts until its slowest mode (by ``zetas``) has decayed by
+    e^-DECAY_NEPERS, at most RECORD_PERIODS of mode 1, FIT_SAMPLES decimated samples and
+    ``seconds``, plus the filter's transient. The filter is no longer than the time in
+    which the fastest-decaying modes (sigma = largest rate / 2) lose e^-FILTER_DECAY."""
+    sigma_max = 0.5 * max(sg.line_properties(s, axial).damping_per_s for s in spec.sections)
+    decimation = poles.plan_decimation(sample_hz, modes_hz[-1], FILTER_DECAY / sigma_max
+                                       if sigma_max > 0.0 else math.inf)
+    rate_hz = decimation.rate_hz(sample_hz)
+    record_s = min(seconds, RECORD_PERIODS / modes_hz[0], FIT_SAMPLES / rate_hz)
+    slowest = min(2.0 * math.pi * f * z for f, z in zip(modes_hz, zetas, strict=True))
+    if slowest > 0.0:
+        record_s = min(record_s, DECAY_NEPERS / slowest)
+    in_band = len(sg.analytic_modes_hz(spec, 64, axial, f_max_hz=0.5 * rate_hz))
+    return DampedFit(decimation, record_s + decimation.taps / sample_hz, in_band)
+
+
+def identified_damping_ratios(preset: Preset, modes_hz: dict[bool, list[float]],
+                              zetas: dict[bool, list[float]], seconds: float
+                              ) -> dict[bool, list[float | None]]:
+    """The damping ratios of the modes at ``modes_hz`` (torsional: False, axial: True),
+    identified on the string with its damping, off bottom under a kinematic top with the
+    hook fixed, turning steadily (:func:`twist_for_steady_turning`): a twist near the bit,
+    about a quarter period of the highest mode wide, is let go (:func:`release_twist`) and
+    the poles of the bit's speeds are fitted (:func:`poles.damping_ratios`). ``zetas``
+    (the analytic ratios) only size the record."""
+    drive = TopDrive(mode="kinematic", inertia_ratio=preset.top_drive.inertia_ratio)
+    sim = off_bottom_simulator(preset, drive)
+    twist_for_steady_turning(sim)
+    sample_hz = _sampling(sim)[1]
+    dt_s = preset.scales.time_s * sim.config.dtau
+    fits = {axial: damped_fit(preset.string, axial, modes_hz[axial], zetas[axial], sample_hz,
+                              seconds) for axial in (False, True) if modes_hz[axial]}
+    out: dict[bool, list[float | None]] = {False: [], True: []}
+    if not fits:
+        return out
+    for axial in fits:
+        z_bit = float(sim.string_arrays()[2][sg.W_Z, line_columns(sim, axial)[1] - 1])
+        release_twist(sim, axial, 0.05 * preset.params.omega0 * z_bit,
+                      TWIST_WIDTH_PERIODS / modes_hz[axial][-1] / dt_s)
+    data, sample_hz = _ring_down(sim, max(f.record_s for f in fits.values()),
+                                 (k.C_OMEGA, k.C_V))
+    for axial, fit in fits.items():
+        record = data[:round(fit.record_s * sample_hz), int(axial)]
+        out[axial] = poles.damping_ratios(record, sample_hz, fit.decimation,
+                                          modes_hz[axial], fit.modes_in_band)
+    return out
 
 
 @dataclass(frozen=True)
