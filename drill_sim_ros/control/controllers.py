@@ -26,9 +26,9 @@ The references (Z, C, I, J, omega_1 from :mod:`drill_sim_ros.control.rig`):
   the reactance at the first mode, where the top is then the damper kp_d, and
   |r| = |Z - kp_d| / (Z + kp_d).
   ``soft_torque`` (the SoftSpeed family: Kyllingstad & Nessjoen 2009, SPE/IADC 119660):
-  kp_d = 2 Z (``impedance_factor``), J_v = J / 10; ``z_torque`` (impedance matching, the
+  kp_d = 2 Z (``impedance_factor``), J_v = J / 5; ``z_torque`` (impedance matching, the
   ZTorque family: Dwars 2015, SPE/IADC-173037-MS): kp_d = Z (``impedance_nm_s``),
-  J_v = J / 20 (``inertia_fraction``), a broader band.
+  J_v = 0.15 J (``inertia_fraction``).
   Why this form (docs/closed-loop.md): a high-pass of T fed to the setpoint (the previous
   designs) made the drive return up to 1.07 of every wave above 5 Hz (the zero-order hold
   and the stiff loop's lag turn its phase), pumping the collars' ring until the motor hit
@@ -171,7 +171,9 @@ class SoftDrive(TopDriveController):
     keeps the real inertia at high frequency and is passive at every frequency; a lighter
     J_v widens the band it absorbs, and the loop's zero-order hold (half a control period)
     then makes it return slightly more than it receives above a few Hz (|r| up to 1.009
-    for J_v = J / 10 and 1.020 for J / 20 on the field drive, docs/closed-loop.md). The
+    for J_v = J / 10 and 1.020 for J / 20 on the field drive, docs/closed-loop.md); the
+    motor must also supply (J / J_v - 1) times the virtual rotor's net torque, so a light
+    J_v drives the motor to its limit on the collars' ring that reaches the top. The
     virtual state starts at the switch-on from the measured drive speed and torque (no
     bump)."""
 
@@ -225,8 +227,8 @@ class SoftDrive(TopDriveController):
 class SoftTorque(SoftDrive):
     """SoftSpeed-class: the emulated drive is a damper of ``impedance_factor`` x Z at the
     first mode, where its integral gain cancels the reactance of its inertia
-    (ki_d = J_v omega_1^2; Kyllingstad & Nessjoen 2009, SPE/IADC 119660), with a tenth of the
-    drive's inertia (a band of absorption about omega_1 / 3 .. 3 omega_1 wide)."""
+    (ki_d = J_v omega_1^2; Kyllingstad & Nessjoen 2009, SPE/IADC 119660), with a fifth of the
+    drive's inertia."""
 
     name = "soft_torque"
     PARAMS: ClassVar[dict[str, str]] = {**SoftDrive.PARAMS,
@@ -234,7 +236,7 @@ class SoftTorque(SoftDrive):
                                   "|r| = 1/3 at the first mode)"}
 
     def defaults(self) -> dict[str, float]:
-        return {**super().defaults(), "impedance_factor": 2.0, "inertia_fraction": 0.1}
+        return {**super().defaults(), "impedance_factor": 2.0, "inertia_fraction": 0.2}
 
     def virtual_gains(self) -> tuple[float, float, float]:
         j_v = self.params["inertia_fraction"] * self.rig.drive_inertia_kg_m2
@@ -245,7 +247,7 @@ class SoftTorque(SoftDrive):
 class ZTorque(SoftDrive):
     """ZTorque-class impedance matching (Dwars 2015, SPE/IADC-173037-MS): the emulated drive
     is the pipe's characteristic impedance Z at the first mode (an arriving wave is absorbed,
-    nothing comes back), with a twentieth of the drive's inertia (a broader band)."""
+    nothing comes back), with 0.15 of the drive's inertia."""
 
     name = "z_torque"
     PARAMS: ClassVar[dict[str, str]] = {**SoftDrive.PARAMS,
@@ -253,7 +255,7 @@ class ZTorque(SoftDrive):
 
     def defaults(self) -> dict[str, float]:
         return {**super().defaults(), "impedance_nm_s": self.rig.impedance_nm_s,
-                "inertia_fraction": 0.05}
+                "inertia_fraction": 0.15}
 
     def virtual_gains(self) -> tuple[float, float, float]:
         j_v = self.params["inertia_fraction"] * self.rig.drive_inertia_kg_m2
