@@ -12,6 +12,7 @@ from pathlib import Path
 from typing import Any
 
 from drill_sim_ros.control.reflection import measure_reflection_with
+from drill_sim_ros.model import string as sg
 from drill_sim_ros.model import string_instruments as si
 from drill_sim_ros.model.errors import ParameterError
 from drill_sim_ros.model.presets import DEFAULT_PRESET, load_preset
@@ -82,13 +83,16 @@ def cmd_reflection(args: Any) -> int:
     preset = load_preset(args.params)
     si.require_distributed(preset)
     curves: dict[str, list[float]] = {}
+    f_hz = si.frequencies_with_modes(preset.string)
+    modes = {round(float(f), 6): k + 1 for k, f in enumerate(sg.analytic_modes_hz(preset.string))}
     if args.controller:
         for name in args.controller:
-            result = measure_reflection_with(args.params, name, args.mode, args.seconds)
+            result = measure_reflection_with(args.params, name, args.mode, args.seconds,
+                                             f_hz=f_hz)
             curves[name] = [round(r, 5) for r in result.r_measured]
         analytic = None
     else:
-        result = si.measure_reflection(preset, seconds=args.seconds)
+        result = si.measure_reflection(preset, seconds=args.seconds, f_hz=f_hz)
         curves["speed loop"] = [round(r, 5) for r in result.r_measured]
         analytic = [round(r, 5) for r in result.r_analytic]
     out: dict[str, Any] = {"f_hz": [round(f, 6) for f in result.f_hz],
@@ -99,8 +103,9 @@ def cmd_reflection(args: Any) -> int:
         print("f Hz    " + "".join(f"{name:>14s}" for name in curves)
               + ("    analytic" if analytic else ""))
         for i, f in enumerate(out["f_hz"]):
+            mode = f"  <- torsional mode {modes[f]}" if f in modes else ""
             print(f"{f:6.3f}  " + "".join(f"{c[i]:14.4f}" for c in curves.values())
-                  + (f"  {analytic[i]:10.4f}" if analytic else ""))
+                  + (f"  {analytic[i]:10.4f}" if analytic else "") + mode)
     if args.plot is not None:
         _plot(args.plot, preset.name, out["f_hz"], curves, analytic)
     print(json.dumps(out))

@@ -317,6 +317,13 @@ def reflection_frequencies(count: int = 16, f_lo_hz: float = 0.05,
     return np.geomspace(f_lo_hz, f_hi_hz, count)
 
 
+def frequencies_with_modes(spec: sg.StringSpec, count: int = 3) -> np.ndarray:
+    """:func:`reflection_frequencies` and the string's first ``count`` torsional modes
+    (fixed top, free bit), sorted: |r| at a mode is what decides whether it is absorbed."""
+    return np.unique(np.concatenate((reflection_frequencies(),
+                                     sg.analytic_modes_hz(spec, count))))
+
+
 def analytic_reflection(z_string: float, inertia: float, kp: float, ki: float,
                         f_hz: np.ndarray) -> np.ndarray:
     """|Z - Z_TD(i w)| / |Z + Z_TD(i w)| with Z_TD(s) = J s + kp + ki / s (SI)."""
