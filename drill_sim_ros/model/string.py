@@ -293,8 +293,11 @@ def wave_line(spec: StringSpec, axial: bool, time_s: float, z_unit: float,
     """Parts of ``spec`` for one kind of wave. ``z_unit`` converts an SI impedance to
     kernel units, ``mass_unit`` an SI damper (N m s/rad or N s/m) likewise (same factor).
 
-    With damping, each section is cut into ``damping_points`` equal parts; each part is two
-    halves around a point damper that carries the part's damping (rate x inertia)."""
+    With damping, each section is cut into ``damping_points`` equal parts, each with a point
+    damper at its middle that carries the part's damping (rate x inertia): the delay lines
+    run from damper to damper, so the section is a half part, ``damping_points - 1`` whole
+    ones and a half (a junction with no damper between two equal lines would only pass the
+    waves on, and cost a step's work)."""
     travel, z, damper, length = [], [], [], []
     for s in spec.sections:
         props = line_properties(s, axial)
@@ -306,13 +309,13 @@ def wave_line(spec: StringSpec, axial: bool, time_s: float, z_unit: float,
             damper.append(0.0)
             length.append(s.length_m)
             continue
-        parts = spec.damping_points
-        d_part = rate * props.inertia_per_m * s.length_m / parts / mass_unit
-        for _ in range(parts):
-            travel += [0.5 * t_tau / parts, 0.5 * t_tau / parts]
-            z += [zi, zi]
-            damper += [d_part, 0.0]
-            length += [0.5 * s.length_m / parts, 0.5 * s.length_m / parts]
+        points = spec.damping_points
+        d_part = rate * props.inertia_per_m * s.length_m / points / mass_unit
+        shares = [0.5] + [1.0] * (points - 1) + [0.5]      # of a part, damper to damper
+        travel += [share * t_tau / points for share in shares]
+        z += [zi] * (points + 1)
+        damper += [d_part] * points + [0.0]
+        length += [share * s.length_m / points for share in shares]
     return WaveLine(tuple(travel), tuple(z), tuple(damper), tuple(length))
 
 
@@ -390,7 +393,7 @@ def kernel_string(spec: StringSpec, time_s: float, torque_nm: float, length_m: f
 
 def _parts_of(spec: StringSpec, section: Section, axial: bool) -> int:
     rate = line_properties(section, axial).damping_per_s
-    return 2 * spec.damping_points if rate > 0.0 else 1
+    return spec.damping_points + 1 if rate > 0.0 else 1
 
 
 # ---- compiled: one step of a line -------------------------------------------------------
