@@ -187,18 +187,29 @@ class Simulator:
         return self.string.model == sg.STRING_DISTRIBUTED
 
     def _init_wave(self, triv: TrivialSolution) -> None:
-        """Steady drilling along the string: the trivial torque and speed everywhere, the
-        applied weight and the trivial rate of penetration axially; the hook feeds at it."""
+        """Steady drilling along the string: the trivial torque at the bit and the speed
+        everywhere, each part carrying the drag of the dampers below it, and the drive's
+        loop holding the torque at the top; the applied weight at the bit and the trivial
+        rate of penetration axially; the hook feeds at it."""
         if not self.distributed:
             return
         self._wave_i[sg.W_POS] = 0
-        parts_t = self._parts[0]
-        sg.fill_uniform(self._wave, self._wave_i, self._wave_f, 0, parts_t, triv.torque,
-                        self.params.omega0)
-        sg.fill_uniform(self._wave, self._wave_i, self._wave_f, parts_t,
-                        self._wave_i.shape[1], self.params.w0, triv.v)
+        self._fill_steady(triv.torque, self.params.omega0, self.params.w0, triv.v)
         self._state[k.S_V_HOOK] = triv.v
         self._state[k.S_HOOK_INTEGRAL] = triv.v
+
+    def _fill_steady(self, bit_torque: float, speed: float, bit_force: float,
+                     axial_speed: float) -> None:
+        """Both lines in steady motion (:func:`string.fill_steady`), and the drive's loop
+        and torque command on the torque that this leaves at the top."""
+        parts_t, parts = self._parts[0], self._wave_i.shape[1]
+        sg.fill_steady(self._wave, self._wave_i, self._wave_f, 0, parts_t, bit_torque, speed)
+        sg.fill_steady(self._wave, self._wave_i, self._wave_f, parts_t, parts, bit_force,
+                       axial_speed)
+        top_torque = bit_torque + speed * float(self._wave_f[sg.W_D, :parts_t].sum())
+        st = self._state
+        st[k.S_TD_INTEGRAL] = st[k.S_MOTOR_TORQUE] = top_torque
+        self._targets[k.I_MOTOR_TORQUE] = top_torque
 
     @property
     def trivial(self) -> TrivialSolution:
@@ -570,22 +581,19 @@ class Simulator:
 
     def hang_off_bottom(self, anechoic: bool = False) -> None:
         """The bit hangs free off bottom (no bit-rock forces), the hook is fixed, and the
-        string is at rest: no twist, no torque, no axial motion, turning at the drive's
-        speed, as the string instruments start (``drill_sim modes``, ``reflection``).
+        string turns steadily at the drive's speed with no axial motion, twisted only by its
+        dampers' drag (none when undamped), as the string instruments start
+        (``drill_sim modes``, ``reflection``).
         ``anechoic``: the torsional line's bottom sends nothing back up (a matched end)."""
         self._prm[k.P_OFF_BOTTOM] = 2.0 if anechoic else 1.0
         st = self._state
-        if self.distributed:
-            parts_t = self._parts[0]
-            sg.fill_uniform(self._wave, self._wave_i, self._wave_f, 0, parts_t, 0.0,
-                            st[k.S_OMEGA_S])
-            sg.fill_uniform(self._wave, self._wave_i, self._wave_f, parts_t,
-                            self._wave_i.shape[1], 0.0, 0.0)
         st[k.S_PHI_S] = st[k.S_PHI]
         st[k.S_OMEGA] = st[k.S_OMEGA_S]
         st[k.S_TD_INTEGRAL] = st[k.S_MOTOR_TORQUE] = 0.0
         st[k.S_V] = st[k.S_V_HOOK] = st[k.S_HOOK_INTEGRAL] = 0.0
         self._targets[k.I_MOTOR_TORQUE] = 0.0
+        if self.distributed:                 # twisted only by its dampers' drag
+            self._fill_steady(0.0, st[k.S_OMEGA_S], 0.0, 0.0)
 
     def string_arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, tuple[int, ...]]:
         """The delay lines as they are (wave, layout int, layout float, parts per line), for

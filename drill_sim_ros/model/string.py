@@ -342,11 +342,15 @@ def build_lines(lines: tuple[WaveLine, ...], dtau: float
                                                                  for x in lines)
 
 
-def fill_uniform(wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray, lo: int, hi: int,
-                 force: float, speed: float) -> None:
-    """Every part of parts ``lo..hi-1`` carries ``force`` and ``speed`` (steady state)."""
+def fill_steady(wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray, lo: int, hi: int,
+                end_force: float, speed: float) -> None:
+    """Parts ``lo..hi-1`` turning (moving) steadily at ``speed``: each carries the force at
+    the bottom end, ``end_force``, plus the drag D x speed of every point damper below its
+    top (the damper below part j sits at its bottom), so no damper sheds a wave."""
+    drag_below = np.cumsum(wave_f[W_D, lo:hi][::-1])[::-1] * speed
     for j in range(lo, hi):
         n, off, z = wave_i[W_LEN, j], wave_i[W_OFF, j], wave_f[W_Z, j]
+        force = end_force + float(drag_below[j - lo])
         wave[off:off + n] = force + z * speed
         wave[off + n:off + 2 * n] = force - z * speed
 

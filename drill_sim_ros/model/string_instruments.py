@@ -143,18 +143,6 @@ def send_pulse_from_bit(sim: Simulator, axial: bool, amplitude: float,
     wave[a_slots[:cells.size]] -= amplitude * np.exp(-0.5 * (cells / width_steps) ** 2)
 
 
-def twist_for_steady_turning(sim: Simulator) -> None:
-    """The torsional line twisted as its point dampers need to keep it turning at the
-    drive's speed: each part carries the drag D w of every damper below it. Under a
-    kinematic top this is the steady state of the damped string off bottom (the untwisted
-    string of :meth:`Simulator.hang_off_bottom` would ring as it settles)."""
-    wave, wave_i, wave_f, parts = sim.string_arrays()
-    speed = float(sim.state[k.S_OMEGA_S])
-    drag_below = np.cumsum(wave_f[sg.W_D, :parts[0]][::-1])[::-1]
-    for j in range(parts[0]):
-        sg.fill_uniform(wave, wave_i, wave_f, j, j + 1, speed * float(drag_below[j]), speed)
-
-
 def release_twist(sim: Simulator, axial: bool, amplitude: float, width_steps: float) -> None:
     """Add a torque (axially a force) T(h) = A (h / w) exp(-(h / w)^2 / 2) to the line at
     the height h above the bit (in cells, w = ``width_steps``), the speeds unchanged: a
@@ -274,13 +262,12 @@ def identified_damping_ratios(preset: Preset, modes_hz: dict[bool, list[float]],
                               ) -> dict[bool, list[float | None]]:
     """The damping ratios of the modes at ``modes_hz`` (torsional: False, axial: True),
     identified on the string with its damping, off bottom under a kinematic top with the
-    hook fixed, turning steadily (:func:`twist_for_steady_turning`): a twist near the bit,
+    hook fixed, turning steadily (:meth:`Simulator.hang_off_bottom`): a twist near the bit,
     about a quarter period of the highest mode wide, is let go (:func:`release_twist`) and
     the poles of the bit's speeds are fitted (:func:`poles.damping_ratios`). ``zetas``
     (the analytic ratios) only size the record."""
     drive = TopDrive(mode="kinematic", inertia_ratio=preset.top_drive.inertia_ratio)
     sim = off_bottom_simulator(preset, drive)
-    twist_for_steady_turning(sim)
     sample_hz = _sampling(sim)[1]
     dt_s = preset.scales.time_s * sim.config.dtau
     fits = {axial: damped_fit(preset.string, axial, modes_hz[axial], zetas[axial], sample_hz,

@@ -270,20 +270,41 @@ def test_per_section_rates_give_the_first_order_damping_ratio(axial: bool) -> No
 
 
 def test_a_damped_string_turns_steadily_once_twisted_for_its_dampers() -> None:
-    """Off bottom under a kinematic top, the damped string twisted by
-    twist_for_steady_turning stays as it is (each damper's drag D w carried by the parts
-    above it); untwisted, it rings."""
+    """Off bottom under a kinematic top, the damped string as hang_off_bottom leaves it
+    (each part carrying the drag D w of every damper below it, string.fill_steady) stays as
+    it is; filled untwisted (the same speed, no drag carried), it rings."""
     preset = per_section_preset(10.0)
     drive = TopDrive(mode="kinematic", inertia_ratio=14.0)
     speeds = []
     for twisted in (True, False):
         sim = si.off_bottom_simulator(preset, drive)
-        if twisted:
-            si.twist_for_steady_turning(sim)
+        if not twisted:
+            wave, wave_i, wave_f, parts = sim.string_arrays()
+            no_drag = wave_f.copy()
+            no_drag[sg.W_D] = 0.0
+            sg.fill_steady(wave, wave_i, no_drag, 0, parts[0], 0.0,
+                           float(sim.state[k.S_OMEGA_S]))
         rows = sim.advance(sim.steps_for(3.0), every=1).data
         speeds.append(np.abs(rows[:, k.C_OMEGA] / preset.params.omega0 - 1).max())
     assert speeds[0] < 1e-12
     assert speeds[1] > 1e-3
+
+
+def test_drilling_starts_steady_on_the_damped_string() -> None:
+    """At t = 0 the damped field string carries the trivial bit torque plus the drag of
+    its dampers (rate x inertia x speed, summed: the viscous torque of the whole string),
+    and the drive's loop holds that torque: the drive's speed does not move in the first
+    0.1 s (no damper sheds a wave before the bit's own motion reaches the top, 0.85 s)."""
+    preset = load_preset("field_8p5in_shale")
+    sim = Simulator(preset.params, SimConfig(dtau=preset.dtau), top_drive=preset.top_drive,
+                    scales=preset.scales, string=preset.kernel_string)
+    omega0 = preset.params.omega0
+    drag = sum(s.torsional_damping_per_s * s.inertia_kg_m2 for s in preset.string.sections)
+    drag_scaled = drag * omega0 / (preset.scales.torque_nm * preset.scales.time_s)
+    assert sim.state[k.S_MOTOR_TORQUE] == pytest.approx(sim.trivial.torque + drag_scaled,
+                                                       rel=1e-12)
+    rows = sim.advance(sim.steps_for(0.1 / preset.scales.time_s), every=1).data
+    assert np.abs(rows[:, k.C_OMEGA_S] / omega0 - 1).max() < 1e-12
 
 
 DAMPED_STRINGS = {
