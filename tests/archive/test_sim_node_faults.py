@@ -3,26 +3,30 @@ record.path, a full disk, bad parameters and params files, and split recordings.
 
 from __future__ import annotations
 
+import math
 import os
 import signal
 import subprocess
 import time
+from pathlib import Path
 
+import numpy as np
 import pytest
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from rclpy.qos import QoSProfile
 
 from drill_sim_ros import topics
 from drill_sim_ros.archive.reader import ArchiveReader
-from drill_sim_ros.model.presets import DEFAULT_PRESET
+from drill_sim_ros.archive.writer import DEFAULT_MAX_CHUNK_SPAN_S
+from drill_sim_ros.model.presets import DEFAULT_PRESET, load_preset
+from drill_sim_ros.ros import typed
+from drill_sim_ros.ros.parameters import SPEC_BY_NAME
 from drill_sim_ros.viz.mcap_telemetry import recorded_preset
 from tests.archive.helpers import BIN, counts_mcap_ros2, running, stop, wait_for
 from tests.archive.ros_fixtures import ros_node, step_sim
 from tests.archive.test_sim_node_archive import SAMPLE_TOPICS, _sim_command
 
 pytestmark = pytest.mark.ros
-# 0.5 s of log time: every sample topic (/clock included) at 100 Hz, and /diagnostics
-CHUNK_MESSAGES = 50 * len(SAMPLE_TOPICS) + 10
 
 
 def _sim(*ros_args: str, timeout_s: float = 60) -> subprocess.CompletedProcess:
@@ -113,8 +117,33 @@ def test_a_full_disk_turns_diagnostics_to_error_and_the_sim_runs_on(small_disk, 
     kept = int(final[0].split("; ")[-1].split(" messages kept")[0])
     readable = sum(1 for _ in ArchiveReader(path).messages())
     # kept counts chunks whose every record reached the OS; the chunk whose message index
-    # hit the full disk may still be readable: at most one 0.5 s chunk (10 topics x 100 Hz)
-    assert 0 < kept <= readable <= kept + CHUNK_MESSAGES
+    # hit the full disk may still be readable: at most one chunk more
+    assert 0 < kept <= readable <= kept + chunk_messages(path)
+
+
+def chunk_messages(path: Path) -> int:
+    """The most messages one chunk of sim_node's in-process recording (default rates, default
+    preset) can hold. A chunk closes at the first message DEFAULT_MAX_CHUNK_SPAN_S of log
+    (= simulated) time after its first one (archive/writer.py), so it holds that many
+    seconds of whole periods of every per-sample topic (the typed telemetry twin too when
+    drill_sim_msgs is installed) and the message that closes it; a string profile every
+    round(publish_rate_hz / string.rate_hz) periods (a distributed string); the latched run
+    info (and its typed twin); and the /diagnostics of the wall time those seconds took:
+    they come at 1 Hz of wall time and are logged at simulated time, so their closest
+    spacing in the recording bounds how many one chunk spans."""
+    rate_hz = SPEC_BY_NAME["publish_rate_hz"].default
+    span_ns = round(DEFAULT_MAX_CHUNK_SPAN_S * 1e9)
+    periods = round(DEFAULT_MAX_CHUNK_SPAN_S * rate_hz)
+    per_sample = len(SAMPLE_TOPICS) + typed.AVAILABLE
+    every = max(1, round(rate_hz / SPEC_BY_NAME["string.rate_hz"].default))
+    profiles = math.ceil(periods / every) if load_preset(DEFAULT_PRESET).string.distributed \
+        else 0
+    run_info = 1 + typed.AVAILABLE
+    diagnostics_ns = [m.log_time_ns for m in ArchiveReader(path).messages(
+        lambda topic: topic == topics.DIAGNOSTICS)]
+    diagnostics = len(diagnostics_ns) if len(diagnostics_ns) < 2 else \
+        span_ns // max(1, int(np.diff(diagnostics_ns).min())) + 1
+    return periods * per_sample + 1 + profiles + run_info + diagnostics
 
 
 def test_in_process_recording_splits_by_simulated_duration(tmp_path) -> None:

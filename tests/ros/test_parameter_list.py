@@ -7,7 +7,10 @@ import json
 import subprocess
 import sys
 
+from drill_sim_ros.model.presets import DEFAULT_PRESET, load_preset
 from drill_sim_ros.ros.parameters import SPECS
+
+LUMPED = "field_8p5in_shale_lumped"     # a preset whose rpm and WOB differ from the default's
 
 
 def drill_sim_params(*args: str) -> subprocess.CompletedProcess:
@@ -26,7 +29,15 @@ def test_every_parameter_is_listed_with_its_type_unit_range_default_and_runtime(
     assert rows["lockstep.warn_after_s"]["unit"] == "s"
     assert rows["lockstep.warn_after_s"]["runtime"] == "yes"
     assert rows["model.applied_wob_n"]["unit"] == "N"                # from its [N]
-    assert rows["model.applied_wob_n"]["default"] == 60000.0         # the field preset's
+    default, lumped = load_preset(DEFAULT_PRESET).physical, load_preset(LUMPED).physical
+    assert rows["model.applied_wob_n"]["default"] == default.applied_wob_n   # the preset's
+    assert rows["model.surface_rpm"]["default"] == default.surface_rpm
+    other = {row["name"]: row for row in json.loads(drill_sim_params(
+        "--preset", LUMPED, "--json").stdout)}
+    assert (lumped.applied_wob_n, lumped.surface_rpm) != (default.applied_wob_n,
+                                                          default.surface_rpm)
+    assert other["model.applied_wob_n"]["default"] == lumped.applied_wob_n
+    assert other["model.surface_rpm"]["default"] == lumped.surface_rpm
     assert rows["lockstep_trigger"]["range"] == "service | command"
     assert rows["model.n_nodes"]["range"] == "[16, 4194304]"
 

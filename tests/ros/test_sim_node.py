@@ -28,6 +28,8 @@ from tests.ros.harness import Probe, Ros, overrides, ros_context
 
 pytestmark = pytest.mark.ros
 F = topics.TELEMETRY_INDEX
+# RGD07's lumped string: the expected means of tests/ros/physics.py (M dv/dt = W_app - W, twist
+# = surface torque / C) are its equations of motion, not the wave guide's of the default preset
 FIELD = "field_8p5in_shale_lumped"
 PERIOD_S = 0.01          # publish_rate_hz 100 (the default)
 NODE = f"/{topics.NODE_NAME}"
@@ -42,6 +44,7 @@ def ros():
 
 def start_node(ros: Ros, **params) -> SimNode:
     params.setdefault("status_line", False)
+    params.setdefault("model__preset", FIELD)     # the preset every expectation here is from
     # the paper's imposed top-drive speed unless a test asks for the drive (the field preset's
     # default is the speed loop), so commanded speeds show exactly in surface_rpm
     params.setdefault("top_drive__mode", "kinematic")
@@ -132,7 +135,7 @@ def test_every_topic_published_with_its_type_and_one_stamp_per_sample(ros):
     np.testing.assert_allclose(surf_arr[:, 4], rows[:, F["surface_torque_nm"]])
     np.testing.assert_allclose(surf_arr[:, 5], rows[:, F["applied_wob_n"]])   # hook: WOB
 
-    # Plausible values for the field preset (60 rpm, 60 kN, 2500 m of 5-in pipe + 200 m BHA).
+    # Plausible values for the field preset (2500 m of 5-in pipe + 200 m BHA, its rpm and WOB).
     preset = load_preset(FIELD)
     wob0 = preset.physical.applied_wob_n
     np.testing.assert_allclose(rows[:, F["surface_rpm"]], preset.physical.surface_rpm)
