@@ -9,6 +9,7 @@ kernel as it was before the string existed (hashes of its output at commit 855bf
 from __future__ import annotations
 
 import cmath
+import dataclasses
 import hashlib
 import json
 import math
@@ -114,34 +115,47 @@ def test_junction_transmits_as_the_impedances_say() -> None:
 
 
 # ---- modes --------------------------------------------------------------------------------
-def closed_form_two_section_hz(preset, axial: bool, count: int = 3) -> list[float]:
-    """Roots of tan(k L1) tan(k L2) = S1 / S2 (one material, fixed top, free bit), written
-    as S1 cos cos - S2 sin sin = 0 and bracketed on a fine grid."""
+def closed_form_two_section_hz(preset, axial: bool, bit_inertia: float = 0.0,
+                               count: int = 3) -> list[float]:
+    """Roots in omega of the two-section condition (one material, wave speed c, k = omega / c,
+    fixed top, a lumped ``bit_inertia`` J at the bit, kg m^2 or kg): with u1 = A sin kx in the
+    top section, u2 = B cos ky + C sin ky in the bottom one, continuity of u and of the
+    force S u' at the junction and S2 u2'(L2) = J omega^2 u2(L2) at the bit give
+    S1 cos cos - S2 sin sin - J omega c (sin1 cos2 + S1 / S2 cos1 sin2) = 0, which for J = 0
+    is tan(k L1) tan(k L2) = S1 / S2; bracketed on a fine grid."""
     top, bottom = preset.string.sections
     c = top.axial_speed_m_s if axial else top.torsional_speed_m_s
     s1, s2 = ((top.axial_stiffness_n, bottom.axial_stiffness_n) if axial else
               (top.torsional_stiffness_nm, bottom.torsional_stiffness_nm))
     w = np.linspace(1e-4, 2 * math.pi * 5.0, 2_000_001)
-    g = s1 * np.cos(w * top.length_m / c) * np.cos(w * bottom.length_m / c) \
-        - s2 * np.sin(w * top.length_m / c) * np.sin(w * bottom.length_m / c)
+    sin1, cos1 = np.sin(w * top.length_m / c), np.cos(w * top.length_m / c)
+    sin2, cos2 = np.sin(w * bottom.length_m / c), np.cos(w * bottom.length_m / c)
+    g = s1 * cos1 * cos2 - s2 * sin1 * sin2 \
+        - bit_inertia * w * c * (sin1 * cos2 + s1 / s2 * cos1 * sin2)
     i = np.flatnonzero(np.sign(g[:-1]) != np.sign(g[1:]))[:count]
     roots = w[i] - g[i] * (w[i + 1] - w[i]) / (g[i + 1] - g[i])
     return list(roots / (2 * math.pi))
 
 
 def test_field_modes_identified_from_the_ring_down() -> None:
+    """The field string's modes with its bit inertia (torsion; the axial line has no lumped
+    bit mass): transfer matrices against the closed form, and the ring-down finds them."""
     preset = load_preset("field_8p5in_shale")
     modes = si.identify_modes(preset)
+    bit = preset.string.bit_inertia_kg_m2
+    assert bit > 0.0                          # the closed form's inertia term is exercised
     for axial, identified, analytic in ((False, modes.torsional_identified_hz,
                                          modes.torsional_analytic_hz),
                                         (True, modes.axial_identified_hz,
                                          modes.axial_analytic_hz)):
-        closed = closed_form_two_section_hz(preset, axial)
+        closed = closed_form_two_section_hz(preset, axial, 0.0 if axial else bit)
         assert analytic == pytest.approx(closed, rel=1e-5)
         assert len(identified) == 3
         assert identified == pytest.approx(analytic, rel=0.005)
     # the issue's figures for this string (fixed top, free bit, E = 206 GPa)
-    assert modes.torsional_analytic_hz == pytest.approx([0.2115, 0.7276, 1.3211], abs=1e-4)
+    free = dataclasses.replace(preset.string, bit_inertia_kg_m2=0.0)
+    assert sg.analytic_modes_hz(free, 3, axial=False) == pytest.approx(
+        [0.2115, 0.7276, 1.3211], abs=1e-4)
     assert modes.axial_analytic_hz == pytest.approx([0.3616, 1.1983, 2.1463], abs=1e-4)
 
 
