@@ -76,9 +76,13 @@ def test_saturation_fraction_counts_the_torque_limit_alone() -> None:
     t = rows[:, F["sim_time_s"]]
     rows[(t > 50.0) & (t <= 52.0), F["motor_torque_nm"]] = -RIG.max_torque_nm   # 200 samples
     rows[(t > 60.0) & (t <= 61.0), F["speed_setpoint_rpm"]] = 0.0               # 100 samples
+    # clamped to the rpm limit, as the telemetry reads it back through a preset's t* (the
+    # default preset's: one ulp below the limit)
+    at_limit = np.nextafter(RIG.max_surface_rpm, 0.0)
+    rows[(t > 70.0) & (t <= 70.5), F["speed_setpoint_rpm"]] = at_limit         # 50 samples
     card = score(rows, 20.0, Schedule(60.0, 60e3), RIG, PERIOD_S)
     after = np.count_nonzero(t > 20.0)
-    assert card["saturation_count"] == 300
+    assert card["saturation_count"] == 350
     assert card["saturation_fraction"] == pytest.approx(200 / after, rel=1e-12)
 
 
