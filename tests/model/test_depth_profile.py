@@ -110,7 +110,7 @@ def test_lumped_string_has_no_profiles_and_the_bha_is_the_bit() -> None:
 
 
 def test_bha_speed_follows_the_bottom_of_the_string() -> None:
-    sim = session(string_rate_hz=10.0)
+    sim = SimSession(SessionConfig(preset=lossless_field(), string_rate_hz=10.0))
     block = sim.run(1000)
     last = block.strings[-1]
     row = block.rows[block.stamps_ns.tolist().index(last.stamp_ns)]
