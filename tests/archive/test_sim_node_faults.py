@@ -15,14 +15,17 @@ from rclpy.qos import QoSProfile
 from drill_sim_ros import topics
 from drill_sim_ros.archive.reader import ArchiveReader
 from drill_sim_ros.model.presets import DEFAULT_PRESET
+from drill_sim_ros.ros import typed
 from drill_sim_ros.viz.mcap_telemetry import recorded_preset
 from tests.archive.helpers import BIN, counts_mcap_ros2, running, stop, wait_for
 from tests.archive.ros_fixtures import ros_node, step_sim
 from tests.archive.test_sim_node_archive import SAMPLE_TOPICS, _sim_command
 
 pytestmark = pytest.mark.ros
-# 0.5 s of log time: every sample topic (/clock included) at 100 Hz, and /diagnostics
-CHUNK_MESSAGES = 50 * len(SAMPLE_TOPICS) + 10
+# 0.5 s of log time: every sample topic (/clock included, and the typed telemetry twin when
+# drill_sim_msgs is built) at 100 Hz, the string profiles at string.rate_hz (10 Hz), and
+# /diagnostics
+CHUNK_MESSAGES = 50 * (len(SAMPLE_TOPICS) + int(typed.AVAILABLE)) + 5 + 10
 
 
 def _sim(*ros_args: str, timeout_s: float = 60) -> subprocess.CompletedProcess:
