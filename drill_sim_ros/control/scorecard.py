@@ -155,9 +155,11 @@ def at_torque_limit(rows: np.ndarray, rig: RigPhysics) -> np.ndarray:
 
 def saturated(rows: np.ndarray, rig: RigPhysics) -> np.ndarray:
     """Samples where the drive is saturated: the motor torque at its limit, or the speed
-    setpoint at 0 or at the rpm limit."""
+    setpoint at 0 or at the rpm limit (to the same relative 1e-9 as the torque: a setpoint
+    clamped to the limit comes back through the kernel's time scale an ulp off)."""
     setpoint = rows[:, F["speed_setpoint_rpm"]]
-    return at_torque_limit(rows, rig) | (setpoint <= 0.0) | (setpoint >= rig.max_surface_rpm)
+    return at_torque_limit(rows, rig) | (setpoint <= 0.0) \
+        | (setpoint >= rig.max_surface_rpm * (1 - 1e-9))
 
 
 def _period_s(slow_rpm: np.ndarray, sample_period_s: float) -> float | None:

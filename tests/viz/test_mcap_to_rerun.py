@@ -40,7 +40,7 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> dict:
     preset = load_preset(PRESET)
     rows = telemetry_rows(preset, SECONDS)
     mcap, rrd = tmp / "run.mcap", tmp / "run.rrd"
-    write_mcap(mcap, rows)
+    write_mcap(mcap, rows, metadata={"preset": PRESET})     # the views take its scales
     proc = run_cli(str(mcap), "-o", str(rrd))
     assert proc.returncode == 0, proc.stderr
     with open(mcap, "rb") as stream:

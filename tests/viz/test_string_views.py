@@ -23,6 +23,7 @@ from tests.viz.rrd_read import read_recording, view_origins
 from tests.viz.sim_telemetry import FLOAT64_MULTI_ARRAY_DEF, SEPARATOR, telemetry_message
 
 SECONDS = 40.0
+FIELD = "field_8p5in_shale"
 STRING_VIEWS = {"/string/depth_time", "/string/speed", "/string/torque"}
 JOINT_STATE_DEF = (
     "std_msgs/Header header\nstring[] name\nfloat64[] position\nfloat64[] velocity\n"
@@ -32,7 +33,7 @@ JOINT_STATE_DEF = (
 
 
 def field_run() -> tuple[np.ndarray, list, SimSession]:
-    sim = SimSession(SessionConfig(preset=load_preset("field_8p5in_shale"),
+    sim = SimSession(SessionConfig(preset=load_preset(FIELD),
                                    string_rate_hz=10.0, perturb_v=1e-2))
     first = sim.current()
     block = sim.run(round(SECONDS * 100))
@@ -110,7 +111,7 @@ def test_depth_time_picture_rows_are_depths_columns_the_last_profiles(run: dict)
     assert image.shape == (len(run["depths"]), IMAGE_PROFILES, 3)
     by_stamp = {s.stamp_ns: s for s in run["strings"]}
     last = by_stamp[int(data.time_ns[-1])]
-    full_scale = 2.0 * 60.0                 # twice the preset's 60 rpm
+    full_scale = 2.0 * load_preset(FIELD).physical.surface_rpm    # twice the preset's speed
     np.testing.assert_array_equal(image[:, -1], speed_colors(last.speed_rad_s * RPM_PER_RAD_S,
                                                              full_scale))
     first = data.columns["Image:format"][0][0]
