@@ -60,10 +60,17 @@ def test_profiles_come_at_the_rate_on_sample_stamps_and_t0_is_the_steady_state()
     first = sim.current()
     assert [s.stamp_ns for s in first.strings] == [0]
     row, profile = first.rows[0], first.strings[0]
-    # the string starts in steady rotation: the drive's speed and the bit's torque everywhere
-    np.testing.assert_allclose(profile.speed_rad_s, row[F["surface_rpm"]] / RPM_PER_RAD_S,
-                               rtol=1e-12)
-    np.testing.assert_allclose(profile.torque_nm, row[F["tob_nm"]], rtol=1e-9)
+    # the string starts in steady rotation: the drive's speed everywhere, and the bit's
+    # torque plus the viscous drag of the string below each depth (rate x inertia x speed:
+    # all of it near the top; none below the last damper, 25 m above the bit)
+    omega = row[F["surface_rpm"]] / RPM_PER_RAD_S
+    np.testing.assert_allclose(profile.speed_rad_s, omega, rtol=1e-12)
+    spec = load_preset(FIELD).string
+    drag_nm = sum(s.torsional_damping_per_s * s.inertia_kg_m2 for s in spec.sections) * omega
+    torque = np.asarray(profile.torque_nm)
+    assert torque[0] == pytest.approx(row[F["tob_nm"]] + drag_nm, rel=1e-9)
+    assert torque[-1] == pytest.approx(row[F["tob_nm"]], rel=1e-9)
+    assert np.all(np.diff(torque) <= 1e-9 * torque[0])
     block = sim.run(25)
     assert [s.stamp_ns for s in block.strings] == [100_000_000, 200_000_000]
     assert set(s.stamp_ns for s in block.strings) <= set(block.stamps_ns.tolist())
