@@ -54,12 +54,6 @@ class RigPhysics:
         """omega_1 = sqrt(C / I), the torsional mode of the bit on the pipe (1/t*)."""
         return math.sqrt(self.stiffness_nm_rad / self.bit_inertia_kg_m2)
 
-    @property
-    def lumped_impedance_nm_s(self) -> float:
-        """sqrt(C I): the damping coefficient at the top that damps the lumped mode with a
-        damping ratio of 1/2 (see ``SoftTorque``); for a uniform pipe alone it is Z."""
-        return math.sqrt(self.stiffness_nm_rad * self.bit_inertia_kg_m2)
-
 
 def rig_physics(preset: Preset) -> RigPhysics:
     """The physics of a physical preset; ParameterError for a dimensionless one."""
