@@ -158,11 +158,13 @@ Drive = namedtuple("Drive", (
 Drive.__doc__ = """A run's top-drive parameters and commands (top_drive.drive_step)."""
 Response = namedtuple("Response", (
     "cursor", "doc", "t_top", "f_top", "v_new", "omega_new", "w_f", "wob", "tob", "mode",
-    "stuck", "omega_s_next", "omega_ref", "integral", "motor", "v_hook", "hook_int"))
-Response.__doc__ = """What one step computes from the state before anything moves: the exact
+    "stuck", "v_hook", "hook_int"))
+Response.__doc__ = """What a step computes on the bit's side before anything moves: the exact
 delay's cursor, the depth of cut, the string's torque and force at the top, the bit's new
-speeds and forces and mode (eqs. 29-33), the drive's next speed, setpoint, integral and
-motor torque, the hook's speed and integral."""
+speeds, forces and mode (eqs. 29-33), the hook's speed and integral."""
+DriveStep = namedtuple("DriveStep", ("omega_s_next", "omega_ref", "integral", "motor"))
+DriveStep.__doc__ = """The drive over a step: its speed at the end, the setpoint in force, the
+speed loop's integral, the motor torque (top_drive.drive_step)."""
 
 STATUS_OK = 0
 STATUS_NONFINITE = 1
@@ -190,30 +192,33 @@ def _first_countdown(step: int, every: int) -> int:
 
 
 @njit(cache=True, inline="always")
-def _accumulate(acc: np.ndarray, tau: float, tau_avg: float, mode: int, w_f: float,
-                tob: float, doc: float, wob: float, omega: float, t_pipe: float,
-                v: float) -> None:
-    """One step into the statistics ``acc`` (``A_*``), in place: first stick and bounce
-    times always, the window sums for tau >= tau_avg. (In place, not a tuple of locals:
-    thirteen loop-carried values fewer for the register allocator.)"""
-    if mode == MODE_STUCK and acc[A_FIRST_STICK] != acc[A_FIRST_STICK]:
+def _accumulate(acc: np.ndarray, x: Loop, r: Response, motor: float, law: Law,
+                probe: float) -> float:
+    """Step ``r`` from ``x`` into the statistics ``acc`` (``A_*``), in place: first stick and
+    bounce times always, the window sums for tau >= the window's start. (In place, not a
+    tuple of locals: thirteen loop-carried values fewer for the register allocator.)
+    Returns ``probe`` plus the step's forces: a NaN there survives the contact logic."""
+    tau = x.step * law.dt
+    if r.mode == MODE_STUCK and acc[A_FIRST_STICK] != acc[A_FIRST_STICK]:
         acc[A_FIRST_STICK] = tau
-    if mode == MODE_OFF_BOTTOM and acc[A_FIRST_BOUNCE] != acc[A_FIRST_BOUNCE]:
+    if r.mode == MODE_OFF_BOTTOM and acc[A_FIRST_BOUNCE] != acc[A_FIRST_BOUNCE]:
         acc[A_FIRST_BOUNCE] = tau
-    if tau < tau_avg:
-        return
+    probe += r.w_f + r.tob + motor
+    if tau < law.tau_avg:
+        return probe
     acc[A_COUNT] += 1.0
-    acc[A_WF] += w_f
-    acc[A_TOB] += tob
-    acc[A_DOC] += doc
-    acc[A_WOB] += wob
-    acc[A_OMEGA] += omega
-    acc[A_T_PIPE] += t_pipe
-    acc[A_V] += v
-    acc[A_OMEGA_MIN] = min(acc[A_OMEGA_MIN], omega)
-    acc[A_OMEGA_MAX] = max(acc[A_OMEGA_MAX], omega)
-    if mode == MODE_STUCK:
+    acc[A_WF] += r.w_f
+    acc[A_TOB] += r.tob
+    acc[A_DOC] += r.doc
+    acc[A_WOB] += r.wob
+    acc[A_OMEGA] += x.omega
+    acc[A_T_PIPE] += r.t_top
+    acc[A_V] += x.v
+    acc[A_OMEGA_MIN] = min(acc[A_OMEGA_MIN], x.omega)
+    acc[A_OMEGA_MAX] = max(acc[A_OMEGA_MAX], x.omega)
+    if r.mode == MODE_STUCK:
         acc[A_STUCK] += 1.0
+    return probe
 
 
 @njit(cache=True, inline="always")
@@ -239,10 +244,10 @@ def _cutting(cut_factor: float, off_bottom: bool, doc: float) -> float:
 
 
 @njit(cache=True, inline="always")
-def _write_row(out: np.ndarray, n_rows: int, x: Loop, r: Response, dt: float,
-               omega_bha: float) -> int:
+def _write_row(out: np.ndarray, n_rows: int, x: Loop, r: Response, d: DriveStep,
+               dt: float, omega_bha: float) -> int:
     """Sample row ``n_rows`` of ``out`` (columns C_*): the state ``x`` at the start of the
-    step and what the step ``r`` computed from it; returns the rows written. Called only
+    step and what the step ``r``, ``d`` computed from it; returns the rows written. Called only
     when a row is due: an array handed to an inlined function costs a reference count (two
     calls, around which every register spills), so ``out`` stays out of the per-step path."""
     row = out[n_rows]
@@ -251,7 +256,7 @@ def _write_row(out: np.ndarray, n_rows: int, x: Loop, r: Response, dt: float,
     row[C_PHI_S], row[C_OMEGA_S], row[C_W_APP] = x.phi_s, x.omega_s, x.w_app
     row[C_WOB], row[C_TOB], row[C_DOC], row[C_WF] = r.wob, r.tob, r.doc, r.w_f
     row[C_T_PIPE], row[C_MODE] = r.t_top, r.mode
-    row[C_MOTOR_TORQUE], row[C_OMEGA_REF] = r.motor, r.omega_ref
+    row[C_MOTOR_TORQUE], row[C_OMEGA_REF] = d.motor, d.omega_ref
     row[C_F_TOP], row[C_OMEGA_BHA] = r.f_top, omega_bha
     return n_rows + 1
 
@@ -271,90 +276,100 @@ def _steps(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarray
            hist: np.ndarray, meta: np.ndarray, acc: np.ndarray, out: np.ndarray,
            wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray,
            n_steps: int, every: int, exact: bool, dry: bool) -> tuple[int, int]:
-    """:func:`advance`: the bookkeeping of a run (sample rows, statistics, status) around
-    the physics of each step, computed by :func:`_respond` and committed by :func:`_move`.
-    ``dry``: only the first step's sample row, then back: nothing else is written."""
+    """:func:`advance` step by step: read the delay and the string's ends, respond, record,
+    move on. ``dry``: the first step's row only, nothing else written (module doc)."""
     x = _unpack(st, meta)
     law, drive = _law_params(prm, tgt, profile), _drive_params(prm, tgt)
-    lay = sg.layout(wave_i, int(prm[P_PARTS_T]), prm[P_BIT_INERTIA],
-                    0.0 if prm[P_OFF_BOTTOM] == 2.0 else 1.0, int(prm[P_BHA_PART]))
+    lay = _string_layout(prm, wave_i)
     countdown, n_rows, status, probe = _first_countdown(x.step, every), 0, STATUS_OK, 0.0
-    for _ in range(n_steps):
-        r = _respond(x, law, drive, lay, st[S_MOTOR_TORQUE], profile, hist, wave, wave_i,
-                     wave_f, exact)       # the lag's last torque is read back from st
-        probe += r.w_f + r.tob + r.motor        # (a NaN survives the contact logic)
+    for _ in range(n_steps):      # the delay: U(tau - tau_n), eqs. 6-7, 26-28
+        surface, cursor = br.delayed_depth(hist[0], hist[1], x.head, x.count, x.cursor,
+            x.phi - law.sector) if exact else (br.profile_surface(profile, x.node, x.frac,
+                                                                   x.h_old), x.cursor)
+        r = _respond(x, law, surface, cursor, sg.ends(
+            wave, wave_i, wave_f, lay, law.psi, law.dt, x.phi_s, x.phi, x.v, x.omega, x.w_app,
+            x.omega_s, x.v_hook), wave is None)
+        d = _drive(x, drive, law.dt, st[S_MOTOR_TORQUE], r.t_top)  # the lag's last torque
         if countdown == 0 and n_rows < out.shape[0]:      # the sample at the step's start
-            n_rows = _write_row(out, n_rows, x, r, law.dt,
+            n_rows = _write_row(out, n_rows, x, r, d, law.dt,
                                 sg.bha_speed(wave, wave_i, wave_f, lay, x.omega))
         countdown = every - 1 if countdown == 0 else countdown - 1
         if dry:                       # (nothing written before this line but the row)
             return STATUS_OK, n_rows
-        st[S_MOTOR_TORQUE] = r.motor  # (no register held through the bit law)
-        _accumulate(acc, x.step * law.dt, law.tau_avg, r.mode, r.w_f, r.tob, r.doc, r.wob,
-                    x.omega, r.t_top, x.v)
-        x, ok = _move(x, r, law, drive.mode, lay, profile, hist, wave, wave_i, wave_f, exact)
+        st[S_MOTOR_TORQUE] = d.motor      # (read back: no register held through the bit law)
+        probe = _accumulate(acc, x, r, d.motor, law, probe)
+        sg.advance(wave, wave_i, wave_f, lay, d.omega_s_next, r.v_hook, r.omega_new, r.v_new)
+        u_new, phi_new = x.u + r.v_new * law.dt, x.phi + r.omega_new * law.dt     # eq. C.1
+        head, count, node, frac, h_old = x.head, x.count, x.node, x.frac, x.h_old
+        if exact:
+            head, count, cursor, ok = br.history_store(hist, head, count, r.cursor, x.phi,
+                                                       phi_new, u_new)
+        else:
+            node, frac, h_old, ok = br.profile_recut(profile, node, frac, h_old, x.u, u_new,
+                                                     (phi_new - x.phi) * law.inv_spacing)
+        x = _moved(x, r, d, law, drive.mode == TD_KINEMATIC and wave is None, u_new, phi_new,
+                   node, frac, h_old, head, count, cursor)
         if not ok or x.u >= law.layer_u:
-            status = STATUS_LAYER if ok else (STATUS_HISTORY_FULL if exact else STATUS_RUNAWAY)
+            status = _stop_status(ok, exact)
             break
     _pack(st, meta, x, law.dt)
     return _finish(status, (x.u, x.v, x.phi, x.omega, x.omega_s, probe)), n_rows
 
 
 @njit(cache=True, inline="always")
-def _respond(x: Loop, law: Law, drive: Drive, lay: tuple, last_motor: float,
-             profile: np.ndarray, hist: np.ndarray, wave: np.ndarray, wave_i: np.ndarray,
-             wave_f: np.ndarray, exact: bool) -> Response:
-    """The physics of one step from ``x``, nothing written: the depth of cut from the delay
-    (eqs. 6-8, 26-28), what the string presents at its ends, the bit law (eqs. 29-33), the
-    drive against the string torque at the quill, and the hook's WOB loop."""
-    cursor = x.cursor
-    if exact:                     # the delay: U(tau - tau_n), eqs. 6-7, 26-28
-        surface, cursor = br.delayed_depth(hist[0], hist[1], x.head, x.count, cursor,
-                                           x.phi - law.sector)
-    else:
-        surface = br.profile_surface(profile, x.node, x.frac, x.h_old)
+def _respond(x: Loop, law: Law, surface: float, cursor: int, ends: tuple,
+             lumped: bool) -> Response:
+    """The bit's side of a step from ``x``, given the rock surface under the bit and what
+    the string presents at its ends (string.ends): the depth of cut (eq. 8), the bit law
+    (eqs. 29-33), and the hook's WOB loop on the force at the top."""
     doc = law.n_blades * (x.u - surface)        # delta = n (U - U(tau - tau_n)), eq. 8
-    v0, kick_v, f_ext, omega0, kick_w, t_ext, t_top, f_top = sg.ends(
-        wave, wave_i, wave_f, lay, law.psi, law.dt, x.phi_s, x.phi, x.v, x.omega, x.w_app,
-        x.omega_s, x.v_hook)
+    v0, kick_v, f_ext, omega0, kick_w, t_ext, t_top, f_top = ends
     v_new, omega_new, w_f, wob, tob, mode, stuck = br.bit_response(
         v0, kick_v, f_ext, omega0, kick_w, t_ext, _cutting(law.cut_factor, law.off_bottom, doc),
         x.stuck, law.beta, law.lam)
-    omega_s_next, omega_ref, integral, motor = drive_step(
-        drive.mode, x.omega_s, x.omega_ref, x.integral, last_motor, t_top, drive.omega,
-        drive.torque, drive.omega_rate, drive.inertia, drive.kp, drive.ki, drive.max_torque,
-        drive.lag_alpha, law.dt)
     v_hook, hook_int = x.v_hook, x.hook_int
-    if wave is not None:          # the hook's WOB loop
+    if not lumped:                # the hook's WOB loop
         v_hook, hook_int = _hook(law.hook_kp, law.hook_ki, law.off_bottom, law.dt, x.w_app,
                                  f_top, hook_int)
     return Response(cursor, doc, t_top, f_top, v_new, omega_new, w_f, wob, tob, mode, stuck,
-                    omega_s_next, omega_ref, integral, motor, v_hook, hook_int)
+                    v_hook, hook_int)
 
 
 @njit(cache=True, inline="always")
-def _move(x: Loop, r: Response, law: Law, td_mode: int, lay: tuple, profile: np.ndarray,
-          hist: np.ndarray, wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray,
-          exact: bool) -> tuple[Loop, bool]:
-    """The step ``r`` committed: the string one step on, the drive's angle, the bit's motion
-    (symplectic Euler, eq. C.1), the rock re-cut under the blades (or the exact history
-    stored), the applied weight ramped. Returns the new state and False on a runaway (or a
-    full history)."""
-    sg.advance(wave, wave_i, wave_f, lay, r.omega_s_next, r.v_hook, r.omega_new, r.v_new)
-    kinematic_lumped = wave is None and td_mode == TD_KINEMATIC
-    phi_s = x.phi_s + (x.omega_s if kinematic_lumped else r.omega_s_next) * law.dt
-    u_new, phi_new = x.u + r.v_new * law.dt, x.phi + r.omega_new * law.dt     # eq. C.1
-    head, count, cursor, node, frac, h_old = x.head, x.count, r.cursor, x.node, x.frac, x.h_old
-    if exact:
-        head, count, cursor, ok = br.history_store(hist, head, count, cursor, x.phi, phi_new,
-                                                   u_new)
-    else:
-        node, frac, h_old, ok = br.profile_recut(profile, node, frac, h_old, x.u, u_new,
-                                                 (phi_new - x.phi) * law.inv_spacing)
-    return Loop(u_new, r.v_new, phi_new, r.omega_new, phi_s, r.omega_s_next,
+def _drive(x: Loop, drive: Drive, dt: float, last_motor: float, t_top: float) -> DriveStep:
+    """The top drive over the step against the string torque at the quill ``t_top``, its
+    motor torque lagging from ``last_motor`` (top_drive.drive_step)."""
+    return DriveStep(*drive_step(drive.mode, x.omega_s, x.omega_ref, x.integral, last_motor,
+                                 t_top, drive.omega, drive.torque, drive.omega_rate,
+                                 drive.inertia, drive.kp, drive.ki, drive.max_torque,
+                                 drive.lag_alpha, dt))
+
+
+@njit(cache=True, inline="always")
+def _moved(x: Loop, r: Response, d: DriveStep, law: Law, lumped_kinematic: bool,
+           u_new: float, phi_new: float, node: int, frac: float, h_old: float, head: int,
+           count: int, cursor: int) -> Loop:
+    """The state after step ``r``, ``d``, the bit moved to ``u_new``, ``phi_new`` (eq. C.1) over
+    the rock's new bookkeeping: the drive's angle on (RGD07's kinematic drive on the lumped
+    string turns at the old speed), the applied weight ramped."""
+    phi_s = x.phi_s + (x.omega_s if lumped_kinematic else d.omega_s_next) * law.dt
+    return Loop(u_new, r.v_new, phi_new, r.omega_new, phi_s, d.omega_s_next,
                 ramp(x.w_app, law.tgt_w, law.w_rate, law.dt), r.stuck, node, frac, h_old,
-                x.step + 1, r.omega_ref, r.integral, r.motor, r.v_hook, r.hook_int, head,
-                count, cursor), ok
+                x.step + 1, d.omega_ref, d.integral, d.motor, r.v_hook, r.hook_int, head,
+                count, cursor)
+
+
+@njit(cache=True, inline="always")
+def _string_layout(prm: np.ndarray, wave_i: np.ndarray | None) -> tuple:
+    """The distributed string's layout for a run (string.layout) from the parameters."""
+    return sg.layout(wave_i, int(prm[P_PARTS_T]), prm[P_BIT_INERTIA],
+                     0.0 if prm[P_OFF_BOTTOM] == 2.0 else 1.0, int(prm[P_BHA_PART]))
+
+
+@njit(cache=True, inline="always")
+def _stop_status(ok: bool, exact: bool) -> int:
+    """Why a run stopped early: the next layer's top reached, or a failure."""
+    return STATUS_LAYER if ok else (STATUS_HISTORY_FULL if exact else STATUS_RUNAWAY)
 
 
 @njit(cache=True, inline="always")

@@ -450,8 +450,12 @@ def advance(wave: np.ndarray | None, wave_i: np.ndarray | None, wave_f: np.ndarr
     if wave is None:
         return
     parts_t, parts, _, echo, _ = lay
-    drive_line(wave, wave_i, wave_f, 0, parts_t, omega_top, omega_bit, echo)
-    drive_line(wave, wave_i, wave_f, parts_t, parts, v_top, v_bit, 1.0)
+    b_top, a_bottom = arriving(wave, wave_i, 0, parts_t)        # (drive_line, unrolled: an
+    scatter(wave, wave_i, wave_f, 0, parts_t, b_top + 2.0 * wave_f[W_Z, 0] * omega_top,
+            (a_bottom - 2.0 * wave_f[W_Z, parts_t - 1] * omega_bit) * echo)
+    b_top, a_bottom = arriving(wave, wave_i, parts_t, parts)    # inlined level less)
+    scatter(wave, wave_i, wave_f, parts_t, parts, b_top + 2.0 * wave_f[W_Z, parts_t] * v_top,
+            (a_bottom - 2.0 * wave_f[W_Z, parts - 1] * v_bit) * 1.0)
 
 
 @njit(cache=True, inline="always")
