@@ -63,7 +63,7 @@ def add_parsers(sub: Any, add_model_args: Callable[[argparse.ArgumentParser], No
 def map_spec_from(args: argparse.Namespace,
                   resolve: Callable[[argparse.Namespace], Any]) -> MapSpec:
     """A :class:`MapSpec` from the ``map`` options; ``resolve`` is ``drill_sim run``'s."""
-    from drill_sim_ros.model.validate_input import load_checked_preset
+    from drill_sim_ros.model.presets import load_preset
     from drill_sim_ros.study.grid import Control, MapSpec, Numerics, parse_vary
     control = None
     if args.controller is not None:
@@ -74,7 +74,7 @@ def map_spec_from(args: argparse.Namespace,
     num = Numerics(tau_end=run.tau_end, average_from=run.average_from, dtau=run.dtau,
                    n_nodes=run.n_nodes, method=run.method, perturb_v=run.perturb_v,
                    perturb_omega=run.perturb_omega)
-    name = load_checked_preset(args.params).name if args.params else ""
+    name = load_preset(args.params).name if args.params else ""
     return MapSpec(run.params, tuple(parse_vary(v) for v in args.vary), num,
                    scales=run.scales if run.physical else None, preset=name,
                    control=control)
