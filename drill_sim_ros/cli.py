@@ -24,9 +24,8 @@ from dataclasses import dataclass, fields
 from pathlib import Path
 from typing import Any, TextIO
 
-from drill_sim_ros import string_cli
+from drill_sim_ros import closed_loop_cli, string_cli
 from drill_sim_ros.archive.output import open_output
-from drill_sim_ros.control import closed_loop_cli
 from drill_sim_ros.model import analysis, telemetry
 from drill_sim_ros.model import kernel as k
 from drill_sim_ros.model.checks import check_blade_counts
