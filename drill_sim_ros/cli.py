@@ -24,17 +24,16 @@ from dataclasses import dataclass, fields
 from pathlib import Path
 from typing import Any, TextIO
 
-from drill_sim_ros import string_cli
+from drill_sim_ros import closed_loop_cli, string_cli
 from drill_sim_ros.archive.output import open_output
-from drill_sim_ros.control import closed_loop_cli
 from drill_sim_ros.model import analysis, telemetry
 from drill_sim_ros.model import kernel as k
+from drill_sim_ros.model.checks import check_blade_counts
 from drill_sim_ros.model.errors import DrillSimError
 from drill_sim_ros.model.params import GROUPS, UNIT_SCALES, DimensionlessParams, Scales
 from drill_sim_ros.model.presets import DEFAULT_PRESET, Preset, available_presets, load_preset
 from drill_sim_ros.model.simulator import SimConfig, Simulator
 from drill_sim_ros.model.top_drive import MODES, TopDrive
-from drill_sim_ros.model.validate_input import check_blade_counts, load_checked_preset
 from drill_sim_ros.study import cli as study_cli
 from drill_sim_ros.study import suite_cli
 from drill_sim_ros.terminal import StatusLine
@@ -142,7 +141,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 def _resolve(args: argparse.Namespace) -> RunSpec:
     """Turn parsed arguments into a validated :class:`RunSpec`."""
-    preset: Preset | None = load_checked_preset(args.params) if args.params else None
+    preset: Preset | None = load_preset(args.params) if args.params else None
     base = preset.params if preset else DimensionlessParams()
     overrides = {g: getattr(args, g) for g in GROUPS if getattr(args, g) is not None}
     params = base.with_(**overrides) if overrides else base
@@ -409,7 +408,7 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
 
 
 def _cmd_info(args: argparse.Namespace) -> int:
-    preset = load_checked_preset(args.preset)
+    preset = load_preset(args.preset)
     p = preset.params
     print(f"{preset.name}: {preset.description}")
     print("  groups  " + "  ".join(f"{g}={getattr(p, g):.4g}" for g in GROUPS))

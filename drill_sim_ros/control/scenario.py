@@ -54,10 +54,11 @@ from drill_sim_ros.model.presets import (
     DEFAULT_PRESET,
     Preset,
     config_dirs,
+    load_preset,
     preset_from_dict,
     preset_path,
 )
-from drill_sim_ros.model.validate_input import check_preset_mapping, load_checked_preset
+from drill_sim_ros.model.validate_input import check_preset_mapping
 
 SCENARIO_KEYS = ("preset", "duration_s", "control_rate_hz", "mode", "controller", "params",
                  "enable_at_s", "schedule", "sensors", "description", "overrides", "drive",
@@ -145,7 +146,7 @@ class Scenario:
         if "max_torque_nm" in self.drive:
             overrides.setdefault("top_drive", {})["max_torque_nm"] = self.drive["max_torque_nm"]
         if not overrides:
-            return load_checked_preset(self.preset)
+            return load_preset(self.preset)
         path = preset_path(self.preset)
         data = yaml.safe_load(path.read_text()) or {}
         for section, values in overrides.items():

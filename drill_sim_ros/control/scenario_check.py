@@ -13,9 +13,9 @@ from __future__ import annotations
 import math
 from typing import Any
 
+from drill_sim_ros.model.checks import as_number, check_known_keys
 from drill_sim_ros.model.errors import ParameterError
 from drill_sim_ros.model.measurement import MAX_DELAY_PERIODS, SIGNALS
-from drill_sim_ros.model.validate_input import as_number, check_known_keys
 
 CONTROL_RATE_RANGE_HZ = (1.0, 1000.0)      # sim_node's publish_rate_hz
 MAX_PERIODS = 2_000_000                    # 2e6 rows x 24 float64 = 384 MB per run

@@ -19,8 +19,8 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
+from drill_sim_ros.model.checks import check_known_keys
 from drill_sim_ros.model.errors import ParameterError
-from drill_sim_ros.model.validate_input import check_known_keys
 
 LAYER_KEYS = ("top_m", "intrinsic_specific_energy_pa", "mu_gamma",
               "contact_stress_times_wearflat_n_per_m")

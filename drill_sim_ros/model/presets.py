@@ -19,8 +19,7 @@ from dataclasses import MISSING, Field, dataclass, field, fields
 from pathlib import Path
 from typing import Any
 
-import yaml
-
+from drill_sim_ros.model.checks import check_known_keys
 from drill_sim_ros.model.errors import ParameterError
 from drill_sim_ros.model.formation import Rock
 from drill_sim_ros.model.params import (
@@ -41,7 +40,7 @@ from drill_sim_ros.model.string import (
     kernel_string,
 )
 from drill_sim_ros.model.top_drive import TopDrive, top_drive_from_dict
-from drill_sim_ros.model.validate_input import check_known_keys, check_preset_mapping
+from drill_sim_ros.model.validate_input import check_preset_mapping, read_preset_file
 
 DEFAULT_PRESET = "field_8p5in_shale"
 GRAVITY_M_S2 = 9.80665
@@ -253,13 +252,13 @@ def string_from_dict(values: Any, phys: PhysicalParams) -> StringSpec:
     return spec
 
 
-def load_preset(name_or_path: str = DEFAULT_PRESET) -> Preset:
-    """Load a preset by name or path; errors name the file and the bad key."""
+def load_preset(name_or_path: Any = DEFAULT_PRESET) -> Preset:
+    """Load a preset by name or path, its file read once; each error is one line naming the
+    file and the bad key."""
+    if not isinstance(name_or_path, str) or not name_or_path:
+        raise ParameterError(f"preset = {name_or_path!r} must be a preset name or a YAML path")
     path = preset_path(name_or_path)
-    try:
-        data = yaml.safe_load(path.read_text())
-    except yaml.YAMLError as exc:
-        raise ParameterError(f"preset file {path} is not valid YAML: {exc}") from exc
+    data = read_preset_file(path)
     try:
         return preset_from_dict(path.stem, data)
     except ParameterError as exc:

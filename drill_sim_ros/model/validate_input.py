@@ -5,19 +5,20 @@ error naming it and the known ones, a physical or dimensionless section must giv
 quantity (no silent default), and every value has its type: a number is a YAML number (not
 ``abc``, not ``true``), an integer is a whole number (``n_blades: 6.5`` is refused, not
 truncated). Each error is one :class:`ParameterError` line naming the key, the value and
-what is allowed; :func:`load_checked_preset` adds the file.
+what is allowed; :func:`read_preset_file` adds the file. The key and number checks shared
+with the other readers of input are in :mod:`drill_sim_ros.model.checks`.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable
 from dataclasses import fields
 from pathlib import Path
 from typing import Any
 
 import yaml
 
+from drill_sim_ros.model.checks import as_number, check_known_keys
 from drill_sim_ros.model.errors import ParameterError
 from drill_sim_ros.model.params import DimensionlessParams, PhysicalParams
 from drill_sim_ros.model.top_drive import MODES, TopDrive, TopDrivePhysical
@@ -38,21 +39,6 @@ def _names(cls: type) -> tuple[str, ...]:
     return tuple(f.name for f in fields(cls))
 
 
-def as_number(value: Any) -> float | int | None:
-    """``value`` as a number; YAML 1.1 reads ``79.3e9`` (no dot, no exponent sign) as a
-    string, so a string that is a number counts as one (``abc`` does not)."""
-    if isinstance(value, bool):
-        return None
-    if isinstance(value, (int, float)):
-        return value
-    if isinstance(value, str):
-        try:
-            return float(value)
-        except ValueError:
-            return None
-    return None
-
-
 def check_value(where: str, key: str, value: Any) -> None:
     """``value`` of ``where.key`` has its key's type: an integer, a string or a number."""
     if key in STRING_KEYS:
@@ -66,23 +52,6 @@ def check_value(where: str, key: str, value: Any) -> None:
         raise ParameterError(f"'{where}.{key}' = {value!r} must be a whole number")
     if not math.isfinite(number) and not (key.startswith("max_torque") and number > 0):
         raise ParameterError(f"'{where}.{key}' = {value!r} must be finite")
-
-
-def check_blade_counts(values: Iterable[float], where: str) -> None:
-    """Every value of n a whole number: n counts the blades and is never rounded."""
-    for value in values:
-        if not float(value).is_integer():
-            raise ParameterError(f"{where}: n = {value:g} is not a whole number (n counts the "
-                                 "blades; it is never rounded)")
-
-
-def check_known_keys(values: dict[Any, Any], known: tuple[str, ...], where: str = "") -> None:
-    """ParameterError naming the keys of ``values`` that are not ``known`` (and the known)."""
-    unknown = sorted(str(k) for k in set(values) - set(known))
-    if unknown:
-        place = f" in '{where}'" if where else ""
-        raise ParameterError(f"unknown key(s) {', '.join(unknown)}{place}; known: "
-                             f"{', '.join(known)}")
 
 
 def check_section(where: str, values: Any, known: tuple[str, ...], required: bool,
@@ -137,8 +106,9 @@ def check_preset_mapping(data: Any) -> None:
                                  f"{', '.join(MODES)}")
 
 
-def check_preset_file(path: Path) -> None:
-    """Read ``path`` and check its mapping; the error names the file."""
+def read_preset_file(path: Path) -> dict[str, Any]:
+    """The mapping of the preset file ``path``, read once and checked; the error names the
+    file."""
     try:
         data = yaml.safe_load(path.read_text())
     except OSError as exc:
@@ -150,12 +120,4 @@ def check_preset_file(path: Path) -> None:
         check_preset_mapping(data)
     except ParameterError as exc:
         raise ParameterError(f"preset file {path}: {exc}") from None
-
-
-def load_checked_preset(name_or_path: Any) -> Any:
-    """:func:`~drill_sim_ros.model.presets.load_preset` after :func:`check_preset_file`."""
-    from drill_sim_ros.model.presets import load_preset, preset_path
-    if not isinstance(name_or_path, str) or not name_or_path:
-        raise ParameterError(f"preset = {name_or_path!r} must be a preset name or a YAML path")
-    check_preset_file(preset_path(name_or_path))
-    return load_preset(name_or_path)
+    return data

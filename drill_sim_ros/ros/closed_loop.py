@@ -20,6 +20,7 @@ import sys
 import tempfile
 from collections.abc import Callable
 from pathlib import Path
+from typing import TextIO
 
 import numpy as np
 from mcap.reader import make_reader
@@ -30,6 +31,7 @@ from drill_sim_ros.control.bench import ClosedLoopRun, sim_node_parameters
 from drill_sim_ros.control.isolation import ControllerError
 from drill_sim_ros.control.scenario import Scenario, save_scenario
 from drill_sim_ros.model.errors import DrillSimError
+from drill_sim_ros.model.presets import Preset
 from drill_sim_ros.model.telemetry import N_FIELDS
 
 _log = logging.getLogger(__name__)
@@ -96,6 +98,70 @@ def _controller_error(stderr: str) -> str:
         f"over DDS: top_drive_controller exited 2: {stderr.strip()[-300:]}"
 
 
+def _start_sim(scenario: Scenario, preset: Preset, record_path: Path, log_path: Path,
+               env: dict[str, str]) -> tuple[subprocess.Popen, TextIO]:
+    """sim_node in command-triggered lockstep, recording to ``record_path``, its output in
+    ``log_path``; the process and the open log (the caller closes it)."""
+    sim_values = {"lockstep": True, "lockstep_trigger": "command", "status_line": False,
+                  "publish_clock": False, "record.path": str(record_path),
+                  **sim_node_parameters(scenario, preset)}
+    sim_log = open(log_path, "w")  # noqa: SIM115 (closed by the caller)
+    sim = subprocess.Popen([sys.executable, "-m", "drill_sim_ros.ros.sim_node",
+                            "--ros-args", *_ros_args(sim_values)], env=env,
+                           stdout=sim_log, stderr=subprocess.STDOUT)
+    return sim, sim_log
+
+
+def _run_controller(scenario_path: Path, periods: int, env: dict[str, str],
+                    timeout_s: float) -> subprocess.CompletedProcess[str]:
+    """The top_drive_controller node for ``periods`` periods of the scenario file."""
+    return subprocess.run(
+        [sys.executable, "-m", "drill_sim_ros.ros.controller_node", "--ros-args",
+         *_ros_args({"scenario": str(scenario_path), "periods": periods})],
+        env=env, capture_output=True, text=True, timeout=timeout_s)
+
+
+def _check_exits(controller: subprocess.CompletedProcess[str], sim_rc: int,
+                 sim_log_path: Path) -> None:
+    """Pass on the controller's warnings; ControllerError or DrillSimError if either failed."""
+    for line in controller.stderr.splitlines():     # e.g. a slow controller
+        if "warning: controller" in line:
+            _log.warning("%s (over DDS)", line[line.index("warning: controller"):])
+    if controller.returncode == 2:
+        raise ControllerError(_controller_error(controller.stderr))
+    if controller.returncode != 0 or sim_rc != 0:
+        raise DrillSimError(
+            f"over DDS: top_drive_controller exited {controller.returncode}, sim_node "
+            f"{sim_rc}: {controller.stderr.strip()[-400:]} "
+            f"{sim_log_path.read_text()[-400:]}")
+
+
+def _run_processes(scenario: Scenario, preset: Preset, tmp: Path, env: dict[str, str],
+                   timeout_s: float) -> ClosedLoopRun:
+    """sim_node and the controller node on ``scenario``, their files in ``tmp``; the
+    recording's telemetry (``interrupted`` and the rows so far on Ctrl-C)."""
+    scenario_path = tmp / "scenario.yaml"
+    record_path, log_path = tmp / "run.mcap", tmp / "sim_node.log"
+    save_scenario(scenario, scenario_path)
+    sim, sim_log = _start_sim(scenario, preset, record_path, log_path, env)
+    try:
+        controller = _run_controller(scenario_path, scenario.periods, env, timeout_s)
+    except subprocess.TimeoutExpired as exc:
+        _stop(sim)
+        raise DrillSimError(f"the controller node did not finish {scenario.periods} periods "
+                            f"in {timeout_s:g} s") from exc
+    except KeyboardInterrupt:                # the children had SIGINT too: both stop
+        _stop(sim)
+        return ClosedLoopRun(scenario, _recorded_rows(record_path), 0.0, interrupted=True)
+    finally:
+        rc = _stop(sim)
+        sim_log.close()
+    _check_exits(controller, rc, log_path)
+    summary = json.loads(controller.stdout.strip().splitlines()[-1])
+    return ClosedLoopRun(scenario, read_telemetry(record_path), float(summary["wall_s"]),
+                         int(summary["clamped_commands"]))
+
+
 def run_over_dds(scenario: Scenario,
                  progress: Callable[[int, int], None] | None = None,
                  timeout_s: float | None = None) -> ClosedLoopRun:
@@ -109,47 +175,12 @@ def run_over_dds(scenario: Scenario,
     timeout_s = timeout_s or 120.0 + periods / 50.0
     env = ros_environment()
     with tempfile.TemporaryDirectory(prefix="drill_closed_loop_") as tmp:
-        scenario_path, record_path = Path(tmp) / "scenario.yaml", Path(tmp) / "run.mcap"
-        save_scenario(scenario, scenario_path)
-        sim_values = {"lockstep": True, "lockstep_trigger": "command", "status_line": False,
-                      "publish_clock": False, "record.path": str(record_path),
-                      **sim_node_parameters(scenario, preset)}
-        sim_log = open(Path(tmp) / "sim_node.log", "w")  # noqa: SIM115 (closed below)
-        sim = subprocess.Popen([sys.executable, "-m", "drill_sim_ros.ros.sim_node",
-                                "--ros-args", *_ros_args(sim_values)], env=env,
-                               stdout=sim_log, stderr=subprocess.STDOUT)
-        try:
-            controller = subprocess.run(
-                [sys.executable, "-m", "drill_sim_ros.ros.controller_node", "--ros-args",
-                 *_ros_args({"scenario": str(scenario_path), "periods": periods})],
-                env=env, capture_output=True, text=True, timeout=timeout_s)
-        except subprocess.TimeoutExpired as exc:
-            _stop(sim)
-            raise DrillSimError(f"the controller node did not finish {periods} periods in "
-                                f"{timeout_s:g} s") from exc
-        except KeyboardInterrupt:                # the children had SIGINT too: both stop
-            _stop(sim)
-            return ClosedLoopRun(scenario, _recorded_rows(record_path), 0.0,
-                                 interrupted=True)
-        finally:
-            rc = _stop(sim)
-            sim_log.close()
-        for line in controller.stderr.splitlines():     # e.g. a slow controller
-            if "warning: controller" in line:
-                _log.warning("%s (over DDS)", line[line.index("warning: controller"):])
-        if controller.returncode == 2:
-            raise ControllerError(_controller_error(controller.stderr))
-        if controller.returncode != 0 or rc != 0:
-            raise DrillSimError(
-                f"over DDS: top_drive_controller exited {controller.returncode}, sim_node "
-                f"{rc}: {controller.stderr.strip()[-400:]} "
-                f"{(Path(tmp) / 'sim_node.log').read_text()[-400:]}")
-        summary = json.loads(controller.stdout.strip().splitlines()[-1])
-        rows = read_telemetry(record_path)
+        run = _run_processes(scenario, preset, Path(tmp), env, timeout_s)
+    if run.interrupted:
+        return run
     if progress is not None:
         progress(periods, periods)
-    if len(rows) != periods + 1:
-        raise DrillSimError(f"over DDS: the recording holds {len(rows)} samples, expected "
+    if len(run.rows) != periods + 1:
+        raise DrillSimError(f"over DDS: the recording holds {len(run.rows)} samples, expected "
                             f"{periods + 1}")
-    return ClosedLoopRun(scenario, rows, float(summary["wall_s"]),
-                         int(summary["clamped_commands"]))
+    return run

@@ -179,6 +179,22 @@ class SimNode(Node):
         super().__init__(topics.NODE_NAME, **node_kwargs)
         self._steady = Clock(clock_type=ClockType.STEADY_TIME)
         self._preset, self._values = declare_all(self, load_preset)
+        self._init_run_state()
+        self._pubs = {t: self.create_publisher(messages.type_of(t), topics.node_relative(t),
+                                               self._qos(t), event_callbacks=QUIET_PUBLISHER)
+                      for t in (*SAMPLE_TOPICS, topics.CLOCK, topics.DIAGNOSTICS,
+                                topics.RUN_INFO, *string_topics(self._preset, self._values))}
+        self._sinks = SampleSinks(self._pubs)
+        self._string_sink: StringTorsionSink | None = None     # made by start()
+        self._add_command_topics()
+        self._typed_pubs = self._add_typed_topics()
+        self._add_services()
+        self._add_timers()
+        self.add_on_set_parameters_callback(self._validate_parameters)
+        self.add_post_set_parameters_callback(self._apply_parameters)
+
+    def _init_run_state(self) -> None:
+        """The run's plain state before :meth:`start`: no session, not paused, no counts."""
         self.finished = Future()
         self._lock = HandoffLock()
         self._status = StatusLine()
@@ -196,12 +212,9 @@ class SimNode(Node):
         self._diagnostics = Diagnostics(source_of(self.get_fully_qualified_name(),
                                                   self.get_namespace()))
         self._last_row: np.ndarray | None = None     # SI, TELEMETRY_FIELDS; lock held
-        self._pubs = {t: self.create_publisher(messages.type_of(t), topics.node_relative(t),
-                                               self._qos(t), event_callbacks=QUIET_PUBLISHER)
-                      for t in (*SAMPLE_TOPICS, topics.CLOCK, topics.DIAGNOSTICS,
-                                topics.RUN_INFO, *string_topics(self._preset, self._values))}
-        self._sinks = SampleSinks(self._pubs)
-        self._string_sink: StringTorsionSink | None = None     # made by start()
+
+    def _add_command_topics(self) -> None:
+        """The subscriptions of the three command topics, each counting its DDS losses."""
         self._command_names: dict[str, str] = {}      # command topic -> its resolved name
         self._command_subs = {}
         for topic, callback in ((topics.CMD_SURFACE_RPM, self._on_surface_rpm),
@@ -215,13 +228,19 @@ class SimNode(Node):
             self._command_subs[topic] = sub
         self._foreign_commands = ForeignCommandTypes(
             {name: topics.MSG_TYPES[topic] for topic, name in self._command_names.items()})
-        self._typed_pubs = self._add_typed_topics()
+
+    def _add_services(self) -> None:
+        """``~/reset``, ``~/pause`` and ``~/step``, and the lockstep handshake of ``~/step``."""
         self.create_service(Trigger, "~/reset", self._on_reset)
         self.create_service(SetBool, "~/pause", self._on_pause)
         step = self.create_service(Trigger, "~/step", self._on_step)
         self._handshake = Handshake(self.get_logger(), self._command_names[topics.CMD_TOP_DRIVE],
                                     self.resolve_service_name(step.srv_name),
                                     time.monotonic())
+
+    def _add_timers(self) -> None:
+        """The steady-clock timers (lockstep waits, diagnostics, the status line, the first
+        spin and ``run_seconds``, the last two armed by :meth:`start`) and the ticker."""
         self.create_timer(WAIT_CHECK_PERIOD_S, self._check_waiting, clock=self._steady)
         self._ticker = Ticker(self._tick, self._on_tick_error, name="drill_sim_ticker")
         self._first_spin = self.create_timer(0.0, self._start_ticker, clock=self._steady)
@@ -232,8 +251,6 @@ class SimNode(Node):
         self._stop_timer = self.create_timer(max(self._values["run_seconds"], 1e-3),
                                              self._on_run_limit, clock=self._steady)
         self._stop_timer.cancel()                      # start() arms it when run_seconds > 0
-        self.add_on_set_parameters_callback(self._validate_parameters)
-        self.add_post_set_parameters_callback(self._apply_parameters)
 
     def _add_typed_topics(self) -> dict[str, Any]:
         """The drill_sim_msgs twins of the telemetry, run info and command, when that package

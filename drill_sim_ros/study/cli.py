@@ -18,6 +18,14 @@ if TYPE_CHECKING:
 
 def add_parsers(sub: Any, add_model_args: Callable[[argparse.ArgumentParser], None]) -> None:
     """The three sub-commands on the ``drill_sim`` sub-parser ``sub``."""
+    _add_map_parser(sub, add_model_args)
+    _add_map_plot_parser(sub)
+    _add_figures_parser(sub)
+
+
+def _add_map_parser(sub: Any,
+                    add_model_args: Callable[[argparse.ArgumentParser], None]) -> None:
+    """``drill_sim map``: the model's options, the grid, the Dask cluster, the closed loop."""
     m = sub.add_parser("map", help="regime map over a grid of parameters (Dask), to NetCDF")
     add_model_args(m)
     m.add_argument("--vary", action="append", required=True, metavar="NAME=START:STOP:COUNT",
@@ -41,6 +49,10 @@ def add_parsers(sub: Any, add_model_args: Callable[[argparse.ArgumentParser], No
                         "(default speed)")
     c.add_argument("--enable-at", type=float, default=0.0, metavar="S",
                    help="switch-on time of the controller, s (default 0)")
+
+
+def _add_map_plot_parser(sub: Any) -> None:
+    """``drill_sim map-plot``: a map file drawn as a PNG."""
     p = sub.add_parser("map-plot", help="draw a map file (regime map or one variable)")
     p.add_argument("map", type=Path, help="NetCDF file written by drill_sim map")
     p.add_argument("-o", "--output", type=Path, default=None, help="PNG (default: MAP.png)")
@@ -49,6 +61,10 @@ def add_parsers(sub: Any, add_model_args: Callable[[argparse.ArgumentParser], No
     p.add_argument("--at", action="append", default=[], metavar="NAME=VALUE",
                    help="for maps of more than two axes: the value of an extra axis "
                         "(nearest point)")
+
+
+def _add_figures_parser(sub: Any) -> None:
+    """``drill_sim figures``: the paper's figures regenerated."""
     f = sub.add_parser("figures", help="regenerate the paper's figures (PNG gallery)")
     f.add_argument("-o", "--output", type=Path, default=Path("docs/gallery"),
                    help="directory of the PNGs (default docs/gallery)")
@@ -63,7 +79,7 @@ def add_parsers(sub: Any, add_model_args: Callable[[argparse.ArgumentParser], No
 def map_spec_from(args: argparse.Namespace,
                   resolve: Callable[[argparse.Namespace], Any]) -> MapSpec:
     """A :class:`MapSpec` from the ``map`` options; ``resolve`` is ``drill_sim run``'s."""
-    from drill_sim_ros.model.validate_input import load_checked_preset
+    from drill_sim_ros.model.presets import load_preset
     from drill_sim_ros.study.grid import Control, MapSpec, Numerics, parse_vary
     control = None
     if args.controller is not None:
@@ -74,7 +90,7 @@ def map_spec_from(args: argparse.Namespace,
     num = Numerics(tau_end=run.tau_end, average_from=run.average_from, dtau=run.dtau,
                    n_nodes=run.n_nodes, method=run.method, perturb_v=run.perturb_v,
                    perturb_omega=run.perturb_omega)
-    name = load_checked_preset(args.params).name if args.params else ""
+    name = load_preset(args.params).name if args.params else ""
     return MapSpec(run.params, tuple(parse_vary(v) for v in args.vary), num,
                    scales=run.scales if run.physical else None, preset=name,
                    control=control)

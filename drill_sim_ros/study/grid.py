@@ -16,9 +16,9 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
+from drill_sim_ros.model.checks import check_blade_counts
 from drill_sim_ros.model.errors import ParameterError
 from drill_sim_ros.model.params import DimensionlessParams, Scales
-from drill_sim_ros.model.validate_input import check_blade_counts
 
 GROUPS = ("n", "psi", "beta", "lam", "w0", "omega0")
 DIMENSIONLESS_AXES = (*GROUPS, "w0_ratio")

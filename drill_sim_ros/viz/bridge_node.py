@@ -347,21 +347,9 @@ def _interrupt(signum: int, frame: object) -> None:
     raise KeyboardInterrupt(f"signal {signum}")
 
 
-def main(argv: list[str] | None = None) -> int:
-    disable_analytics()
-    argv = sys.argv if argv is None else argv
-    args = parse_args(remove_ros_args(argv)[1:])
-    logger = rclpy.logging.get_logger(NODE_NAME)
-    try:
-        check_sinks(args)
-    except StartError as exc:
-        logger.fatal(str(exc))
-        return 2
-    # Own signal handling: the context stays up on SIGINT/SIGTERM/SIGHUP so the queue is
-    # drained and the .rrd finished.
-    rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
-    signal.signal(signal.SIGTERM, _interrupt)
-    signal.signal(signal.SIGHUP, _interrupt)
+def _spin_bridge(args: argparse.Namespace, logger: Any) -> tuple[Outputs | None, list[str]]:
+    """Open the outputs and spin the bridge until a signal or a shutdown; the outputs (None if
+    they did not open) and what could not be flushed to them."""
     outputs: Outputs | None = None
     node: RerunBridge | None = None
     try:
@@ -379,6 +367,11 @@ def main(argv: list[str] | None = None) -> int:
             node.destroy_node()
         rclpy.try_shutdown()
         problems = [] if outputs is None else outputs.close()
+    return outputs, problems
+
+
+def _exit_code(outputs: Outputs | None, problems: list[str], logger: Any) -> int:
+    """Log what was lost; 1 if anything was, else 0 (leaving at once past a stuck viewer)."""
     for problem in problems:
         logger.error(problem)
     code = 1 if problems else 0
@@ -389,6 +382,25 @@ def main(argv: list[str] | None = None) -> int:
         sys.stderr.flush()
         os._exit(code)
     return code
+
+
+def main(argv: list[str] | None = None) -> int:
+    disable_analytics()
+    argv = sys.argv if argv is None else argv
+    args = parse_args(remove_ros_args(argv)[1:])
+    logger = rclpy.logging.get_logger(NODE_NAME)
+    try:
+        check_sinks(args)
+    except StartError as exc:
+        logger.fatal(str(exc))
+        return 2
+    # Own signal handling: the context stays up on SIGINT/SIGTERM/SIGHUP so the queue is
+    # drained and the .rrd finished.
+    rclpy.init(args=argv, signal_handler_options=SignalHandlerOptions.NO)
+    signal.signal(signal.SIGTERM, _interrupt)
+    signal.signal(signal.SIGHUP, _interrupt)
+    outputs, problems = _spin_bridge(args, logger)
+    return _exit_code(outputs, problems, logger)
 
 
 if __name__ == "__main__":

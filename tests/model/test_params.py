@@ -3,8 +3,10 @@
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import pytest
+import yaml
 
 from drill_sim_ros.model.errors import ParameterError
 from drill_sim_ros.model.params import (
@@ -120,3 +122,38 @@ def test_field_preset_is_realistic() -> None:
 def test_missing_preset_lists_the_known_ones() -> None:
     with pytest.raises(ParameterError, match="fig5_8a"):
         load_preset("no_such_case")
+
+
+def test_a_preset_file_is_parsed_once(monkeypatch: pytest.MonkeyPatch) -> None:
+    """load_preset reads and checks the YAML once, then builds from that mapping."""
+    calls: list[str] = []
+    safe_load = yaml.safe_load
+
+    def counting(text: str) -> object:
+        calls.append(text)
+        return safe_load(text)
+
+    monkeypatch.setattr(yaml, "safe_load", counting)
+    load_preset("field_8p5in_shale")
+    assert len(calls) == 1
+
+
+@pytest.mark.parametrize(("name", "words"), [
+    (5, ("preset = 5", "preset name or a YAML path")),
+    ("", ("preset = ''",)),
+])
+def test_a_preset_that_is_not_a_name_is_one_line(name: object, words: tuple[str, ...]) -> None:
+    with pytest.raises(ParameterError) as caught:
+        load_preset(name)
+    assert "\n" not in str(caught.value)
+    for word in words:
+        assert word in str(caught.value)
+
+
+def test_a_preset_file_that_is_not_yaml_is_one_line_naming_it(tmp_path: Path) -> None:
+    path = tmp_path / "broken.yaml"
+    path.write_text("physical: [1,\n  2\n")
+    with pytest.raises(ParameterError) as caught:
+        load_preset(str(path))
+    message = str(caught.value)
+    assert "\n" not in message and f"preset file {path} is not valid YAML" in message

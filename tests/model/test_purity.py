@@ -10,7 +10,7 @@ def test_model_imports_no_adapters() -> None:
     code = ("import sys, drill_sim_ros.model.simulator, drill_sim_ros.model.analysis, "
             "drill_sim_ros.model.top_drive, drill_sim_ros.model.measurement, "
             "drill_sim_ros.model.presets, drill_sim_ros.cli, drill_sim_ros.control.bench, "
-            "drill_sim_ros.control.closed_loop_cli, drill_sim_ros.control.scorecard, "
+            "drill_sim_ros.closed_loop_cli, drill_sim_ros.control.scorecard, "
             "drill_sim_ros.study.engine, drill_sim_ros.study.figures, drill_sim_ros.study.cli\n"
             "bad = [m for m in sys.modules if m.split('.')[0] in "
             "('rclpy', 'mcap', 'mcap_ros2', 'rerun', 'rosbags')]\n"

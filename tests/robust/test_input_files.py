@@ -10,7 +10,7 @@ import yaml
 
 from drill_sim_ros.model.errors import ParameterError
 from drill_sim_ros.model.presets import available_presets, preset_path
-from drill_sim_ros.model.validate_input import check_preset_file
+from drill_sim_ros.model.validate_input import read_preset_file
 from drill_sim_ros.ros.parameters import check_params_files
 from tests.robust.helpers import ROOT, one_error_line, run_cli
 
@@ -79,7 +79,7 @@ def test_every_shipped_preset_passes_the_checks() -> None:
     names = available_presets()
     assert len(names) >= 10
     for name in names:
-        check_preset_file(preset_path(name))
+        read_preset_file(preset_path(name))
 
 
 @pytest.mark.parametrize(("text", "names"), [

@@ -17,8 +17,9 @@ from drill_sim_ros.archive.output import (
 )
 from drill_sim_ros.control.bench import ClosedLoopRun, run_in_process
 from drill_sim_ros.control.controllers import CONTROL_MODES
-from drill_sim_ros.control.rig import rig_physics
+from drill_sim_ros.control.rig import RigPhysics, rig_physics
 from drill_sim_ros.control.scenario import Scenario, load_scenario
+from drill_sim_ros.control.schedule import Schedule
 from drill_sim_ros.control.scorecard import SCORE_FIELDS, score, status_text
 from drill_sim_ros.model.errors import DrillSimError
 from drill_sim_ros.model.presets import Preset
@@ -151,26 +152,18 @@ def _interrupted(run: ClosedLoopRun) -> int:
     return 130
 
 
-def _closed_loop(args: argparse.Namespace, scenario: Scenario, preset: Preset,
-                 plot_tmp: Path | None) -> int:
-    rig = rig_physics(preset)
-    schedule = scenario.setpoints(preset)
-    controlled = _run(scenario, args.ros, scenario.controller)
-    if controlled.interrupted:
-        return _interrupted(controlled)
-    columns = {}
-    baseline = None
-    if not args.no_baseline and scenario.controller != "none":
-        baseline = _run(scenario.with_(controller="none", mode="speed", params={}), False,
-                        "no control")
-        if baseline.interrupted:
-            return _interrupted(baseline)
-        columns["no control"] = score(baseline.rows, scenario.enable_at_s, schedule, rig,
-                                      scenario.period_s)
-    label = f"{scenario.controller.split(':')[-1]} ({scenario.mode})"
-    columns[label] = score(controlled.rows, scenario.enable_at_s, schedule, rig,
-                           scenario.period_s)
-    rate = scenario.periods / controlled.wall_s if controlled.wall_s > 0 else math.nan
+def _baseline(args: argparse.Namespace, scenario: Scenario) -> ClosedLoopRun | None:
+    """The uncontrolled run beside the controller's (in process), unless there is none."""
+    if args.no_baseline or scenario.controller == "none":
+        return None
+    return _run(scenario.with_(controller="none", mode="speed", params={}), False,
+                "no control")
+
+
+def _print_scores(args: argparse.Namespace, scenario: Scenario,
+                  columns: dict[str, dict[str, Any]], label: str, wall_s: float) -> None:
+    """The scorecards as one JSON object (``--json``) or as a table and the run's speed."""
+    rate = scenario.periods / wall_s if wall_s > 0 else math.nan
     if args.json:
         print(json.dumps({"scenario": scenario.to_dict(), "path": "ros" if args.ros else
                           "in-process", "periods": scenario.periods,
@@ -181,17 +174,40 @@ def _closed_loop(args: argparse.Namespace, scenario: Scenario, preset: Preset,
         print(f"{scenario.periods:,} periods of {scenario.period_s * 1e3:g} ms "
               f"{'over DDS' if args.ros else 'in process'}: {rate:,.0f} periods/s "
               f"({rate * scenario.period_s:,.0f}x real time)")
+
+
+def _write_plot(args: argparse.Namespace, plot_tmp: Path, title: str, scenario: Scenario,
+                runs: dict[str, ClosedLoopRun], columns: dict[str, dict[str, Any]],
+                schedule: Schedule, rig: RigPhysics) -> None:
+    """The runs' picture into ``plot_tmp``, then committed to ``--plot``."""
+    from drill_sim_ros.control.plot import PlotContext, PlotRun, plot_runs, schedule_events
+    plots = [PlotRun(name, run.rows, name == "no control" or scenario.mode == "speed",
+                     status_text(columns[name])) for name, run in runs.items()]
+    plot_runs(plot_tmp, plots, PlotContext(title, schedule, scenario.enable_at_s, rig,
+                                           schedule_events(schedule)))
+    try:
+        commit(plot_tmp, args.plot, args.overwrite)
+    except OutputError as exc:
+        raise DrillSimError(f"--plot: {exc}") from None
+
+
+def _closed_loop(args: argparse.Namespace, scenario: Scenario, preset: Preset,
+                 plot_tmp: Path | None) -> int:
+    rig = rig_physics(preset)
+    schedule = scenario.setpoints(preset)
+    controlled = _run(scenario, args.ros, scenario.controller)
+    if controlled.interrupted:
+        return _interrupted(controlled)
+    baseline = _baseline(args, scenario)
+    if baseline is not None and baseline.interrupted:
+        return _interrupted(baseline)
+    label = f"{scenario.controller.split(':')[-1]} ({scenario.mode})"
+    runs = {"no control": baseline} if baseline is not None else {}
+    runs[label] = controlled
+    columns = {name: score(run.rows, scenario.enable_at_s, schedule, rig, scenario.period_s)
+               for name, run in runs.items()}
+    _print_scores(args, scenario, columns, label, controlled.wall_s)
     if plot_tmp is not None:
-        from drill_sim_ros.control.plot import PlotContext, PlotRun, plot_runs, schedule_events
-        runs = [PlotRun(name, rows, speed_mode, status_text(columns[name]))
-                for name, rows, speed_mode in (
-                    ("no control", None if baseline is None else baseline.rows, True),
-                    (label, controlled.rows, scenario.mode == "speed")) if rows is not None]
-        plot_runs(plot_tmp, runs, PlotContext(
-            f"{preset.name}: {label}, switched on at {scenario.enable_at_s:g} s", schedule,
-            scenario.enable_at_s, rig, schedule_events(schedule)))
-        try:
-            commit(plot_tmp, args.plot, args.overwrite)
-        except OutputError as exc:
-            raise DrillSimError(f"--plot: {exc}") from None
+        _write_plot(args, plot_tmp, f"{preset.name}: {label}, switched on at "
+                    f"{scenario.enable_at_s:g} s", scenario, runs, columns, schedule, rig)
     return 0

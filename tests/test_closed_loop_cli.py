@@ -11,13 +11,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from drill_sim_ros.closed_loop_cli import LABELS
 from drill_sim_ros.control.bench import run_in_process
-from drill_sim_ros.control.closed_loop_cli import LABELS
 from drill_sim_ros.control.scenario import Scenario
 from drill_sim_ros.control.scorecard import SCORE_FIELDS
 from drill_sim_ros.model.telemetry import TELEMETRY_INDEX
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[1]
 F = TELEMETRY_INDEX
 
 
