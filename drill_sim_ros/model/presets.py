@@ -262,7 +262,7 @@ def load_preset(name_or_path: Any = DEFAULT_PRESET) -> Preset:
     try:
         return preset_from_dict(path.stem, data)
     except ParameterError as exc:
-        raise ParameterError(f"{path}: {exc}") from exc
+        raise ParameterError(f"preset file {path}: {exc}") from None
 
 
 def submerged_string_weight_n(preset: Preset | None,
