@@ -154,11 +154,23 @@ def preset_from_dict(name: str, data: dict[str, Any]) -> Preset:
         params, scales = dimensionless_from_dict(data["dimensionless"]), UNIT_SCALES
     n_nodes = numerics.get("n_nodes")
     drive = top_drive_from_dict(data.get("top_drive"), scales, has_phys)
+    if has_phys and data.get("top_drive") is not None:
+        drive = rounded_as_before(drive, scales)
     return Preset(name=name, description=str(data.get("description", "")).strip(),
                   params=params, scales=scales, physical=physical,
                   dtau=float(numerics.get("dtau", 1e-4)),
                   n_nodes=None if n_nodes is None else int(n_nodes), drive=drive,
                   string=string)
+
+
+def rounded_as_before(drive: TopDrivePhysical, scales: Scales) -> TopDrivePhysical:
+    """A physical preset's drive rounded as sim_node and the bench ran it before issue 34,
+    when the preset held it in kernel units and they read it back in SI: through
+    :meth:`TopDrivePhysical.scaled` and :meth:`TopDrive.physical` once (on the field preset
+    kp_nm_s 23200 becomes 23199.999999999996, max_torque_nm 50000.00000000001; the kernel's
+    kp moves by one ulp). It keeps their telemetry bit-identical; without it every road runs
+    the file's own values, which changes the bits of the field preset's speed-loop runs."""
+    return drive.scaled(scales).physical(scales)
 
 
 SECTION_KEYS = ("outer_radius_m", "inner_radius_m", "length_m", "density_kg_m3",
