@@ -153,8 +153,9 @@ def preset_from_dict(name: str, data: dict[str, Any]) -> Preset:
                                  "dimensionless one is RGD07's lumped string)")
         params, scales = dimensionless_from_dict(data["dimensionless"]), UNIT_SCALES
     n_nodes = numerics.get("n_nodes")
-    drive = top_drive_from_dict(data.get("top_drive"), scales, has_phys)
-    if has_phys and data.get("top_drive") is not None:
+    section = data.get("top_drive")
+    drive = top_drive_from_dict(section, scales, has_phys)
+    if has_phys and section is not None:
         drive = rounded_as_before(drive, scales)
     return Preset(name=name, description=str(data.get("description", "")).strip(),
                   params=params, scales=scales, physical=physical,

@@ -249,13 +249,19 @@ def _from_dict(cls: type, values: dict[str, Any]) -> Any:
     return cls(**{key: (str(v) if key == "mode" else float(v)) for key, v in values.items()})
 
 
+def paper_drive(scales: Scales) -> TopDrivePhysical:
+    """The paper's kinematic drive (the :class:`TopDrive` defaults) in the SI of ``scales``:
+    a preset's drive when it gives none."""
+    return TopDrive().physical(scales)
+
+
 def top_drive_from_dict(values: dict[str, Any] | None, scales: Scales,
                         physical: bool) -> TopDrivePhysical:
     """A preset's ``top_drive`` mapping in SI: SI keys (:class:`TopDrivePhysical`) in a
     physical preset; scaled keys (:class:`TopDrive`) in a dimensionless one, turned into SI
     once with its ``scales``; None (no ``top_drive``): the paper's kinematic drive."""
     if values is None:
-        return TopDrive().physical(scales)
+        return paper_drive(scales)
     if physical:
         return _from_dict(TopDrivePhysical, values)
     return _from_dict(TopDrive, values).physical(scales)

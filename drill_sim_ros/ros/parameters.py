@@ -29,7 +29,7 @@ from drill_sim_ros.model.errors import ParameterError
 from drill_sim_ros.model.measurement import MAX_DELAY_PERIODS, SIGNALS
 from drill_sim_ros.model.params import UNIT_SCALES
 from drill_sim_ros.model.presets import DEFAULT_PRESET, Preset, submerged_string_weight_n
-from drill_sim_ros.model.top_drive import MODES, TopDrive, TopDrivePhysical
+from drill_sim_ros.model.top_drive import MODES, TopDrivePhysical, paper_drive
 from drill_sim_ros.ros.params_file_check import check_params_content
 from drill_sim_ros.topics import NODE_NAME
 
@@ -90,7 +90,7 @@ def torque_limit_nm(parameter: float) -> float:
 def _drive_value(name: str) -> Callable[[Preset | None], Any]:
     """The ``top_drive.<name>`` default: the preset's drive's ``name`` (SI, as it is)."""
     def default(preset: Preset | None) -> Any:
-        drive = TopDrive().physical(UNIT_SCALES) if preset is None else preset.drive
+        drive = paper_drive(UNIT_SCALES) if preset is None else preset.drive
         value = getattr(drive, name)
         return torque_limit_parameter(value) if name == "max_torque_nm" else value
     return default
@@ -99,9 +99,9 @@ def _drive_value(name: str) -> Callable[[Preset | None], Any]:
 def top_drive_of(values: dict[str, Any]) -> TopDrivePhysical:
     """The drive of the ``top_drive.<field>`` parameters in ``values``: one parameter per
     field of :class:`TopDrivePhysical`, the torque limit through :func:`torque_limit_nm`."""
-    return TopDrivePhysical(**{
-        f.name: torque_limit_nm(values[f"top_drive.{f.name}"]) if f.name == "max_torque_nm"
-        else values[f"top_drive.{f.name}"] for f in fields(TopDrivePhysical)})
+    drive = {f.name: values[f"top_drive.{f.name}"] for f in fields(TopDrivePhysical)}
+    drive["max_torque_nm"] = torque_limit_nm(drive["max_torque_nm"])
+    return TopDrivePhysical(**drive)
 
 
 def _sensor_specs() -> tuple[ParamSpec, ...]:
