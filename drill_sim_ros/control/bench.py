@@ -10,9 +10,9 @@ lockstep_trigger:=command``), so both give the same telemetry bit for bit:
 2. the controller's first command answers the t = 0 sample (stamp 0), which sim_node
    publishes, latched, before it waits for its first command;
 3. each command is applied with sim_node's limits (``control.command.apply_command``: speed and WOB
-   within [0, limit], motor torque within +-the drive's limit) and stamped with the sample it
-   reacts to; then exactly one period runs under it (zero-order hold), and the sample at the
-   END of that period is what the controller reacts to next.
+   within [0, limit]; the drive applies a motor torque within its own limit) and stamped with
+   the sample it reacts to; then exactly one period runs under it (zero-order hold), and the
+   sample at the END of that period is what the controller reacts to next.
 """
 
 from __future__ import annotations
@@ -20,7 +20,7 @@ from __future__ import annotations
 import json
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -45,9 +45,9 @@ from drill_sim_ros.model.top_drive import TopDrivePhysical
 
 
 def command_limits(preset: Preset, rig: RigPhysics) -> CommandLimits:
-    """sim_node's command limits at their defaults (limits.*, top_drive.max_torque_nm)."""
+    """sim_node's command limits at their defaults (limits.*)."""
     wob_n = preset.scales.wob_n(preset.params.w0)
-    return CommandLimits(rig.max_surface_rpm, defaults.max_wob_n(wob_n), rig.max_torque_nm)
+    return CommandLimits(rig.max_surface_rpm, defaults.max_wob_n(wob_n))
 
 
 @dataclass
@@ -65,12 +65,12 @@ class ClosedLoopRun:
     interrupted: bool = False     # Ctrl-C: ``rows`` holds the periods done
 
 
-def drive_of(preset: Preset, mode: str, motor_lag_s: float | None = None) -> TopDrivePhysical:
-    """The preset's drive in SI, in ``mode`` (and with ``motor_lag_s`` when given)."""
-    d = preset.top_drive.physical(preset.scales)
-    return TopDrivePhysical(mode=mode, inertia_kg_m2=d.inertia_kg_m2, kp_nm_s=d.kp_nm_s,
-                            ki_nm=d.ki_nm, max_torque_nm=d.max_torque_nm,
-                            motor_lag_s=d.motor_lag_s if motor_lag_s is None else motor_lag_s)
+def scenario_drive(scenario: Scenario, preset: Preset) -> TopDrivePhysical:
+    """The drive sim_node runs for ``scenario`` (SI): the preset's, with the scenario's torque
+    limit (:meth:`Scenario.load_preset`), in its mode and with its ``drive.motor_lag_s``."""
+    lag = {"motor_lag_s": float(scenario.drive["motor_lag_s"])} \
+        if "motor_lag_s" in scenario.drive else {}
+    return replace(preset.drive, mode=scenario.mode, **lag)
 
 
 def session_config(scenario: Scenario, preset: Preset) -> SessionConfig:
@@ -81,7 +81,7 @@ def session_config(scenario: Scenario, preset: Preset) -> SessionConfig:
         n_nodes=defaults.n_nodes(preset), perturb_v=defaults.PERTURB_V,
         applied_wob_n=schedule.wob_at(0.0), surface_rpm=schedule.rpm_at(0.0),
         window_s=defaults.WINDOW_S, submerged_weight_n=submerged_string_weight_n(preset),
-        top_drive=drive_of(preset, scenario.mode, scenario.drive.get("motor_lag_s")),
+        top_drive=scenario_drive(scenario, preset),
         sensors=scenario.rig_sensors(), formation=tuple(scenario.formation),
         top_drive_accel_rpm_s=float(scenario.drive.get("accel_rpm_s", 0.0)),
         wob_rate_n_s=float(scenario.drive.get("wob_rate_n_s", 0.0)),
@@ -99,7 +99,7 @@ def sim_node_parameters(scenario: Scenario, preset: Preset) -> dict[str, object]
     for signal in SIGNALS:
         for key, value in (scenario.sensors.get(signal) or {}).items():
             out[f"sensors.{signal}.{key}"] = value
-    for key, name in DRIVE_PARAMETERS.items():
+    for key, name in SCENARIO_DRIVE_PARAMETERS.items():
         if key in scenario.drive:
             out[name] = float(scenario.drive[key])
     if scenario.formation:
@@ -107,12 +107,12 @@ def sim_node_parameters(scenario: Scenario, preset: Preset) -> dict[str, object]
     return out
 
 
-# scenario drive keys -> sim_node parameters
-DRIVE_PARAMETERS = {"accel_rpm_s": "limits.top_drive_accel_rpm_s",
-                    "wob_rate_n_s": "limits.wob_rate_n_s",
-                    "max_torque_nm": "top_drive.max_torque_nm",
-                    "command_delay_s": "commands.delay_s",
-                    "motor_lag_s": "top_drive.motor_lag_s"}
+# a scenario's drive keys (the drive and the command path) -> sim_node's parameters
+SCENARIO_DRIVE_PARAMETERS = {"accel_rpm_s": "limits.top_drive_accel_rpm_s",
+                             "wob_rate_n_s": "limits.wob_rate_n_s",
+                             "max_torque_nm": "top_drive.max_torque_nm",
+                             "command_delay_s": "commands.delay_s",
+                             "motor_lag_s": "top_drive.motor_lag_s"}
 
 
 def build_controller(scenario: Scenario, preset: Preset) -> IsolatedController:

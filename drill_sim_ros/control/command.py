@@ -56,12 +56,11 @@ def measurement_of_row(row: np.ndarray, time_ns: int) -> SurfaceMeasurement:
 
 @dataclass(frozen=True)
 class CommandLimits:
-    """The bounds a command is clamped to (sim_node's ``limits.*`` and
-    ``top_drive.max_torque_nm``; inf: none)."""
+    """The bounds a setpoint command is clamped to (sim_node's ``limits.*``). A motor
+    torque has the drive's own limit, applied by the drive (``top_drive.within_limit``)."""
 
     max_surface_rpm: float
     max_wob_n: float
-    max_torque_nm: float = math.inf
 
 
 def clamp_command(value: float, limit: float, unit: str, low: float = 0.0
@@ -88,10 +87,12 @@ def rpm_of_rad_s(speed_rad_s: float) -> float:
 
 def apply_command(session: SimSession, command: Command, limits: CommandLimits
                   ) -> list[tuple[bool, str]]:
-    """Set what ``command`` commands on ``session`` (from its next period), each value
-    clamped to ``limits``; a non-finite value is not applied (the last setpoint stays).
-    Returns ``(applied, why)`` for each value that was clamped (applied) or rejected. The one
-    implementation behind sim_node's commands and the in-process bench."""
+    """Set what ``command`` commands on ``session`` (from its next period): the speed and
+    WOB setpoints clamped to ``limits``, the motor torque as it is (the drive applies it
+    within its limit, ``session.drive.max_torque_nm``); a non-finite value is not applied
+    (the last setpoint stays). Returns ``(applied, why)`` for each value that was clamped or
+    lies beyond the drive's limit (applied) or was rejected. The one implementation behind
+    sim_node's commands and the in-process bench."""
     problems: list[tuple[bool, str]] = []
 
     def bounded(value: float, high: float, unit: str, low: float = 0.0) -> float | None:
@@ -105,10 +106,9 @@ def apply_command(session: SimSession, command: Command, limits: CommandLimits
         if rpm is not None:
             session.set_surface_rpm(rpm)
     if command.motor_torque_nm is not None:
-        torque = bounded(command.motor_torque_nm, limits.max_torque_nm, "N m",
-                         -limits.max_torque_nm)
-        if torque is not None:
-            session.set_motor_torque_nm(torque)
+        limit_nm = session.drive.max_torque_nm
+        if bounded(command.motor_torque_nm, limit_nm, "N m", -limit_nm) is not None:
+            session.set_motor_torque_nm(command.motor_torque_nm)
     if command.wob_n is not None:
         wob = bounded(command.wob_n, limits.max_wob_n, "N")
         if wob is not None:

@@ -68,7 +68,7 @@ def rig_physics(preset: Preset) -> RigPhysics:
         pipe_polar_m4 = 0.5 * math.pi * (phys.pipe_outer_radius_m**4
                                          - phys.pipe_inner_radius_m**4)
         impedance = pipe_polar_m4 * math.sqrt(phys.shear_modulus_pa * phys.density_kg_m3)
-    drive = preset.top_drive.physical(preset.scales)
+    drive = preset.drive
     modes_hz = tuple(analytic_modes_hz(sections_of(preset.string, phys), MODE_COUNT))
     return RigPhysics(
         stiffness_nm_rad=s.stiffness_nm_per_rad, bit_inertia_kg_m2=s.inertia_kg_m2,

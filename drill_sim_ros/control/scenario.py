@@ -141,10 +141,17 @@ class Scenario:
         return 1.0 / self.control_rate_hz
 
     def load_preset(self) -> Preset:
-        """The preset with the scenario's ``overrides`` and ``drive.max_torque_nm``."""
+        """The preset with the scenario's ``overrides``, its drive with the scenario's
+        ``drive.max_torque_nm`` (what sim_node's ``top_drive.max_torque_nm`` gets)."""
+        preset = self._overridden_preset()
+        if "max_torque_nm" not in self.drive:
+            return preset
+        limit_nm = float(self.drive["max_torque_nm"])
+        return replace(preset, drive=replace(preset.drive, max_torque_nm=limit_nm))
+
+    def _overridden_preset(self) -> Preset:
+        """The preset with the scenario's ``overrides`` of its sections."""
         overrides = {section: dict(values) for section, values in self.overrides.items()}
-        if "max_torque_nm" in self.drive:
-            overrides.setdefault("top_drive", {})["max_torque_nm"] = self.drive["max_torque_nm"]
         if not overrides:
             return load_preset(self.preset)
         path = preset_path(self.preset)

@@ -4,7 +4,8 @@ A preset file holds ``description``, either ``dimensionless`` (RGD07 groups; the
 then in units of t* and L*) or ``physical`` (SI; see :class:`PhysicalParams`), optional
 ``numerics`` (``dtau``, ``n_nodes``), an optional ``top_drive`` (SI keys of
 :class:`TopDrivePhysical` in a physical preset, scaled keys of :class:`TopDrive` in a
-dimensionless one; absent: the paper's kinematic drive) and, in a physical preset, an
+dimensionless one; absent: the paper's kinematic drive; either way :attr:`Preset.drive` holds
+it in SI) and, in a physical preset, an
 optional ``string`` (:func:`string_from_dict`: ``lumped``, RGD07's spring, by default, or
 ``distributed`` sections; without ``sections`` the ``pipe_*`` / ``bha_*`` keys are the
 two-section shorthand).
@@ -39,7 +40,7 @@ from drill_sim_ros.model.string import (
     StringSpec,
     kernel_string,
 )
-from drill_sim_ros.model.top_drive import TopDrive, top_drive_from_dict
+from drill_sim_ros.model.top_drive import TopDrive, TopDrivePhysical, top_drive_from_dict
 from drill_sim_ros.model.validate_input import check_preset_mapping, read_preset_file
 
 DEFAULT_PRESET = "field_8p5in_shale"
@@ -50,7 +51,8 @@ PACKAGE = "drill_sim_ros"
 
 @dataclass(frozen=True)
 class Preset:
-    """A resolved preset: the groups, the scales to SI, and the numerical step."""
+    """A resolved preset: the groups, the scales to SI, the numerical step, the drive and
+    the string (both in SI)."""
 
     name: str
     description: str
@@ -59,7 +61,7 @@ class Preset:
     physical: PhysicalParams | None
     dtau: float
     n_nodes: int | None
-    top_drive: TopDrive = field(default_factory=TopDrive)
+    drive: TopDrivePhysical          # SI (a dimensionless preset: in its unit scales)
     string: StringSpec = field(default_factory=StringSpec)
 
     @property
@@ -77,6 +79,12 @@ class Preset:
                     mu_gamma=phys.mu_gamma,
                     sigma_l_n_per_m=phys.contact_stress_times_wearflat_n_per_m,
                     length_m=self.scales.length_m)
+
+    @property
+    def top_drive(self) -> TopDrive:
+        """The drive in kernel units (what a simulator built directly takes), :attr:`drive`
+        converted by :meth:`TopDrivePhysical.scaled`."""
+        return self.drive.scaled(self.scales)
 
     @property
     def kernel_string(self) -> KernelString:
@@ -144,13 +152,25 @@ def preset_from_dict(name: str, data: dict[str, Any]) -> Preset:
                                  "dimensionless one is RGD07's lumped string)")
         params, scales = dimensionless_from_dict(data["dimensionless"]), UNIT_SCALES
     n_nodes = numerics.get("n_nodes")
-    drive = data.get("top_drive")
-    top_drive = TopDrive() if drive is None else top_drive_from_dict(drive, scales, has_phys)
+    section = data.get("top_drive")
+    drive = top_drive_from_dict(section, scales, has_phys)
+    if has_phys and section is not None:
+        drive = rounded_as_before(drive, scales)
     return Preset(name=name, description=str(data.get("description", "")).strip(),
                   params=params, scales=scales, physical=physical,
                   dtau=float(numerics.get("dtau", 1e-4)),
-                  n_nodes=None if n_nodes is None else int(n_nodes), top_drive=top_drive,
+                  n_nodes=None if n_nodes is None else int(n_nodes), drive=drive,
                   string=string)
+
+
+def rounded_as_before(drive: TopDrivePhysical, scales: Scales) -> TopDrivePhysical:
+    """A physical preset's drive rounded as sim_node and the bench ran it before issue 34,
+    when the preset held it in kernel units and they read it back in SI: through
+    :meth:`TopDrivePhysical.scaled` and :meth:`TopDrive.physical` once (on the field preset
+    kp_nm_s 23200 becomes 23199.999999999996, max_torque_nm 50000.00000000001; the kernel's
+    kp moves by one ulp). It keeps their telemetry bit-identical; without it every road runs
+    the file's own values, which changes the bits of the field preset's speed-loop runs."""
+    return drive.scaled(scales).physical(scales)
 
 
 SECTION_FIELDS = {f.name: f for f in fields(Section)}

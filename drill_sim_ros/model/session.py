@@ -54,7 +54,7 @@ class SessionConfig:
     wob_rate_n_s: float = 0.0            # 0: no limit
     window_s: float = defaults.WINDOW_S
     submerged_weight_n: float = 0.0      # for the hook load
-    top_drive: TopDrivePhysical | None = None   # None: the preset's drive
+    top_drive: TopDrivePhysical | None = None   # SI; None: the preset's (Preset.drive)
     sensors: RigSensors | None = None           # None: perfect surface sensors
     command_delay_s: float = 0.0         # transport delay of the set_* inputs (0: none)
     formation: tuple[dict, ...] = ()     # rock layers by depth (model.formation, SI keys)
@@ -90,7 +90,8 @@ def steps_per_period(period_tau: float, dtau_max: float) -> int:
 
 
 def build_simulator(cfg: SessionConfig, period_tau: float, steps: int) -> Simulator:
-    """The simulator of ``cfg`` with initial setpoints and ramp limits in model units."""
+    """The simulator of ``cfg`` with initial setpoints, ramp limits and the drive in model
+    units."""
     sc = cfg.preset.scales
     params = cfg.preset.params
     if cfg.applied_wob_n is not None:
@@ -102,9 +103,14 @@ def build_simulator(cfg: SessionConfig, period_tau: float, steps: int) -> Simula
     w_rate = sc.w_from_newton(cfg.wob_rate_n_s) * sc.time_s if cfg.wob_rate_n_s > 0 else math.inf
     config = SimConfig(dtau=period_tau / steps, n_nodes=cfg.n_nodes, omega_rate=omega_rate,
                        w_rate=w_rate)
-    drive = cfg.preset.top_drive if cfg.top_drive is None else cfg.top_drive.scaled(sc)
-    return Simulator(params, config, perturb_v=cfg.perturb_v, top_drive=drive, scales=sc,
+    return Simulator(params, config, perturb_v=cfg.perturb_v,
+                     top_drive=session_drive(cfg).scaled(sc), scales=sc,
                      string=cfg.preset.kernel_string)
+
+
+def session_drive(cfg: SessionConfig) -> TopDrivePhysical:
+    """The drive ``cfg`` starts with, SI: its own, else the preset's."""
+    return cfg.preset.drive if cfg.top_drive is None else cfg.top_drive
 
 
 class SimSession:
@@ -117,6 +123,7 @@ class SimSession:
         period_tau = self.period_ns / NS_PER_S / self.scales.time_s
         self.steps = steps_per_period(period_tau, cfg.dtau_max)
         self.sim = build_simulator(cfg, period_tau, self.steps)
+        self.drive = session_drive(cfg)       # the drive in force, SI
         if cfg.formation:
             self.set_formation(list(cfg.formation))
         self.submerged_weight_n = cfg.submerged_weight_n
@@ -316,8 +323,8 @@ class SimSession:
         self._input(self._set_wob, wob_n)
 
     def set_motor_torque_nm(self, torque_nm: float) -> None:
-        """The motor torque command of the torque mode (within the drive's limit), from now
-        plus the command delay."""
+        """The motor torque command of the torque mode, from now plus the command delay; the
+        drive applies it within its limit (``top_drive.within_limit``)."""
         self._input(self.sim.set_motor_torque_nm, torque_nm)
 
     def _set_rpm(self, rpm: float) -> None:
@@ -336,6 +343,7 @@ class SimSession:
         """New drive gains, limit and mode (SI) from the next period, without a bump; the
         inertia is fixed for a session."""
         self.sim.set_top_drive(drive.scaled(self.scales))
+        self.drive = drive
 
     def check_formation(self, layers: list[dict]) -> None:
         """ParameterError (one line naming the layer and key) if ``layers`` are not valid."""

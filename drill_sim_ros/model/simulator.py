@@ -148,15 +148,10 @@ class Simulator:
         self._prm[k.P_OMEGA_RATE] = c.omega_rate
         self._prm[k.P_W_RATE] = c.w_rate
         self._prm[k.P_TAU_AVG] = c.tau_avg
-        d = self.top_drive
-        self._prm[k.P_TD_MODE] = td.mode_index(d.mode)
-        if d.mode == "speed":
-            td.check_speed_loop(d, c.dtau, self.scales)
-        self._prm[k.P_TD_INERTIA] = d.inertia_ratio
-        self._prm[k.P_TD_KP] = d.kp
-        self._prm[k.P_TD_KI] = d.ki
-        self._prm[k.P_TD_MAX_TORQUE] = d.max_torque
-        self._prm[k.P_TD_LAG_ALPHA] = d.lag_alpha(c.dtau)
+        self._prm[k.P_TD_MODE] = td.mode_index(self.top_drive.mode)
+        if self.top_drive.mode == "speed":
+            td.check_speed_loop(self.top_drive, c.dtau, self.scales)
+        self._fill_drive(self.top_drive)
         self._prm[k.P_CUT] = 1.0
         self._prm[k.P_LAYER_U] = math.inf
         s = self.string
@@ -166,6 +161,16 @@ class Simulator:
         self._prm[k.P_HOOK_KP] = s.hook_kp
         self._prm[k.P_HOOK_KI] = s.hook_ki
         self._prm[k.P_BHA_PART] = s.bha_part
+
+    def _fill_drive(self, drive: td.TopDrive) -> None:
+        """The drive's inertia ratio, gains, torque limit and lag into the parameters (its
+        mode: the callers)."""
+        self.top_drive = drive
+        self._prm[k.P_TD_INERTIA] = drive.inertia_ratio
+        self._prm[k.P_TD_KP] = drive.kp
+        self._prm[k.P_TD_KI] = drive.ki
+        self._prm[k.P_TD_MAX_TORQUE] = drive.max_torque
+        self._prm[k.P_TD_LAG_ALPHA] = drive.lag_alpha(self.config.dtau)
 
     def _wave_layout(self) -> None:
         """The delay lines of a distributed string at this step (none for the lumped one);
@@ -318,8 +323,8 @@ class Simulator:
             td.check_speed_loop(self.top_drive, self.config.dtau, self.scales)
         if index == int(self._prm[k.P_TD_MODE]):
             return                             # no switch: the loop and the command stay
-        st, limit = self._state, self._prm[k.P_TD_MAX_TORQUE]
-        held = min(max(float(st[k.S_MOTOR_TORQUE]), -limit), limit)
+        st = self._state
+        held = td.within_limit(float(st[k.S_MOTOR_TORQUE]), self._prm[k.P_TD_MAX_TORQUE])
         if index == td.TD_SPEED:
             st[k.S_OMEGA_REF] = st[k.S_OMEGA_S]
             st[k.S_TD_INTEGRAL] = held
@@ -330,12 +335,7 @@ class Simulator:
     def set_top_drive(self, drive: td.TopDrive) -> None:
         """New drive parameters (gains, limit, inertia) from the next run, and its mode
         through :meth:`set_top_drive_mode`; call it between runs, like that."""
-        self.top_drive = drive
-        self._prm[k.P_TD_INERTIA] = drive.inertia_ratio
-        self._prm[k.P_TD_KP] = drive.kp
-        self._prm[k.P_TD_KI] = drive.ki
-        self._prm[k.P_TD_MAX_TORQUE] = drive.max_torque
-        self._prm[k.P_TD_LAG_ALPHA] = drive.lag_alpha(self.config.dtau)
+        self._fill_drive(drive)
         self.set_top_drive_mode(drive.mode)
 
     def set_speed_setpoint_rad_s(self, speed_rad_s: float) -> None:
@@ -345,7 +345,8 @@ class Simulator:
 
     def set_motor_torque_nm(self, torque_nm: float) -> bool:
         """Motor torque command in N m (torque mode), from the next step. The drive applies
-        it within +-max torque; returns True when the command lies beyond that limit."""
+        it within +-max torque (``top_drive.within_limit``, in its step); returns True when
+        the command lies beyond that limit."""
         torque_nm = float(torque_nm)
         if not math.isfinite(torque_nm):
             raise ParameterError(f"input 'motor_torque_nm' = {torque_nm!r} must be finite")

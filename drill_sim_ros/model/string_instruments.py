@@ -385,7 +385,7 @@ def measure_reflection(preset: Preset, seconds: float = 120.0,
 
     sample_hz = 1.0 / (32 * line.dtau * line.scales.time_s)
     ratio = reflection_of(run, sample_hz, f_hz)
-    phys = drive.physical(preset.scales)
+    phys = preset.drive
     z_si = preset.string.sections[0].torsional_impedance_nm_s
     analytic = analytic_reflection(z_si, phys.inertia_kg_m2, phys.kp_nm_s, phys.ki_nm, f_hz)
     return Reflection([float(f) for f in f_hz], [float(r) for r in ratio],

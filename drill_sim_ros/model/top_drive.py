@@ -63,6 +63,14 @@ def kinematic_torque(omega_s: float, omega_next: float, t_string: float, inertia
 
 
 @njit(cache=True, inline="always")
+def within_limit(torque: float, max_torque: float) -> float:
+    """``torque`` within the drive's limit, ``|m| <= max_torque`` (inf: no limit): the one
+    clip of the motor torque (the speed loop's output and integral, the torque mode's
+    command, the bumpless switch's held torque)."""
+    return min(max(torque, -max_torque), max_torque)
+
+
+@njit(cache=True, inline="always")
 def speed_loop(omega_ref: float, omega_s: float, integral: float, kp: float, ki: float,
                max_torque: float, dt: float) -> tuple[float, float]:
     """PI speed loop with a torque limit: ``(motor torque, new integral)``.
@@ -71,23 +79,11 @@ def speed_loop(omega_ref: float, omega_s: float, integral: float, kp: float, ki:
     error pushes (conditional integration), and never exceeds the limit itself.
     """
     err = omega_ref - omega_s
-    integral_new = min(max(integral + ki * err * dt, -max_torque), max_torque)
-    motor = kp * err + integral_new
-    if motor > max_torque:
-        motor = max_torque
-        if err > 0.0:
-            integral_new = integral
-    elif motor < -max_torque:
-        motor = -max_torque
-        if err < 0.0:
-            integral_new = integral
-    return motor, integral_new
-
-
-@njit(cache=True, inline="always")
-def torque_command(command: float, max_torque: float) -> float:
-    """The commanded motor torque within the drive's limit."""
-    return min(max(command, -max_torque), max_torque)
+    integral_new = within_limit(integral + ki * err * dt, max_torque)
+    unlimited = kp * err + integral_new
+    if (unlimited > max_torque and err > 0.0) or (unlimited < -max_torque and err < 0.0):
+        integral_new = integral
+    return within_limit(unlimited, max_torque), integral_new
 
 
 @njit(cache=True, inline="always")
@@ -120,16 +116,40 @@ def drive_step(mode: int, omega_s: float, omega_ref: float, integral: float, mot
     if mode == TD_SPEED:
         command, integral = speed_loop(omega_ref, omega_s, integral, kp, ki, max_torque, dt)
     else:
-        command = torque_command(tgt_torque, max_torque)
+        command = within_limit(tgt_torque, max_torque)
     motor = motor_lag(motor, command, lag_alpha)
     return (omega_s + drive_acceleration(motor, t_string, inertia) * dt, omega_ref, integral,
             motor)
 
 
 # ---- parameters -------------------------------------------------------------------------
+def _check_fields(drive: Any, inertia: str, gains: tuple[str, str], limit: str,
+                  lag: str) -> None:
+    """ParameterError naming ``top_drive.<field>`` of ``drive`` unless its mode is known, its
+    ``inertia`` finite and > 0, its ``gains`` finite and >= 0, its ``limit`` > 0 (inf: no
+    limit) and its ``lag`` finite and >= 0: the one check of a drive, in either units."""
+    mode_index(drive.mode)
+    value = getattr(drive, lag)
+    if not (math.isfinite(value) and value >= 0.0):
+        raise ParameterError(f"parameter 'top_drive.{lag}' = {value!r} must be finite and "
+                             ">= 0")
+    for name in (inertia, limit):
+        value = getattr(drive, name)
+        if math.isnan(value) or value <= 0.0:
+            raise ParameterError(f"parameter 'top_drive.{name}' = {value!r} must be > 0")
+    for name in gains:
+        value = getattr(drive, name)
+        if not (math.isfinite(value) and value >= 0.0):
+            raise ParameterError(f"parameter 'top_drive.{name}' = {value!r} must be "
+                                 "finite and >= 0")
+    if not math.isfinite(getattr(drive, inertia)):
+        raise ParameterError(f"parameter 'top_drive.{inertia}' must be finite")
+
+
 @dataclass(frozen=True)
 class TopDrive:
-    """The drive in the paper's scaling (see the module docstring).
+    """The drive in kernel units, the paper's scaling (see the module docstring): what the
+    :class:`~drill_sim_ros.model.simulator.Simulator` takes.
 
     mode: 'kinematic' | 'speed' | 'torque'; inertia_ratio: J / I; kp: kp_SI / (C t*);
     ki: ki_SI / C; max_torque: max_SI / C (inf: no limit); motor_lag: time constant of the
@@ -145,28 +165,15 @@ class TopDrive:
     motor_lag: float = 0.0
 
     def __post_init__(self) -> None:
-        mode_index(self.mode)
-        if not (math.isfinite(self.motor_lag) and self.motor_lag >= 0.0):
-            raise ParameterError(f"parameter 'top_drive.motor_lag' = {self.motor_lag!r} must "
-                                 "be finite and >= 0")
-        for name in ("inertia_ratio", "max_torque"):
-            value = getattr(self, name)
-            if math.isnan(value) or value <= 0.0:
-                raise ParameterError(f"parameter 'top_drive.{name}' = {value!r} must be > 0")
-        for name in ("kp", "ki"):
-            value = getattr(self, name)
-            if not (math.isfinite(value) and value >= 0.0):
-                raise ParameterError(f"parameter 'top_drive.{name}' = {value!r} must be "
-                                     "finite and >= 0")
-        if not math.isfinite(self.inertia_ratio):
-            raise ParameterError("parameter 'top_drive.inertia_ratio' must be finite")
+        _check_fields(self, "inertia_ratio", ("kp", "ki"), "max_torque", "motor_lag")
 
     def with_(self, **changes: Any) -> TopDrive:
         """A copy with ``changes`` applied (validated)."""
         return replace(self, **changes)
 
     def physical(self, scales: Scales) -> TopDrivePhysical:
-        """The same drive in SI (inverse of :meth:`TopDrivePhysical.scaled`)."""
+        """The same drive in SI (inverse of :meth:`TopDrivePhysical.scaled`): how a
+        dimensionless preset's drive, given in these units, becomes SI once."""
         c, t_star = scales.torque_nm, scales.time_s
         return TopDrivePhysical(mode=self.mode, inertia_kg_m2=self.inertia_ratio * c * t_star**2,
                                 kp_nm_s=self.kp * c * t_star, ki_nm=self.ki * c,
@@ -180,11 +187,16 @@ class TopDrive:
 
 @dataclass(frozen=True)
 class TopDrivePhysical:
-    """The drive in SI, referred to the quill.
+    """The drive in SI, referred to the quill: the one description of a drive. It is built
+    once, from a preset (``presets.preset_from_dict``, :attr:`Preset.drive`) or from
+    sim_node's ``top_drive.*`` parameters (``ros.parameters.top_drive_of``), handed down as
+    it is (a change of mode or lag: ``dataclasses.replace``) and converted to kernel units
+    once, by :meth:`scaled`, where the session builds or updates its simulator.
 
     mode; inertia_kg_m2: J; kp_nm_s: proportional gain, N m per rad/s; ki_nm: integral gain,
-    N m per rad; max_torque_nm: motor torque limit, N m; motor_lag_s: time constant of the
-    first-order lag of the motor torque behind its command (VFD torque bandwidth), s.
+    N m per rad; max_torque_nm: motor torque limit, N m (inf: no limit); motor_lag_s: time
+    constant of the first-order lag of the motor torque behind its command (VFD torque
+    bandwidth), s.
     """
 
     mode: str = "speed"
@@ -193,6 +205,10 @@ class TopDrivePhysical:
     ki_nm: float = 46_400.0
     max_torque_nm: float = 50_000.0
     motor_lag_s: float = 0.0
+
+    def __post_init__(self) -> None:
+        _check_fields(self, "inertia_kg_m2", ("kp_nm_s", "ki_nm"), "max_torque_nm",
+                      "motor_lag_s")
 
     def scaled(self, scales: Scales) -> TopDrive:
         """The paper's scaling: I = C t*^2, so j = J / (C t*^2) (eqs. 19-20)."""
@@ -233,9 +249,19 @@ def _from_dict(cls: type, values: dict[str, Any]) -> Any:
     return cls(**{key: (str(v) if key == "mode" else float(v)) for key, v in values.items()})
 
 
-def top_drive_from_dict(values: dict[str, Any], scales: Scales, physical: bool) -> TopDrive:
-    """A preset's ``top_drive`` mapping: SI keys (:class:`TopDrivePhysical`) for a physical
-    preset, scaled keys (:class:`TopDrive`) for a dimensionless one."""
+def paper_drive(scales: Scales) -> TopDrivePhysical:
+    """The paper's kinematic drive (the :class:`TopDrive` defaults) in the SI of ``scales``:
+    a preset's drive when it gives none."""
+    return TopDrive().physical(scales)
+
+
+def top_drive_from_dict(values: dict[str, Any] | None, scales: Scales,
+                        physical: bool) -> TopDrivePhysical:
+    """A preset's ``top_drive`` mapping in SI: SI keys (:class:`TopDrivePhysical`) in a
+    physical preset; scaled keys (:class:`TopDrive`) in a dimensionless one, turned into SI
+    once with its ``scales``; None (no ``top_drive``): the paper's kinematic drive."""
+    if values is None:
+        return paper_drive(scales)
     if physical:
-        return _from_dict(TopDrivePhysical, values).scaled(scales)
-    return _from_dict(TopDrive, values)
+        return _from_dict(TopDrivePhysical, values)
+    return _from_dict(TopDrive, values).physical(scales)

@@ -14,7 +14,7 @@ import math
 import re
 import sys
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 from typing import Any
 
 import rclpy
@@ -29,7 +29,7 @@ from drill_sim_ros.model.errors import ParameterError
 from drill_sim_ros.model.measurement import MAX_DELAY_PERIODS, SIGNALS
 from drill_sim_ros.model.params import UNIT_SCALES
 from drill_sim_ros.model.presets import DEFAULT_PRESET, Preset, submerged_string_weight_n
-from drill_sim_ros.model.top_drive import MODES, TopDrive, TopDrivePhysical
+from drill_sim_ros.model.top_drive import MODES, TopDrivePhysical, paper_drive
 from drill_sim_ros.ros.params_file_check import check_params_content
 from drill_sim_ros.topics import NODE_NAME
 
@@ -71,17 +71,37 @@ def _max_wob_n(preset: Preset | None) -> float:
     return defaults.max_wob_n(_preset_wob_n(preset))
 
 
-def _drive(preset: Preset | None) -> TopDrivePhysical:
-    return TopDrive().physical(UNIT_SCALES) if preset is None else \
-        preset.top_drive.physical(preset.scales)
+# top_drive.max_torque_nm's "no limit": a ROS double parameter has a finite range, so the
+# parameter says 0 where the drive (TopDrivePhysical, the kernel) says inf. These two
+# functions are the only places that know it.
+NO_TORQUE_LIMIT_PARAMETER = 0.0
+
+
+def torque_limit_parameter(max_torque_nm: float) -> float:
+    """The ``top_drive.max_torque_nm`` value of a drive's limit (inf: none -> 0)."""
+    return NO_TORQUE_LIMIT_PARAMETER if math.isinf(max_torque_nm) else max_torque_nm
+
+
+def torque_limit_nm(parameter: float) -> float:
+    """The drive's limit of a ``top_drive.max_torque_nm`` value (0: none -> inf)."""
+    return math.inf if parameter == NO_TORQUE_LIMIT_PARAMETER else parameter
 
 
 def _drive_value(name: str) -> Callable[[Preset | None], Any]:
-    """The preset's top-drive value ``name`` (SI; an unlimited torque as 0)."""
+    """The ``top_drive.<name>`` default: the preset's drive's ``name`` (SI, as it is)."""
     def default(preset: Preset | None) -> Any:
-        value = getattr(_drive(preset), name)
-        return 0.0 if name == "max_torque_nm" and math.isinf(value) else value
+        drive = paper_drive(UNIT_SCALES) if preset is None else preset.drive
+        value = getattr(drive, name)
+        return torque_limit_parameter(value) if name == "max_torque_nm" else value
     return default
+
+
+def top_drive_of(values: dict[str, Any]) -> TopDrivePhysical:
+    """The drive of the ``top_drive.<field>`` parameters in ``values``: one parameter per
+    field of :class:`TopDrivePhysical`, the torque limit through :func:`torque_limit_nm`."""
+    drive = {f.name: values[f"top_drive.{f.name}"] for f in fields(TopDrivePhysical)}
+    drive["max_torque_nm"] = torque_limit_nm(drive["max_torque_nm"])
+    return TopDrivePhysical(**drive)
 
 
 def _sensor_specs() -> tuple[ParamSpec, ...]:
@@ -222,6 +242,9 @@ SPECS: tuple[ParamSpec, ...] = (
               "Show one live status line when stderr is a terminal."),
 )
 SPEC_BY_NAME = {spec.name: spec for spec in SPECS}
+# the top_drive.* parameters that may change at runtime: a change rebuilds the drive
+RUNTIME_DRIVE_PARAMETERS = frozenset(spec.name for spec in SPECS if not spec.read_only
+                                     and spec.name.startswith("top_drive."))
 
 
 def descriptor(spec: ParamSpec) -> ParameterDescriptor:

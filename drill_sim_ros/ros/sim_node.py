@@ -48,7 +48,6 @@ from drill_sim_ros.model.params import RPM_PER_RAD_S
 from drill_sim_ros.model.presets import load_preset
 from drill_sim_ros.model.session import Block, SessionConfig, SimSession
 from drill_sim_ros.model.telemetry import MODE_NAMES, NS_PER_S, TELEMETRY_INDEX
-from drill_sim_ros.model.top_drive import TopDrivePhysical
 from drill_sim_ros.realtime.pacing import Pacer, RateMeter
 from drill_sim_ros.realtime.ticker import HandoffLock, Ticker
 from drill_sim_ros.ros import messages, typed
@@ -58,11 +57,13 @@ from drill_sim_ros.ros.frame import SAMPLE_TOPICS
 from drill_sim_ros.ros.handshake import COMMAND_MODE, SERVICE_MODE, Handshake
 from drill_sim_ros.ros.messages import LATEST_SAMPLE_QOS, RUN_INFO_QOS, TELEMETRY_QOS, stamp_ns
 from drill_sim_ros.ros.parameters import (
+    RUNTIME_DRIVE_PARAMETERS,
     SPEC_BY_NAME,
     coerce,
     declare_all,
     init_ros,
     recording_options,
+    top_drive_of,
     validate,
 )
 from drill_sim_ros.ros.sinks import SampleSinks, TypedTelemetry
@@ -101,24 +102,10 @@ def session_config(values: dict[str, Any], preset: Any) -> SessionConfig:
         top_drive_accel_rpm_s=values["limits.top_drive_accel_rpm_s"],
         wob_rate_n_s=values["limits.wob_rate_n_s"], window_s=values["diagnostics.window_s"],
         submerged_weight_n=values["model.submerged_string_weight_n"],
-        top_drive=top_drive(values), sensors=rig_sensors(values),
+        top_drive=top_drive_of(values), sensors=rig_sensors(values),
         command_delay_s=values["commands.delay_s"],
         string_rate_hz=values["string.rate_hz"], string_depths=values["string.depths"],
         formation=tuple(formation_layers(values["formation.layers"])))
-
-
-DRIVE_PARAMETERS = {"top_drive.kp_nm_s", "top_drive.ki_nm", "top_drive.max_torque_nm",
-                    "top_drive.mode", "top_drive.motor_lag_s"}
-
-
-def top_drive(values: dict[str, Any]) -> TopDrivePhysical:
-    """The drive of the ``top_drive.*`` parameters (a torque limit of 0: none)."""
-    limit = values["top_drive.max_torque_nm"]
-    return TopDrivePhysical(mode=values["top_drive.mode"],
-                            inertia_kg_m2=values["top_drive.inertia_kg_m2"],
-                            kp_nm_s=values["top_drive.kp_nm_s"], ki_nm=values["top_drive.ki_nm"],
-                            max_torque_nm=limit if limit > 0 else math.inf,
-                            motor_lag_s=values["top_drive.motor_lag_s"])
 
 
 def formation_layers(text: str) -> list[dict[str, Any]]:
@@ -361,12 +348,12 @@ class SimNode(Node):
             reason = None if spec is None else validate(spec, param.value)
             if reason is not None:
                 return SetParametersResult(successful=False, reason=reason)
-        drive = {p.name for p in params} & DRIVE_PARAMETERS
+        drive = {p.name for p in params} & RUNTIME_DRIVE_PARAMETERS
         if drive and self._session is not None:   # the new drive must be stable at the step
             values = {**self._values, **{p.name: coerce(SPEC_BY_NAME[p.name], p.value)
                                          for p in params if p.name in drive}}
             try:
-                self._session.check_top_drive(top_drive(values))
+                self._session.check_top_drive(top_drive_of(values))
             except ParameterError as exc:
                 return SetParametersResult(successful=False, reason=str(exc))
         for p in params:
@@ -386,8 +373,8 @@ class SimNode(Node):
                 return
             self._session.submerged_weight_n = self._values["model.submerged_string_weight_n"]
             names = {p.name for p in params}
-            if names & DRIVE_PARAMETERS:
-                self._session.set_top_drive(top_drive(self._values))   # between runs: no bump
+            if names & RUNTIME_DRIVE_PARAMETERS:      # between runs: no bump
+                self._session.set_top_drive(top_drive_of(self._values))
             if "formation.layers" in names:
                 self._session.set_formation(formation_layers(self._values["formation.layers"]))
             if names & {"real_time_factor", "lockstep", "lockstep_trigger"}:
@@ -552,9 +539,8 @@ class SimNode(Node):
         """``command`` from the next period, clamped to the limits (counted as saturated);
         a non-finite value is rejected and the last setpoint stays (lock held)."""
         self._emit_initial()                 # t = 0 is the state before any command
-        limit_nm = self._values["top_drive.max_torque_nm"] or math.inf
         limits = CommandLimits(self._values["limits.max_surface_rpm"],
-                               self._values["limits.max_wob_n"], limit_nm)
+                               self._values["limits.max_wob_n"])
         for applied, why in apply_command(self._session, command, limits):
             if not applied:
                 self._reject(topic, why)

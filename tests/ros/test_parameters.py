@@ -2,16 +2,24 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import pytest
 
+from drill_sim_ros.control.bench import session_config, sim_node_parameters
+from drill_sim_ros.control.scenario import Scenario
 from drill_sim_ros.model.presets import load_preset
+from drill_sim_ros.model.top_drive import TopDrivePhysical
 from drill_sim_ros.ros.parameters import (
+    RUNTIME_DRIVE_PARAMETERS,
     SPEC_BY_NAME,
     SPECS,
     descriptor,
     submerged_string_weight_n,
+    top_drive_of,
+    torque_limit_nm,
+    torque_limit_parameter,
     validate,
     yaml_defaults,
 )
@@ -55,3 +63,35 @@ def test_physical_defaults_come_from_the_preset():
     defaults = yaml_defaults(preset)
     assert defaults["model.applied_wob_n"] == pytest.approx(preset.physical.applied_wob_n)
     assert defaults["model.surface_rpm"] == pytest.approx(preset.physical.surface_rpm)
+
+
+def test_the_drive_parameters_give_the_presets_drive_back() -> None:
+    # sim_node's top_drive.* parameters default to the preset's SI drive and make it again,
+    # field for field; the only mapping is the torque limit's 0 = none (a ROS double)
+    for name in ("field_8p5in_shale", "field_8p5in_shale_lumped", "fig5_8a"):
+        preset = load_preset(name)
+        assert top_drive_of(yaml_defaults(preset)) == preset.drive, name
+    unlimited = load_preset("fig5_8a")             # the paper's drive: no torque limit
+    assert math.isinf(unlimited.drive.max_torque_nm)
+    assert yaml_defaults(unlimited)["top_drive.max_torque_nm"] == 0.0
+    assert torque_limit_nm(0.0) == math.inf and torque_limit_parameter(math.inf) == 0.0
+    assert torque_limit_nm(torque_limit_parameter(8000.0)) == 8000.0
+
+
+def test_every_drive_field_but_the_inertia_may_change_at_runtime() -> None:
+    every = {f"top_drive.{f.name}" for f in dataclasses.fields(TopDrivePhysical)}
+    assert every - {"top_drive.inertia_kg_m2"} == RUNTIME_DRIVE_PARAMETERS
+    assert SPEC_BY_NAME["top_drive.inertia_kg_m2"].read_only      # fixed for a session
+
+
+@pytest.mark.parametrize("drive", [{}, {"max_torque_nm": 8000.0}, {"motor_lag_s": 0.05},
+                                   {"max_torque_nm": 20e3, "motor_lag_s": 0.01}])
+@pytest.mark.parametrize("mode", ["speed", "torque"])
+def test_the_bench_runs_the_drive_sim_node_makes_of_its_parameters(drive, mode) -> None:
+    # two roads to one drive: sim_node's parameters for a scenario (over the preset's
+    # defaults) and the in-process bench's session, built without them
+    scenario = Scenario(preset="field_8p5in_shale_lumped", mode=mode, drive=drive)
+    preset = scenario.load_preset()
+    values = {**yaml_defaults(load_preset(scenario.preset)),
+              **sim_node_parameters(scenario, preset)}
+    assert session_config(scenario, preset).top_drive == top_drive_of(values)
