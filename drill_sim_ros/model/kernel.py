@@ -157,11 +157,11 @@ Drive = namedtuple("Drive", (
     "mode", "omega", "torque", "omega_rate", "inertia", "kp", "ki", "max_torque", "lag_alpha"))
 Drive.__doc__ = """A run's top-drive parameters and commands (top_drive.drive_step)."""
 Response = namedtuple("Response", (
-    "cursor", "doc", "t_top", "f_top", "v_new", "omega_new", "w_f", "wob", "tob", "mode",
-    "stuck", "v_hook", "hook_int"))
+    "cursor", "doc", "t_top", "f_top", "v_new", "omega_new", "u_new", "phi_new", "w_f", "wob",
+    "tob", "mode", "stuck", "v_hook", "hook_int"))
 Response.__doc__ = """What a step computes on the bit's side before anything moves: the exact
 delay's cursor, the depth of cut, the string's torque and force at the top, the bit's new
-speeds, forces and mode (eqs. 29-33), the hook's speed and integral."""
+speeds, depth and angle, forces and mode (eqs. 29-33, C.1), the hook's speed and integral."""
 DriveStep = namedtuple("DriveStep", ("omega_s_next", "omega_ref", "integral", "motor"))
 DriveStep.__doc__ = """The drive over a step: its speed at the end, the setpoint in force, the
 speed loop's integral, the motor torque (top_drive.drive_step)."""
@@ -192,33 +192,30 @@ def _first_countdown(step: int, every: int) -> int:
 
 
 @njit(cache=True, inline="always")
-def _accumulate(acc: np.ndarray, x: Loop, r: Response, motor: float, law: Law,
-                probe: float) -> float:
-    """Step ``r`` from ``x`` into the statistics ``acc`` (``A_*``), in place: first stick and
-    bounce times always, the window sums for tau >= the window's start. (In place, not a
-    tuple of locals: thirteen loop-carried values fewer for the register allocator.)
-    Returns ``probe`` plus the step's forces: a NaN there survives the contact logic."""
-    tau = x.step * law.dt
-    if r.mode == MODE_STUCK and acc[A_FIRST_STICK] != acc[A_FIRST_STICK]:
+def _accumulate(acc: np.ndarray, tau: float, tau_avg: float, mode: int, w_f: float,
+                tob: float, doc: float, wob: float, omega: float, t_pipe: float,
+                v: float) -> None:
+    """One step into the statistics ``acc`` (``A_*``), in place: first stick and bounce
+    times always, the window sums for tau >= tau_avg. (In place, not a tuple of locals:
+    thirteen loop-carried values fewer for the register allocator.)"""
+    if mode == MODE_STUCK and acc[A_FIRST_STICK] != acc[A_FIRST_STICK]:
         acc[A_FIRST_STICK] = tau
-    if r.mode == MODE_OFF_BOTTOM and acc[A_FIRST_BOUNCE] != acc[A_FIRST_BOUNCE]:
+    if mode == MODE_OFF_BOTTOM and acc[A_FIRST_BOUNCE] != acc[A_FIRST_BOUNCE]:
         acc[A_FIRST_BOUNCE] = tau
-    probe += r.w_f + r.tob + motor
-    if tau < law.tau_avg:
-        return probe
+    if tau < tau_avg:
+        return
     acc[A_COUNT] += 1.0
-    acc[A_WF] += r.w_f
-    acc[A_TOB] += r.tob
-    acc[A_DOC] += r.doc
-    acc[A_WOB] += r.wob
-    acc[A_OMEGA] += x.omega
-    acc[A_T_PIPE] += r.t_top
-    acc[A_V] += x.v
-    acc[A_OMEGA_MIN] = min(acc[A_OMEGA_MIN], x.omega)
-    acc[A_OMEGA_MAX] = max(acc[A_OMEGA_MAX], x.omega)
-    if r.mode == MODE_STUCK:
+    acc[A_WF] += w_f
+    acc[A_TOB] += tob
+    acc[A_DOC] += doc
+    acc[A_WOB] += wob
+    acc[A_OMEGA] += omega
+    acc[A_T_PIPE] += t_pipe
+    acc[A_V] += v
+    acc[A_OMEGA_MIN] = min(acc[A_OMEGA_MIN], omega)
+    acc[A_OMEGA_MAX] = max(acc[A_OMEGA_MAX], omega)
+    if mode == MODE_STUCK:
         acc[A_STUCK] += 1.0
-    return probe
 
 
 @njit(cache=True, inline="always")
@@ -276,11 +273,8 @@ def _steps(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarray
            hist: np.ndarray, meta: np.ndarray, acc: np.ndarray, out: np.ndarray,
            wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray,
            n_steps: int, every: int, exact: bool, dry: bool) -> tuple[int, int]:
-    """:func:`advance` step by step: read the delay and the string's ends, respond, record,
-    move on. ``dry``: the first step's row only, nothing else written (module doc)."""
-    x = _unpack(st, meta)
-    law, drive = _law_params(prm, tgt, profile), _drive_params(prm, tgt)
-    lay = _string_layout(prm, wave_i)
+    """:func:`advance` (module doc); ``dry``: the first step's row only, nothing else written."""
+    x, law, drive, lay = _unpack(st, meta), *_run_params(prm, tgt, profile, wave_i)
     countdown, n_rows, status, probe = _first_countdown(x.step, every), 0, STATUS_OK, 0.0
     for _ in range(n_steps):      # the delay: U(tau - tau_n), eqs. 6-7, 26-28
         surface, cursor = br.delayed_depth(hist[0], hist[1], x.head, x.count, x.cursor,
@@ -297,20 +291,21 @@ def _steps(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarray
         if dry:                       # (nothing written before this line but the row)
             return STATUS_OK, n_rows
         st[S_MOTOR_TORQUE] = d.motor      # (read back: no register held through the bit law)
-        probe = _accumulate(acc, x, r, d.motor, law, probe)
+        probe += r.w_f + r.tob + d.motor
+        _accumulate(acc, x.step * law.dt, law.tau_avg, r.mode, r.w_f, r.tob, r.doc, r.wob,
+                    x.omega, r.t_top, x.v)
         sg.advance(wave, wave_i, wave_f, lay, d.omega_s_next, r.v_hook, r.omega_new, r.v_new)
-        u_new, phi_new = x.u + r.v_new * law.dt, x.phi + r.omega_new * law.dt     # eq. C.1
         head, count, node, frac, h_old = x.head, x.count, x.node, x.frac, x.h_old
-        if exact:
+        if exact:                     # the rock: the history stored, or re-cut under a blade
             head, count, cursor, ok = br.history_store(hist, head, count, r.cursor, x.phi,
-                                                       phi_new, u_new)
+                                                       r.phi_new, r.u_new)
         else:
-            node, frac, h_old, ok = br.profile_recut(profile, node, frac, h_old, x.u, u_new,
-                                                     (phi_new - x.phi) * law.inv_spacing)
-        x = _moved(x, r, d, law, drive.mode == TD_KINEMATIC and wave is None, u_new, phi_new,
-                   node, frac, h_old, head, count, cursor)
-        if not ok or x.u >= law.layer_u:
-            status = _stop_status(ok, exact)
+            node, frac, h_old, ok = br.profile_recut(profile, node, frac, h_old, x.u, r.u_new,
+                                                     (r.phi_new - x.phi) * law.inv_spacing)
+        x = _moved(x, r, d, law, drive.mode == TD_KINEMATIC and wave is None, node, frac,
+                   h_old, head, count, cursor)
+        status = _stopped(ok, exact, x.u, law.layer_u)
+        if status != STATUS_OK:
             break
     _pack(st, meta, x, law.dt)
     return _finish(status, (x.u, x.v, x.phi, x.omega, x.omega_s, probe)), n_rows
@@ -321,7 +316,8 @@ def _respond(x: Loop, law: Law, surface: float, cursor: int, ends: tuple,
              lumped: bool) -> Response:
     """The bit's side of a step from ``x``, given the rock surface under the bit and what
     the string presents at its ends (string.ends): the depth of cut (eq. 8), the bit law
-    (eqs. 29-33), and the hook's WOB loop on the force at the top."""
+    (eqs. 29-33) and the bit's new depth and angle (symplectic Euler, eq. C.1), and the
+    hook's WOB loop on the force at the top."""
     doc = law.n_blades * (x.u - surface)        # delta = n (U - U(tau - tau_n)), eq. 8
     v0, kick_v, f_ext, omega0, kick_w, t_ext, t_top, f_top = ends
     v_new, omega_new, w_f, wob, tob, mode, stuck = br.bit_response(
@@ -331,8 +327,8 @@ def _respond(x: Loop, law: Law, surface: float, cursor: int, ends: tuple,
     if not lumped:                # the hook's WOB loop
         v_hook, hook_int = _hook(law.hook_kp, law.hook_ki, law.off_bottom, law.dt, x.w_app,
                                  f_top, hook_int)
-    return Response(cursor, doc, t_top, f_top, v_new, omega_new, w_f, wob, tob, mode, stuck,
-                    v_hook, hook_int)
+    return Response(cursor, doc, t_top, f_top, v_new, omega_new, x.u + v_new * law.dt,
+                    x.phi + omega_new * law.dt, w_f, wob, tob, mode, stuck, v_hook, hook_int)
 
 
 @njit(cache=True, inline="always")
@@ -346,14 +342,13 @@ def _drive(x: Loop, drive: Drive, dt: float, last_motor: float, t_top: float) ->
 
 
 @njit(cache=True, inline="always")
-def _moved(x: Loop, r: Response, d: DriveStep, law: Law, lumped_kinematic: bool,
-           u_new: float, phi_new: float, node: int, frac: float, h_old: float, head: int,
-           count: int, cursor: int) -> Loop:
-    """The state after step ``r``, ``d``, the bit moved to ``u_new``, ``phi_new`` (eq. C.1) over
-    the rock's new bookkeeping: the drive's angle on (RGD07's kinematic drive on the lumped
-    string turns at the old speed), the applied weight ramped."""
+def _moved(x: Loop, r: Response, d: DriveStep, law: Law, lumped_kinematic: bool, node: int,
+           frac: float, h_old: float, head: int, count: int, cursor: int) -> Loop:
+    """The state after step ``r``, ``d`` over the rock's new bookkeeping: the bit moved
+    (eq. C.1), the drive's angle on (RGD07's kinematic drive on the lumped string turns at
+    the old speed), the applied weight ramped."""
     phi_s = x.phi_s + (x.omega_s if lumped_kinematic else d.omega_s_next) * law.dt
-    return Loop(u_new, r.v_new, phi_new, r.omega_new, phi_s, d.omega_s_next,
+    return Loop(r.u_new, r.v_new, r.phi_new, r.omega_new, phi_s, d.omega_s_next,
                 ramp(x.w_app, law.tgt_w, law.w_rate, law.dt), r.stuck, node, frac, h_old,
                 x.step + 1, d.omega_ref, d.integral, d.motor, r.v_hook, r.hook_int, head,
                 count, cursor)
@@ -367,9 +362,20 @@ def _string_layout(prm: np.ndarray, wave_i: np.ndarray | None) -> tuple:
 
 
 @njit(cache=True, inline="always")
-def _stop_status(ok: bool, exact: bool) -> int:
-    """Why a run stopped early: the next layer's top reached, or a failure."""
-    return STATUS_LAYER if ok else (STATUS_HISTORY_FULL if exact else STATUS_RUNAWAY)
+def _stopped(ok: bool, exact: bool, u: float, layer_u: float) -> int:
+    """Whether a run stops after this step, and why: the next layer's top reached, a
+    runaway or a full history (STATUS_OK: it goes on)."""
+    if not ok:
+        return STATUS_HISTORY_FULL if exact else STATUS_RUNAWAY
+    return STATUS_LAYER if u >= layer_u else STATUS_OK
+
+
+@njit(cache=True, inline="always")
+def _run_params(prm: np.ndarray, tgt: np.ndarray, profile: np.ndarray,
+                wave_i: np.ndarray | None) -> tuple[Law, Drive, tuple]:
+    """A run's constants, read once: the bit law's and the hook's, the drive's, the
+    string's layout."""
+    return _law_params(prm, tgt, profile), _drive_params(prm, tgt), _string_layout(prm, wave_i)
 
 
 @njit(cache=True, inline="always")
