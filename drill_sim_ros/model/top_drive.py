@@ -68,19 +68,21 @@ def speed_loop(omega_ref: float, omega_s: float, integral: float, kp: float, ki:
     """PI speed loop with a torque limit: ``(motor torque, new integral)``.
 
     The integral (in torque units) is held while the output saturates in the direction the
-    error pushes (conditional integration), and never exceeds the limit itself.
+    error pushes (conditional integration), and never exceeds the limit itself (a limit
+    lowered at run time clamps it too).
     """
     err = omega_ref - omega_s
+    held = min(max(integral, -max_torque), max_torque)
     integral_new = min(max(integral + ki * err * dt, -max_torque), max_torque)
     motor = kp * err + integral_new
     if motor > max_torque:
         motor = max_torque
         if err > 0.0:
-            integral_new = integral
+            integral_new = held
     elif motor < -max_torque:
         motor = -max_torque
         if err < 0.0:
-            integral_new = integral
+            integral_new = held
     return motor, integral_new
 
 
