@@ -1,4 +1,5 @@
-"""Test-session environment: DDS on loopback and a domain of our own.
+"""Test-session environment: DDS on loopback, a domain of our own, and SIGINT as a terminal
+delivers it.
 
 Set before anything imports rclpy, so every node and subprocess a test starts inherits it.
 """
@@ -6,6 +7,7 @@ Set before anything imports rclpy, so every node and subprocess a test starts in
 from __future__ import annotations
 
 import os
+import signal
 import sys
 
 os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
@@ -15,6 +17,22 @@ os.environ.setdefault("ROS_DOMAIN_ID", str(1 + os.getpid() % 101))
 _prefixes = [p for p in os.environ.get("AMENT_PREFIX_PATH", "").split(os.pathsep) if p]
 if sys.prefix not in _prefixes:
     os.environ["AMENT_PREFIX_PATH"] = os.pathsep.join([*_prefixes, sys.prefix])
+
+
+def sigint_as_default() -> None:
+    """SIGINT raises KeyboardInterrupt here and is unblocked, whatever the caller set.
+
+    A shell starts a background job (``make test &``, ``nohup``, some CI runners) with
+    SIGINT ignored; an ignored signal survives ``exec``, so every process a test starts
+    would ignore the Ctrl-C the test sends it. A handler does not survive ``exec``: with one
+    here, children start with SIGINT at its default. A blocked signal mask would be
+    inherited as well.
+    """
+    signal.signal(signal.SIGINT, signal.default_int_handler)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+
+
+sigint_as_default()
 
 
 import subprocess  # noqa: E402

@@ -76,13 +76,14 @@ def speed_loop(omega_ref: float, omega_s: float, integral: float, kp: float, ki:
     """PI speed loop with a torque limit: ``(motor torque, new integral)``.
 
     The integral (in torque units) is held while the output saturates in the direction the
-    error pushes (conditional integration), and never exceeds the limit itself.
+    error pushes (conditional integration), and never exceeds the limit itself (a limit
+    lowered at run time clamps it too).
     """
     err = omega_ref - omega_s
     integral_new = within_limit(integral + ki * err * dt, max_torque)
     unlimited = kp * err + integral_new
     if (unlimited > max_torque and err > 0.0) or (unlimited < -max_torque and err < 0.0):
-        integral_new = integral
+        integral_new = within_limit(integral, max_torque)   # held (within a lowered limit)
     return within_limit(unlimited, max_torque), integral_new
 
 

@@ -90,6 +90,8 @@ STATUS_PERIOD_S = 0.25
 WARN_THROTTLE_S = 1.0
 GIL_SWITCH_INTERVAL_S = 0.0005
 WAIT_CHECK_PERIOD_S = 0.1    # how often lockstep's wait is compared with lockstep.warn_after_s
+PAUSED_COMMAND_LOCKSTEP = ("paused (command lockstep: a command answering the latest sample "
+                           "is applied, and its period runs on resume)")
 
 
 def session_config(values: dict[str, Any], preset: Any) -> SessionConfig:
@@ -190,6 +192,7 @@ class SimNode(Node):
         self._pacer = Pacer(1)
         self._rate = RateMeter(time.monotonic_ns(), 0.0)
         self._paused = False
+        self._held_step = False      # paused in command lockstep: a command's period waits
         self._closing = False
         self._fault: str | None = None
         self.recording_failed = False
@@ -514,7 +517,16 @@ class SimNode(Node):
             self._last_command_ns = self._session.sim_time_ns     # the controller is alive
             self._session.command_stamp_ns = reacts_to_ns
             if steps:
-                self._advance(1)
+                self._step_on_command()
+
+    def _step_on_command(self) -> None:
+        """The period an admitted command advances: now, or on resume if paused (the
+        command is applied already, so the period is the one it would have run; lock
+        held)."""
+        if self._paused:
+            self._held_step = True
+        else:
+            self._advance(1)
 
     def _top_drive_command(self, msg: JointState) -> Command:
         """The Command of a drill/cmd/top_drive message; a joint/interface it does not know
@@ -568,6 +580,7 @@ class SimNode(Node):
                   ) -> Trigger.Response:
         with self._lock.urgent():
             self._session.reset()
+            self._held_step = False          # it answered a sample the reset replaced
             if self._fault is not None:
                 self._fault = None
                 self._anchor()       # no catching up on the time spent in the fault
@@ -583,13 +596,27 @@ class SimNode(Node):
 
     def _on_pause(self, request: SetBool.Request, response: SetBool.Response
                   ) -> SetBool.Response:
+        """Pause or resume, in every mode; in command-triggered lockstep a command that
+        answers the latest sample while paused is applied, and its period runs on resume."""
         with self._lock.urgent():
             was_paused, self._paused = self._paused, bool(request.data)
             if was_paused and not self._paused:
-                self._anchor()
+                self._resume()
+            commanded = self._command_steps()
         response.success = True
-        response.message = "paused" if self._paused else "running"
+        response.message = "running"
+        if self._paused:
+            response.message = PAUSED_COMMAND_LOCKSTEP if commanded else "paused"
         return response
+
+    def _resume(self) -> None:
+        """The pause ends: no catching up on it, a lockstep wait counts from now, and the
+        period of a command held while paused runs (lock held)."""
+        self._anchor()
+        self._handshake.restart(time.monotonic())
+        held, self._held_step = self._held_step, False
+        if held and self._command_steps():
+            self._advance(1)
 
     def _on_step(self, _request: Trigger.Request, response: Trigger.Response
                  ) -> Trigger.Response:
@@ -610,8 +637,8 @@ class SimNode(Node):
     # ---- diagnostics, status, shutdown -------------------------------------------------
     def _lockstep_mode(self) -> str | None:
         """What advances the sim now: COMMAND_MODE, SERVICE_MODE, or None (it runs by itself,
-        or cannot run: a fault, closing) (lock held)."""
-        if not self._lockstep or self._fault is not None or self._closing:
+        or cannot run: a fault, closing, paused) (lock held)."""
+        if not self._lockstep or self._fault is not None or self._closing or self._paused:
             return None
         return COMMAND_MODE if self._values["lockstep_trigger"] == "command" else SERVICE_MODE
 

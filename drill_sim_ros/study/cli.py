@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import argparse
+import sys
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -113,7 +114,8 @@ def cmd_map(args: argparse.Namespace, resolve: Callable[[argparse.Namespace], An
     if result is None or result.interrupted:
         kept = f"the points done are kept in {args.out}" if args.out.exists() else \
             "no point was done"
-        print(f"drill_sim map: interrupted; {kept}; re-run the same command to resume")
+        print(f"drill_sim map: interrupted; {kept}; re-run the same command to resume",
+              file=sys.stderr)
         return 130
     done = int(result.dataset["done"].sum())
     rate = result.computed / result.seconds if result.seconds > 0 else 0.0

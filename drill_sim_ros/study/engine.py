@@ -161,67 +161,110 @@ def run_map(spec: MapSpec, out: Path, client: object,
     ``progress`` gets (points done, total, seconds) from the start, so its rate is the real
     one. A file that did not exist is only written once a point is computed.
     """
-    from distributed import as_completed
     existed = out.exists()
     ds = store.open_map(spec, out)
     todo = store.pending(ds)
-    total, done0 = spec.size, spec.size - todo.size
-    start = time.perf_counter()
     if todo.size == 0:
         store.save(ds, out)
-        return MapRun(ds, 0, total, 0.0, False, ())
+        return MapRun(ds, 0, spec.size, 0.0, False, ())
     n_workers = max(1, len(client.scheduler_info(n_workers=-1)["workers"]))
     size = batch or batch_size(todo.size, n_workers)
-    _say(log, f"drill_sim map: {total:,} points ({' x '.join(map(str, spec.shape))}), "
-              f"{todo.size:,} to compute in tasks of {size} on {n_workers} workers")
+    _say(log, size_line(spec, todo.size, size, n_workers))
     # Ctrl-C ends the loop between results (a KeyboardInterrupt raised inside distributed's
     # calls makes it log tracebacks); the rate is measured from the kernel loaded
     with _deferred_interrupt() as sigint:
         client.run(warm_up)
-        start = time.perf_counter()
-        if progress:
-            progress(done0, total, 0.0)
-        chunks = (todo[i:i + size] for i in range(0, todo.size, size))
-        queue = as_completed()
-        futures = []
-
-        def submit(count: int) -> None:
-            for chunk in itertools.islice(chunks, count):
-                futures.append(client.submit(evaluate_batch, spec, chunk, pure=False))
-                queue.add(futures[-1])
-
-        submit(TASKS_IN_FLIGHT * n_workers)
-        results: list[BatchResult] = []
-        computed, last_save, interrupted = 0, time.monotonic(), False
+        tally = _Tally(ds, out, spec.size - todo.size, spec.size, todo.size, n_workers, size,
+                       progress, log, checkpoint_s)
+        tasks = _Tasks(client, spec, todo, size)
+        interrupted = False
         try:
-            while not queue.is_empty() and not sigint:
-                if not queue.has_ready():
-                    time.sleep(POLL_S)
-                    continue
-                res: BatchResult = _result(next(queue))
-                submit(1)
-                store.store_results(ds, res.indices, res.values)
-                results.append(res)
-                computed += len(res.indices)
-                if res.error is not None:
-                    raise DrillSimError(res.error)
-                elapsed = time.perf_counter() - start
-                if progress:
-                    progress(done0 + computed, total, elapsed)
-                if len(results) == min(n_workers, math.ceil(todo.size / size)):
-                    _say(log, estimate_line(computed, todo.size, elapsed))
-                if time.monotonic() - last_save > checkpoint_s:
-                    store.save(ds, out)
-                    last_save = time.monotonic()
-            interrupted = bool(sigint)
+            tasks.submit(TASKS_IN_FLIGHT * n_workers)
+            interrupted = _collect(tasks, tally, sigint)
         except KeyboardInterrupt:
             interrupted = True
         finally:
-            client.cancel(futures)
-            if computed or existed:
+            client.cancel(tasks.futures)
+            if tally.computed or existed:
                 store.save(ds, out)
-    return MapRun(ds, computed, total, time.perf_counter() - start, interrupted,
-                  tuple(results))
+    return MapRun(ds, tally.computed, spec.size, tally.elapsed_s(), interrupted,
+                  tuple(tally.results))
+
+
+def size_line(spec: MapSpec, todo: int, size: int, n_workers: int) -> str:
+    """The line before the work: the map's size and how it is shared out."""
+    return (f"drill_sim map: {spec.size:,} points ({' x '.join(map(str, spec.shape))}), "
+            f"{todo:,} to compute in tasks of {size} on {n_workers} workers")
+
+
+class _Tasks:
+    """The map's tasks on ``client``: ``size`` points of ``todo`` each, submitted a few at
+    a time; ``queue`` yields them as they finish."""
+
+    def __init__(self, client: object, spec: MapSpec, todo: np.ndarray, size: int) -> None:
+        from distributed import as_completed
+        self._client, self._spec = client, spec
+        self._chunks = (todo[i:i + size] for i in range(0, todo.size, size))
+        self.queue = as_completed()
+        self.futures: list[object] = []
+
+    def submit(self, count: int) -> None:
+        """Queue up to ``count`` more tasks (fewer at the end)."""
+        for chunk in itertools.islice(self._chunks, count):
+            self.futures.append(self._client.submit(evaluate_batch, self._spec, chunk,
+                                                    pure=False))
+            self.queue.add(self.futures[-1])
+
+
+def _collect(tasks: _Tasks, tally: _Tally, sigint: list[int]) -> bool:
+    """Take the results as they come, one new task per result, until all are in (False) or
+    Ctrl-C came (True)."""
+    while not tasks.queue.is_empty() and not sigint:
+        if not tasks.queue.has_ready():
+            time.sleep(POLL_S)
+            continue
+        res = _result(next(tasks.queue))
+        tasks.submit(1)
+        tally.take(res)
+    return bool(sigint)
+
+
+class _Tally:
+    """The results so far: written into ``ds`` as they come, saved to ``out`` every
+    ``checkpoint_s``, told to ``progress`` and, after the first round of tasks, ``log``."""
+
+    def __init__(self, ds: xr.Dataset, out: Path, done0: int, total: int, todo: int,
+                 n_workers: int, size: int,
+                 progress: Callable[[int, int, float], None] | None,
+                 log: Callable[[str], None] | None, checkpoint_s: float) -> None:
+        self.ds, self.out, self.done0, self.total, self.todo = ds, out, done0, total, todo
+        self.progress, self.log, self.checkpoint_s = progress, log, checkpoint_s
+        self.first_round = min(n_workers, math.ceil(todo / size))
+        self.results: list[BatchResult] = []
+        self.computed = 0
+        self.start = time.perf_counter()
+        self.last_save = time.monotonic()
+        if progress:
+            progress(done0, total, 0.0)
+
+    def elapsed_s(self) -> float:
+        return time.perf_counter() - self.start
+
+    def take(self, res: BatchResult) -> None:
+        """Store ``res`` (its points before a failing one); DrillSimError if one failed."""
+        store.store_results(self.ds, res.indices, res.values)
+        self.results.append(res)
+        self.computed += len(res.indices)
+        if res.error is not None:
+            raise DrillSimError(res.error)
+        elapsed = self.elapsed_s()
+        if self.progress:
+            self.progress(self.done0 + self.computed, self.total, elapsed)
+        if len(self.results) == self.first_round:
+            _say(self.log, estimate_line(self.computed, self.todo, elapsed))
+        if time.monotonic() - self.last_save > self.checkpoint_s:
+            store.save(self.ds, self.out)
+            self.last_save = time.monotonic()
 
 
 def estimate_line(computed: int, todo: int, elapsed_s: float) -> str:

@@ -18,6 +18,7 @@ import os
 from collections.abc import Iterator
 from datetime import UTC, datetime
 from pathlib import Path
+from typing import IO
 
 import numpy as np
 import xarray as xr
@@ -122,33 +123,59 @@ def lock_path(path: Path) -> Path:
     return path.with_name(f".{path.name}.lock")
 
 
+LOCK_ATTEMPTS = 10      # a lock file removed by its holder between our open and our lock
+
+
 @contextlib.contextmanager
 def map_lock(path: Path) -> Iterator[None]:
     """Hold ``path`` for one map run: a second run on it (same spec or not) is refused
     with one DrillSimError line, at its start. An advisory ``flock`` on a file beside the
-    map, released by the kernel when the process ends however it ends."""
+    map, released by the kernel when the process ends however it ends; the file is removed
+    when the block ends, normally or by an exception (Ctrl-C included)."""
     lock = lock_path(path)
+    stream = _locked(lock, path)
     try:
-        lock.parent.mkdir(parents=True, exist_ok=True)
-        stream = open(lock, "a+")  # noqa: SIM115 (held for the run, closed below)
-    except OSError as exc:
-        raise DrillSimError(f"--out {path}: cannot create {lock} ({exc.strerror or exc})"
-                            ) from None
-    try:
-        try:
-            fcntl.flock(stream, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except BlockingIOError:
-            stream.seek(0)
-            owner = stream.read().strip() or "another process"
-            raise DrillSimError(f"--out {path} is in use by another drill_sim map ({owner}); "
-                                "wait for it to end or choose another --out") from None
         stream.seek(0)
         stream.truncate()
         stream.write(f"pid {os.getpid()}")
         stream.flush()
         yield
     finally:
+        lock.unlink(missing_ok=True)        # while held: a waiting opener sees it gone
         stream.close()
+
+
+def _locked(lock: Path, path: Path) -> IO[str]:
+    """``lock`` opened and flocked, the file its name holds now (a holder removes the
+    file before it lets go: a lock taken on a removed file is taken again on a new one)."""
+    for _ in range(LOCK_ATTEMPTS):
+        try:
+            lock.parent.mkdir(parents=True, exist_ok=True)
+            stream = open(lock, "a+")  # noqa: SIM115 (held for the run by map_lock)
+        except OSError as exc:
+            raise DrillSimError(f"--out {path}: cannot create {lock} "
+                                f"({exc.strerror or exc})") from None
+        try:
+            fcntl.flock(stream, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            stream.seek(0)
+            owner = stream.read().strip() or "another process"
+            stream.close()
+            raise DrillSimError(f"--out {path} is in use by another drill_sim map ({owner}); "
+                                "wait for it to end or choose another --out") from None
+        if _same_file(stream, lock):
+            return stream
+        stream.close()
+    raise DrillSimError(f"--out {path}: {lock} keeps being replaced by other drill_sim maps; "
+                        "wait for them to end or choose another --out")
+
+
+def _same_file(stream: IO[str], lock: Path) -> bool:
+    """``stream`` is the file ``lock`` names now."""
+    try:
+        return os.path.samestat(os.fstat(stream.fileno()), os.stat(lock))
+    except FileNotFoundError:
+        return False
 
 
 def save(ds: xr.Dataset, path: Path) -> None:

@@ -12,7 +12,7 @@ import rerun.blueprint as rrb
 from drill_sim_ros.topics import MODE_NAMES
 from drill_sim_ros.viz import entities as ent
 from drill_sim_ros.viz.frames import Frame2D, ViewFrames
-from drill_sim_ros.viz.string_views import FULL_SCALE_OF_NOMINAL, IMAGE_PROFILES
+from drill_sim_ros.viz.string_views import FRAME_BOUNDS, IMAGE_PROFILES
 
 NO_LEGEND = rrb.PlotLegend(visible=False)
 MODE_TITLE = "mode: " + " \u00b7 ".join(f"{i} {n.replace('_', ' ')}"
@@ -82,12 +82,12 @@ def paper_views(window_s: float, frames: ViewFrames) -> rrb.Vertical:
 
 def string_views() -> rrb.Horizontal:
     """The distributed string: depth x time picture of its speed, speed and torque profiles."""
-    full = f"{FULL_SCALE_OF_NOMINAL:g}x"
+    x_range, y_range = FRAME_BOUNDS
     return rrb.Horizontal(
         rrb.Spatial2DView(origin=ent.STRING_DEPTH_TIME,
-                          name=f"string speed, depth (down: top drive to bit) x last "
-                               f"{IMAGE_PROFILES} profiles (right: now); 0 dark blue .. "
-                               f"{full} nominal rpm dark red"),
+                          name=f"string speed over depth and the last {IMAGE_PROFILES} "
+                               "profiles: white at the mean, blue slower, red faster",
+                          visual_bounds=rrb.VisualBounds2D(x_range=x_range, y_range=y_range)),
         rrb.BarChartView(origin=ent.STRING_SPEED, name="string speed [rpm] over depth [m]",
                          plot_legend=NO_LEGEND),
         rrb.BarChartView(origin=ent.STRING_TORQUE, name="string torque [kN m] over depth [m]",

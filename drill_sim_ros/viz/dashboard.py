@@ -6,7 +6,6 @@ from collections.abc import Iterable
 
 import rerun as rr
 
-from drill_sim_ros.model.params import RPM_PER_RAD_S
 from drill_sim_ros.viz import log_views as lv
 from drill_sim_ros.viz.frames import Extents, ViewFrames, view_frames
 from drill_sim_ros.viz.paper_units import PaperUnits
@@ -37,7 +36,7 @@ class Dashboard:
         self._last_turn: list = []
         self.samples = 0
         self.last_time_s: float | None = None
-        self.strings = StringViews(rec, units.omega0 / units.scales.time_s * RPM_PER_RAD_S)
+        self.strings = StringViews(rec)
         self.log_static(rec)
 
     def log_static(self, rec: rr.RecordingStream | Recordings) -> None:

@@ -62,7 +62,13 @@ STICK_FRACTION = "/severity/stick_fraction"
 INFO = "/info"
 
 # ---- the distributed string (drill/string/torsion; viz.string_views) --------------------
-STRING_DEPTH_TIME = "/string/depth_time"         # RGB image: depth (rows) x profiles (columns)
+STRING_DEPTH_TIME = "/string/depth_time"         # the depth x time view's origin
+STRING_PICTURE = "/string/depth_time/picture"    # RGB image: depth (rows) x profiles (columns)
+STRING_OUTLINE = "/string/depth_time/outline"
+STRING_DEPTH_AXIS = "/string/depth_time/depth_axis"      # depth tick labels m, title
+STRING_TIME_AXIS = "/string/depth_time/time_axis"        # s before the newest profile
+STRING_COLOUR_BAR = "/string/depth_time/colour_bar"      # RGB image of the palette
+STRING_SCALE_LABELS = "/string/depth_time/scale_labels"  # the colour bar's rpm, title
 STRING_SPEED = "/string/speed"                   # bar chart: rpm over depth m
 STRING_TORQUE = "/string/torque"                 # bar chart: kN m over depth m
 

@@ -45,12 +45,14 @@ def log_series_styles(rec: rr.RecordingStream) -> None:
                                                aggregation_policy=AGGREGATION), static=True)
 
 
-def _text(rec: rr.RecordingStream, path: str, xy: list[tuple[float, float]],
-          labels: list[str]) -> None:
+def log_labels(rec: rr.RecordingStream, path: str, xy: list[tuple[float, float]],
+               labels: list[str], static: bool = True) -> None:
     """Labels at stored positions (invisible anchor points): rerun puts a strip's label at
-    its centre, so every label here is placed on purpose."""
+    its centre, so every label here is placed on purpose; ``static``: once per recording,
+    else at the stream's current time."""
     rec.log(path, rr.Points2D(np.array(xy, dtype=np.float64), labels=labels, colors=LABEL,
-                              radii=rr.Radius.ui_points(0.0), show_labels=True), static=True)
+                              radii=rr.Radius.ui_points(0.0), show_labels=True),
+            static=static)
 
 
 def _fmt(value: float) -> str:
@@ -71,15 +73,14 @@ def log_box_axes(rec: rr.RecordingStream, path: str, frame: Frame2D, x_title: st
                                             radii=rr.Radius.ui_points(1.0)), static=True)
     h = frame.height
     left, bottom = frame.stored([x_lo], [y_lo])[0]
-    _text(rec, f"{path}/x_ticks", [(x * frame.x_scale, bottom + 0.05 * h) for x in xs],
-          [_fmt(x) for x in xs])
-    _text(rec, f"{path}/y_ticks", [(left - 0.08 * h, -y * frame.y_scale) for y in ys],
-          [_fmt(y) for y in ys])
+    log_labels(rec, f"{path}/x_ticks", [(x * frame.x_scale, bottom + 0.05 * h) for x in xs],
+               [_fmt(x) for x in xs])
+    log_labels(rec, f"{path}/y_ticks", [(left - 0.08 * h, -y * frame.y_scale) for y in ys],
+               [_fmt(y) for y in ys])
     right = x_hi * frame.x_scale
     top = -y_hi * frame.y_scale
-    _text(rec, f"{path}/titles", [(right - 0.1 * h, bottom + 0.13 * h), (left + 0.12 * h,
-                                                                          top - 0.06 * h)],
-          [x_title, y_title])
+    log_labels(rec, f"{path}/titles", [(right - 0.1 * h, bottom + 0.13 * h),
+                                       (left + 0.12 * h, top - 0.06 * h)], [x_title, y_title])
 
 
 def log_phase_reference(rec: rr.RecordingStream, frame: Frame2D) -> None:
@@ -107,10 +108,10 @@ def log_bottom_hole_reference(rec: rr.RecordingStream, units: PaperUnits,
             static=True)
     names = [("δ₀" if r == 1 else f"{r:g} δ₀") for r in radii]
     offset = 0.04 * frame.height
-    _text(rec, f"{ent.BOTTOM_HOLE_REFERENCE}/labels",
-          [(offset, -r * frame.y_scale - offset) for r in radii], names)
-    _text(rec, f"{ent.BOTTOM_HOLE_REFERENCE}/title", [(0.0, 0.5 * frame.height + 0.08)],
-          ["depth of cut at the bit angle, max(δ, 0)"])
+    log_labels(rec, f"{ent.BOTTOM_HOLE_REFERENCE}/labels",
+               [(offset, -r * frame.y_scale - offset) for r in radii], names)
+    log_labels(rec, f"{ent.BOTTOM_HOLE_REFERENCE}/title", [(0.0, 0.5 * frame.height + 0.08)],
+               ["depth of cut at the bit angle, max(δ, 0)"])
 
 
 def log_es_reference(rec: rr.RecordingStream, units: PaperUnits, frame: Frame2D) -> None:
@@ -135,7 +136,7 @@ def log_es_reference(rec: rr.RecordingStream, units: PaperUnits, frame: Frame2D)
     if trivial:
         spots.append((trivial[0][0] + 0.1 * h, trivial[0][1] + 0.07 * h))
         names.append("trivial (eq. 34)")
-    _text(rec, f"{ent.ES_POINTS}/labels", spots, names)
+    log_labels(rec, f"{ent.ES_POINTS}/labels", spots, names)
     log_box_axes(rec, ent.ES_REFERENCE, frame, "S = ⟨W⟩/⟨δ⟩",
                  "E = ⟨T⟩/⟨δ⟩")
 

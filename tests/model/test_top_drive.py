@@ -1,6 +1,7 @@
 """The top drive as an inertia turned by a motor (RGD07 eq. 12 extended), checked against
 physics: the stiff speed loop tends to the paper's imposed speed, the free oscillations of
-the drive on the string, the energy balance, the torque limit and bumpless mode switches."""
+the drive on the string, the energy balance, the torque limit, bumpless mode switches and the
+speed loop's anti-windup."""
 
 from __future__ import annotations
 
@@ -11,11 +12,12 @@ import pytest
 
 from drill_sim_ros.model import analysis as an
 from drill_sim_ros.model import kernel as k
+from drill_sim_ros.model import top_drive as td
 from drill_sim_ros.model.errors import ParameterError
-from drill_sim_ros.model.params import DimensionlessParams
+from drill_sim_ros.model.params import RPM_PER_RAD_S, DimensionlessParams
 from drill_sim_ros.model.presets import load_preset, preset_from_dict
 from drill_sim_ros.model.simulator import SimConfig, Simulator
-from drill_sim_ros.model.top_drive import TopDrive
+from drill_sim_ros.model.top_drive import TopDrive, TopDrivePhysical
 from tests.model.helpers import FIG8A
 
 FIG11_BASE = DimensionlessParams(n=6, psi=63.0, beta=0.28, lam=5.0, w0=8.5, omega0=4.0)
@@ -246,3 +248,98 @@ def test_inertial_drive_runs_are_chunking_invariant_and_resume_bit_for_bit(mode:
     assert sim.top_drive_mode == mode
     rest = sim.advance(35_000, every=10).data
     assert np.array_equal(rest, whole[2500:])
+
+
+# ---- the speed loop's anti-windup -------------------------------------------------------
+WINDUP_DT_S = 1e-4
+WINDUP_DRIVE = TopDrivePhysical()            # the field drive: J, kp, ki, a 50 kN m limit
+WINDUP_REF_RAD_S = 120.0 / RPM_PER_RAD_S
+DRILLING_NM = 20_000.0                        # the string's torque once it turns
+
+
+def _speed_loop_step(omega_s: float, integral: float, t_string: float,
+                     max_torque_nm: float) -> tuple[float, float]:
+    """One step of the drive's own speed loop (SI, no lag, no ramp): (omega_s, integral)."""
+    d = WINDUP_DRIVE
+    omega_next, _, integral, _ = td.drive_step(
+        td.TD_SPEED, omega_s, WINDUP_REF_RAD_S, integral, 0.0, t_string, WINDUP_REF_RAD_S,
+        0.0, math.inf, d.inertia_kg_m2, d.kp_nm_s, d.ki_nm, max_torque_nm, 1.0, WINDUP_DT_S)
+    return omega_next, integral
+
+
+def _plain_pi_step(omega_s: float, integral: float, t_string: float,
+                   max_torque_nm: float) -> tuple[float, float]:
+    """The same PI loop without anti-windup (the output clipped, the integral free)."""
+    d = WINDUP_DRIVE
+    err = WINDUP_REF_RAD_S - omega_s
+    integral += d.ki_nm * err * WINDUP_DT_S
+    motor = min(max(d.kp_nm_s * err + integral, -max_torque_nm), max_torque_nm)
+    return omega_s + (motor - t_string) / d.inertia_kg_m2 * WINDUP_DT_S, integral
+
+
+def _stuck_then_free(step, stuck_s: float, free_s: float) -> tuple[np.ndarray, np.ndarray]:
+    """The drive at rest, its loop fresh (integral 0), the string stuck: it holds the drive
+    with whatever torque the motor applies (so the drive stays at rest) for ``stuck_s``, then
+    turns with the drilling torque for ``free_s``. The speed error and the integral after
+    the release, one per step."""
+    limit = WINDUP_DRIVE.max_torque_nm
+    omega, integral = 0.0, 0.0
+    for _ in range(round(stuck_s / WINDUP_DT_S)):
+        omega, integral = step(omega, integral, limit, limit)    # saturated: motor = limit
+    assert omega == 0.0
+    errors, integrals = [], []
+    for _ in range(round(free_s / WINDUP_DT_S)):
+        errors.append(WINDUP_REF_RAD_S - omega)
+        integrals.append(integral)
+        omega, integral = step(omega, integral, DRILLING_NM, limit)
+    return np.array(errors), np.array(integrals)
+
+
+def _release_with_anti_windup(t_s: np.ndarray) -> np.ndarray:
+    """The speed error after the release by physics, for a loop whose integral did not move
+    while the motor was saturated (conditional integration): first the motor at its limit M
+    against the drilling torque T (the error falls at (M - T) / J), until kp e = M; from
+    there the linear loop J e' = -(kp e + x), x' = ki e with x = integral - T = -T. The field
+    drive is critically damped (ki = kp^2 / 4J, rate w = kp / 2J), so
+    e = (a + b t) exp(-w t), a = M / kp, b = -(M - T) / J + w a."""
+    d = WINDUP_DRIVE
+    m, j, kp = d.max_torque_nm, d.inertia_kg_m2, d.kp_nm_s
+    assert d.ki_nm == pytest.approx(kp**2 / (4.0 * j), rel=1e-12)
+    e_edge = m / kp
+    t_edge = (WINDUP_REF_RAD_S - e_edge) * j / (m - DRILLING_NM)
+    w = kp / (2.0 * j)
+    a, b = e_edge, -(m - DRILLING_NM) / j + w * e_edge
+    tl = np.maximum(t_s - t_edge, 0.0)
+    linear = (a + b * tl) * np.exp(-w * tl)
+    return np.where(t_s < t_edge, WINDUP_REF_RAD_S - (m - DRILLING_NM) / j * t_s, linear)
+
+
+def test_anti_windup_a_stuck_string_leaves_no_windup_for_its_release() -> None:
+    """3 s stuck against the full motor torque, then free: with anti-windup the integral
+    stays within the torque limit and the release is the physics of a loop that did not
+    wind up (no overshoot beyond the linear loop's); a plain PI loop winds up to
+    ki wref 3 s (1.7 MN m) and more, and overshoots by more than the whole setpoint."""
+    limit = WINDUP_DRIVE.max_torque_nm
+    errors, integrals = _stuck_then_free(_speed_loop_step, 3.0, 6.0)
+    assert np.all(np.abs(integrals) <= limit)
+    t_s = WINDUP_DT_S * np.arange(len(errors))
+    expected = _release_with_anti_windup(t_s)
+    # within one step's change of the error, (M - T) dt / J = 0.001 rad/s
+    np.testing.assert_allclose(errors, expected, rtol=0.0, atol=0.001)
+    assert -errors.min() < 0.005                 # the overshoot, rad/s (0.05 rpm)
+    assert abs(errors[-1]) < 1e-3                # back on the setpoint
+    plain, wound = _stuck_then_free(_plain_pi_step, 3.0, 6.0)
+    assert wound.max() > 20.0 * limit and -plain.min() > WINDUP_REF_RAD_S
+
+
+def test_anti_windup_a_limit_lowered_at_run_time_bounds_the_integral() -> None:
+    """Drilling, the integral holds the drilling torque and the drive runs a little below
+    its setpoint (the string loading up); the limit drops below that torque (a runtime
+    parameter) while the string keeps it: the drive slows, the motor saturates, and the
+    integral is held within the new limit, never above it."""
+    lower_nm = 0.5 * DRILLING_NM
+    omega, integral = WINDUP_REF_RAD_S - 0.1, DRILLING_NM
+    for _ in range(round(1.0 / WINDUP_DT_S)):
+        omega, integral = _speed_loop_step(omega, integral, DRILLING_NM, lower_nm)
+        assert abs(integral) <= lower_nm
+    assert omega < WINDUP_REF_RAD_S - 1.0                          # it did saturate

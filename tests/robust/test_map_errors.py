@@ -1,10 +1,13 @@
 """drill_sim map: every mistake is one line before any Dask work (no file left at --out),
-a wrong --scheduler ends within its timeout, --out is locked for the run, a failing
-controller is one line, the estimate and the rate are measured, Ctrl-C keeps the points."""
+a wrong --scheduler ends within its timeout, --out is locked for the run and its lock file
+goes when the map ends, a failing controller is one line, the estimate and the rate are
+measured, Ctrl-C keeps the points and says so on stderr."""
 
 from __future__ import annotations
 
+import contextlib
 import http.server
+import os
 import queue
 import signal
 import socket
@@ -147,6 +150,72 @@ def test_out_in_use_by_another_map_is_refused_at_start(capsys, tmp_path: Path,
         pass
 
 
+def test_the_lock_file_goes_when_a_map_ends(capsys, tmp_path: Path) -> None:
+    out = tmp_path / "map.nc"
+    rc, _, err = run_cli(capsys, *MAP, "--vary", "beta=0.2,0.4", "--out", str(out))
+    assert rc == 0, err
+    assert out.exists() and not store.lock_path(out).exists()
+
+
+def test_an_interrupted_map_says_so_on_stderr_and_its_lock_file_goes(
+        capsys, monkeypatch, tmp_path: Path) -> None:
+    """Ctrl-C while the map runs (KeyboardInterrupt out of run_map, no cluster needed)."""
+    out = tmp_path / "map.nc"
+    held = []
+
+    def interrupted(*_args, **_kwargs):
+        held.append(store.lock_path(out).exists())
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(engine, "connect", lambda *_args: contextlib.nullcontext(None))
+    monkeypatch.setattr(engine, "run_map", interrupted)
+    rc, stdout, err = run_cli(capsys, *MAP, "--vary", "beta=0.2,0.4", "--out", str(out))
+    assert rc == 130 and held == [True]
+    assert stdout == ""
+    assert err.strip().splitlines()[-1] == (
+        "drill_sim map: interrupted; no point was done; re-run the same command to resume")
+    assert not store.lock_path(out).exists()
+
+
+@pytest.mark.parametrize("ending", [None, KeyboardInterrupt, RuntimeError])
+def test_map_lock_removes_its_file_however_the_block_ends(tmp_path: Path, ending) -> None:
+    out = tmp_path / "map.nc"
+    with contextlib.ExitStack() as stack:
+        if ending is not None:
+            stack.enter_context(pytest.raises(ending))
+        with store.map_lock(out):
+            assert store.lock_path(out).read_text() == f"pid {os.getpid()}"
+            if ending is not None:
+                raise ending
+    assert not store.lock_path(out).exists()
+    with store.map_lock(out):                   # and the next run takes it
+        pass
+
+
+def test_a_lock_taken_on_a_file_its_holder_removed_is_taken_again(tmp_path: Path,
+                                                                   monkeypatch) -> None:
+    """A second map opens the lock file, then the first ends (removes it, lets go) before the
+    second locks it: the second must lock the file the name holds, or a third map could lock
+    a new file and run beside it."""
+    out = tmp_path / "map.nc"
+    lock = store.lock_path(out)
+    real_flock = store.fcntl.flock
+    removed = []
+
+    def flock_after_the_holder_ended(stream, operation):
+        if not removed:                         # the first attempt: the holder ends now
+            lock.unlink()
+            removed.append(stream.name)
+        return real_flock(stream, operation)
+
+    lock.write_text("pid 1")
+    monkeypatch.setattr(store.fcntl, "flock", flock_after_the_holder_ended)
+    with store.map_lock(out):
+        assert removed and lock.exists()
+        assert lock.read_text() == f"pid {os.getpid()}"
+    assert not lock.exists()
+
+
 def test_the_rate_is_measured_from_the_start() -> None:
     clock = iter([100.0, 110.0, 120.0])
     bar = progress.MapProgress(enabled=False)
@@ -214,13 +283,16 @@ def test_ctrl_c_keeps_the_points_done(tmp_path: Path) -> None:
         seen.append(lines.get(timeout=120))      # the size line, then the first result
     assert seen[0].startswith("drill_sim map: 200 points"), seen
     process.send_signal(signal.SIGINT)
-    stdout, _ = process.communicate(timeout=60)
-    reader.join(timeout=10)
+    process.wait(timeout=60)                    # (its stdout is a line at most)
+    reader.join(timeout=10)                     # stderr is the reader's alone, to its end
+    stdout = process.stdout.read()
     err = "".join(seen) + "".join(lines.queue)
     assert process.returncode == 130, err
     assert "Traceback" not in err
-    assert stdout.strip().splitlines() == [
+    assert stdout == ""
+    assert err.strip().splitlines()[-1] == (
         f"drill_sim map: interrupted; the points done are kept in {out}; re-run the same "
-        "command to resume"]
+        "command to resume")
     done = xr.load_dataset(out)["done"].values
     assert 1 <= int(np.sum(done)) < 200
+    assert not store.lock_path(out).exists()

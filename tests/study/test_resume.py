@@ -82,7 +82,8 @@ def test_ctrl_c_keeps_done_points_and_rerun_completes(tmp_path: Path) -> None:
     reader.join(timeout=WAIT_S)                  # stderr is the reader thread's alone
     stdout = proc.stdout.read()
     assert proc.returncode == 130, stdout + "".join(err)[-2000:]
-    assert "interrupted" in stdout
+    assert "interrupted" in "".join(err) and "interrupted" not in stdout     # on stderr
+    assert not store.lock_path(out).exists()
     kept = store.load(out)
     done_before = int(kept["done"].sum())
     assert 2 <= done_before < 36

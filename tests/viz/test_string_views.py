@@ -1,6 +1,7 @@
 """The string views of the dashboard: a run of the distributed field preset (the real
 session), written as MCAP by mcap_ros2's Writer with drill/string/torsion JointStates,
-through mcap_to_rerun, read back by rerun's own reader."""
+through mcap_to_rerun, read back by rerun's own reader: the bar charts, and the depth x time
+picture's layout, its colours centred on the mean speed, its depth axis and colour bar."""
 
 from __future__ import annotations
 
@@ -17,9 +18,19 @@ from drill_sim_ros import topics
 from drill_sim_ros.model.params import RPM_PER_RAD_S
 from drill_sim_ros.model.presets import load_preset
 from drill_sim_ros.model.session import SessionConfig, SimSession
-from drill_sim_ros.viz.string_views import IMAGE_PROFILES, speed_colors
+from drill_sim_ros.viz import entities as ent
+from drill_sim_ros.viz.string_views import (
+    FRAME_BOUNDS,
+    IMAGE_PROFILES,
+    LABEL_DROP,
+    MIDDLE_COLOUR,
+    NO_DATA,
+    PICTURE_HEIGHT,
+    ColourScale,
+    palette,
+)
 from tests.viz import expected as ex
-from tests.viz.rrd_read import read_recording, view_origins
+from tests.viz.rrd_read import read_recording, view_bounds, view_origins
 from tests.viz.sim_telemetry import FLOAT64_MULTI_ARRAY_DEF, SEPARATOR, telemetry_message
 
 SECONDS = 40.0
@@ -74,7 +85,7 @@ def run(tmp_path_factory: pytest.TempPathFactory) -> dict:
                           text=True, timeout=300, check=False)
     assert proc.returncode == 0, proc.stderr
     return {"rows": rows, "strings": strings, "depths": sim.string_depths_m, "rrd": rrd,
-            "data": read_recording(rrd)}
+            "data": read_recording(rrd), "info": sim.run_info()}
 
 
 def tensor(value: list) -> np.ndarray:
@@ -100,35 +111,107 @@ def test_bar_charts_hold_every_profile_in_display_units_over_depth(run: dict) ->
                                    np.round(run["depths"], 1))   # the names: 0.1 m
 
 
+def images(data) -> tuple[np.ndarray, list[np.ndarray]]:
+    """The stamps and RGB arrays of an image entity's rows (rows without an image left out)."""
+    rows = [(t, fmt[0], buf[0]) for t, fmt, buf in zip(
+        data.time_ns, data.columns["Image:format"], data.columns["Image:buffer"], strict=True)
+        if buf is not None]
+    return np.array([t for t, _, _ in rows]), [
+        np.frombuffer(bytes(buf), dtype=np.uint8).reshape(fmt["height"], fmt["width"], 3)
+        for _, fmt, buf in rows]
+
+
+def window_rpm(run: dict, image_ns: int) -> np.ndarray:
+    """(depths, profiles) speeds rpm of the profiles an image at ``image_ns`` shows: the last
+    IMAGE_PROFILES up to it."""
+    shown = [s for s in run["strings"] if s.stamp_ns <= image_ns][-IMAGE_PROFILES:]
+    return np.array([s.speed_rad_s for s in shown]).T * RPM_PER_RAD_S
+
+
 def test_depth_time_picture_rows_are_depths_columns_the_last_profiles(run: dict) -> None:
-    data = run["data"]["/string/depth_time"]
-    times_s = data.time_ns * 1e-9
+    stamps, pictures = images(run["data"][ent.STRING_PICTURE])
+    times_s = stamps * 1e-9
     assert len(times_s) == pytest.approx(SECONDS, abs=1)           # one per second
     assert np.all(np.diff(times_s) >= 1.0 - 1e-9)
-    fmt = data.columns["Image:format"][-1][0]
-    image = np.frombuffer(bytes(data.columns["Image:buffer"][-1][0]), dtype=np.uint8)
-    image = image.reshape(fmt["height"], fmt["width"], 3)
+    image = pictures[-1]
     assert image.shape == (len(run["depths"]), IMAGE_PROFILES, 3)
-    by_stamp = {s.stamp_ns: s for s in run["strings"]}
-    last = by_stamp[int(data.time_ns[-1])]
-    full_scale = 2.0 * load_preset(FIELD).physical.surface_rpm    # twice the preset's speed
-    np.testing.assert_array_equal(image[:, -1], speed_colors(last.speed_rad_s * RPM_PER_RAD_S,
-                                                             full_scale))
-    first = data.columns["Image:format"][0][0]
-    assert (first["width"], first["height"]) == (IMAGE_PROFILES, len(run["depths"]))
-    first_image = np.frombuffer(bytes(data.columns["Image:buffer"][0][0]), dtype=np.uint8)
-    assert np.all(first_image.reshape(first["height"], -1, 3)[:, :-1] == 255)   # t = 0 only
-    earlier = by_stamp[int(data.time_ns[-1]) - 100_000_000 * (IMAGE_PROFILES - 1)]
-    np.testing.assert_array_equal(image[:, 0], speed_colors(
-        earlier.speed_rad_s * RPM_PER_RAD_S, full_scale))
+    shown = window_rpm(run, int(stamps[-1]))
+    assert shown.shape[1] == IMAGE_PROFILES
+    scale = ColourScale.of(shown)
+    np.testing.assert_array_equal(image[:, -1], scale.colours(shown[:, -1]))
+    np.testing.assert_array_equal(image[:, 0], scale.colours(shown[:, 0]))
+    assert pictures[0].shape == (len(run["depths"]), IMAGE_PROFILES, 3)
+    assert np.all(pictures[0][:, :-1] == NO_DATA)                      # t = 0 only
+    # the rows are scaled to the frame's height, whatever the number of depths
+    scales = [v[0] for v in run["data"][ent.STRING_PICTURE].columns["Transform3D:scale"]
+              if v is not None]
+    assert scales == [pytest.approx([1.0, PICTURE_HEIGHT / len(run["depths"]), 1.0])]
 
 
-def test_colour_scale_stops_and_clamping() -> None:
-    stops = [(0, 0, 110), (30, 80, 220), (0, 200, 230), (60, 190, 60), (245, 225, 40),
-             (230, 50, 30), (120, 0, 0)]           # dark blue .. dark red, evenly spaced
-    at_stops = speed_colors(np.linspace(0.0, 150.0, 7), 150.0)
-    np.testing.assert_array_equal(at_stops, stops)
-    np.testing.assert_array_equal(speed_colors(np.array([-10.0, 900.0]), 150.0),
-                                  [stops[0], stops[-1]])
-    halfway = speed_colors(np.array([12.5]), 150.0)[0]          # between the first two
-    np.testing.assert_array_equal(halfway, [15, 40, 165])
+def test_depth_time_colours_are_centred_on_the_mean_speed(run: dict) -> None:
+    """White (the middle colour) where the speed is the mean of the profiles shown, blue
+    where it is well below it, red where well above; the colour bar's middle label is the
+    mean, and its middle row the middle colour."""
+    stamps, pictures = images(run["data"][ent.STRING_PICTURE])
+    for stamp, image in zip(stamps[-10:], pictures[-10:], strict=True):
+        shown = window_rpm(run, int(stamp))
+        picture = image[:, IMAGE_PROFILES - shown.shape[1]:].astype(np.int64)
+        deviation = shown - shown.mean()
+        reach = np.abs(deviation).max()
+        assert reach > 5.0                          # the string is not steady here
+        near = np.abs(deviation) < 0.01 * reach
+        assert near.sum() > 10
+        assert np.abs(picture[near] - MIDDLE_COLOUR).max() <= 6
+        red, blue = picture[..., 0], picture[..., 2]
+        slow, fast = deviation < -0.3 * reach, deviation > 0.3 * reach
+        assert slow.any() and fast.any()
+        assert np.all(blue[slow] > red[slow]) and np.all(red[fast] > blue[fast])
+    labels = run["data"][ent.STRING_SCALE_LABELS]
+    values = labels.columns["Points2D:labels"][-1]
+    assert values[-1] == "rpm"
+    ticks = np.array([float(v) for v in values[:-1]])                # fast at the top
+    assert np.all(np.diff(ticks) < 0)
+    assert ticks[len(ticks) // 2] == pytest.approx(window_rpm(run, int(stamps[-1])).mean(),
+                                                   abs=0.5)           # labels to 1 rpm
+    np.testing.assert_allclose(ticks - ticks[len(ticks) // 2],
+                               -(ticks[::-1] - ticks[len(ticks) // 2]), atol=1.0)
+    bar = images(run["data"][ent.STRING_COLOUR_BAR])[1][-1]
+    assert tuple(bar[len(bar) // 2, 0]) == MIDDLE_COLOUR
+    assert bar[0, 0, 0] > bar[0, 0, 2] and bar[-1, 0, 2] > bar[-1, 0, 0]   # red top, blue
+
+
+def test_depth_time_view_has_a_depth_axis_in_metres(run: dict) -> None:
+    """Tick labels in m at their depths below the top of the string (its length from the
+    preset's sections), the axis titled, and the view framed by FRAME_BOUNDS."""
+    length_m = sum(section["length_m"] for section in run["info"]["string"]["sections"])
+    axis = run["data"][ent.STRING_DEPTH_AXIS]
+    labels = axis.columns["Points2D:labels"][-1]
+    positions = np.array(axis.columns["Points2D:positions"][-1])
+    assert labels[-1] == "depth [m]"
+    depths = np.array([float(v) for v in labels[:-1]])
+    assert labels[0] == "0" and depths[-1] <= length_m and len(depths) >= 4
+    np.testing.assert_allclose(positions[:-1, 1] + LABEL_DROP,
+                               depths / length_m * PICTURE_HEIGHT, atol=1e-3)
+    assert np.all(positions[:-1, 0] < 0.0)                             # left of the picture
+    bounds = view_bounds(run["rrd"])[ent.STRING_DEPTH_TIME]
+    assert bounds == (pytest.approx(list(FRAME_BOUNDS[0])), pytest.approx(list(FRAME_BOUNDS[1])))
+
+
+def test_the_palette_diverges_from_white() -> None:
+    """Dark blue at 0, white in the middle, dark red at 1; clamped beyond; the luminance
+    falls from the middle to both ends, which are both dark (a diverging map)."""
+    ends = palette(np.array([0.0, 0.5, 1.0, -3.0, 7.0]))
+    np.testing.assert_array_equal(ends, [(5, 48, 97), MIDDLE_COLOUR, (103, 0, 31),
+                                         (5, 48, 97), (103, 0, 31)])
+    assert MIDDLE_COLOUR == (247, 247, 247)
+    steps = np.linspace(0.0, 0.5, 26)
+    lightness = palette(np.concatenate((0.5 - steps, 0.5 + steps))).astype(float) @ (
+        0.2126, 0.7152, 0.0722)
+    below, above = lightness[:26], lightness[26:]
+    assert np.all(np.diff(below) <= 0) and np.all(np.diff(above) <= 0)
+    assert max(below[-1], above[-1]) < 0.2 * below[0]
+    halfway = palette(np.array([0.05]))[0]                  # between the first two stops
+    np.testing.assert_array_equal(halfway, [19, 75, 134])
+    scale = ColourScale(centre_rpm=60.0, half_span_rpm=20.0)
+    np.testing.assert_array_equal(scale.colours(np.array([40.0, 60.0, 80.0, 200.0])),
+                                  palette(np.array([0.0, 0.5, 1.0, 1.0])))
