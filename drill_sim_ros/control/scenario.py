@@ -58,7 +58,7 @@ from drill_sim_ros.model.presets import (
     preset_from_dict,
     preset_path,
 )
-from drill_sim_ros.model.validate_input import check_preset_mapping
+from drill_sim_ros.model.validate_input import read_preset_file
 
 SCENARIO_KEYS = ("preset", "duration_s", "control_rate_hz", "mode", "controller", "params",
                  "enable_at_s", "schedule", "sensors", "description", "overrides", "drive",
@@ -155,14 +155,13 @@ class Scenario:
         if not overrides:
             return load_preset(self.preset)
         path = preset_path(self.preset)
-        data = yaml.safe_load(path.read_text()) or {}
+        data = read_preset_file(path) or {}
         for section, values in overrides.items():
             if not isinstance(data.get(section, {}), dict):
                 raise ParameterError(f"scenario: overrides.{section}: the preset's {section} "
                                      "is not a mapping")
             data[section] = {**(data.get(section) or {}), **values}
         try:
-            check_preset_mapping(data)
             return preset_from_dict(path.stem, data)
         except (ParameterError, TypeError) as exc:
             raise ParameterError(f"scenario: overrides of preset {self.preset!r}: {exc}"

@@ -10,10 +10,17 @@ A step reads as three calls on one state:
    string's bottom end in affine form;
 2. the top drive (:mod:`drill_sim_ros.model.top_drive`): its speed at the end of the step
    against the string torque at the quill (kinematic, speed loop or torque mode);
-3. the string (:mod:`drill_sim_ros.model.string`): ``lumped`` is RGD07's spring C with the
-   BHA at the bit (eq. 25, symplectic Euler as eq. C.1 with the updated velocities);
-   ``distributed`` is a chain of wave-guide sections carrying torsional and axial waves,
-   moved on by one step between the drive's and the bit's new speeds.
+3. the string (:mod:`drill_sim_ros.model.string`), one seam: ``string.ends`` before the
+   bit law, ``string.advance`` after it. ``lumped`` is RGD07's spring C with the BHA at the
+   bit (eq. 25, symplectic Euler as eq. C.1 with the updated velocities); ``distributed`` is
+   a chain of wave-guide sections carrying torsional and axial waves, moved on by one step
+   between the drive's and the bit's new speeds.
+
+The loop (:func:`_steps`) keeps the bookkeeping: the sample rows, the statistics, the dry
+step, the status. The physics of a step is in scalar helpers (:func:`_respond`,
+:func:`_drive`, :func:`_moved`) that take and return named tuples (compiled as plain
+locals); the arrays are touched in the loop only, since an array handed down through an
+inlined helper costs reference counting in the hot path (measured: up to twice the time).
 
 Absolute variables (so the surface inputs may change at any step): ``U`` bit depth (down
 positive), ``V = dU/dtau``; ``PHI`` bit angle, ``OMEGA = dPHI/dtau`` (never negative);
@@ -32,6 +39,7 @@ whatever the state (a step that would pass a whole blade sector is a runaway).
 from __future__ import annotations
 
 import math
+from collections import namedtuple
 
 import numpy as np
 from numba import njit
@@ -138,6 +146,33 @@ A_FIRST_STICK = 11  # tau of the first stick (nan if none), whole run
 A_FIRST_BOUNCE = 12  # tau of the first off-bottom step (nan if none), whole run
 N_ACC = 13
 
+# ---- what a step carries (named tuples: compiled as plain locals) ----------------------
+Loop = namedtuple("Loop", (
+    "u", "v", "phi", "omega", "phi_s", "omega_s", "w_app", "stuck", "node", "frac", "h_old",
+    "step", "omega_ref", "integral", "motor", "v_hook", "hook_int", "head", "count",
+    "cursor"))
+Loop.__doc__ = """The loop-carried state of a run (the ``S_*`` slots and the history's bookkeeping
+``meta``: head, count, cursor)."""
+Law = namedtuple("Law", (
+    "dt", "tau_avg", "beta", "lam", "n_blades", "psi", "off_bottom", "layer_u", "cut_factor",
+    "sector", "tgt_w", "w_rate", "inv_spacing", "hook_kp", "hook_ki"))
+Law.__doc__ = """A run's constants of the bit law, the rock and the hook: dtau, the statistics
+window start, beta, lambda, n, psi, off bottom, the next layer's top, the cutting factor, the
+blade sector 2 pi / n, the applied weight's target and ramp rate, the profile's nodes per
+radian, the hook's WOB loop gains."""
+Drive = namedtuple("Drive", (
+    "mode", "omega", "torque", "omega_rate", "inertia", "kp", "ki", "max_torque", "lag_alpha"))
+Drive.__doc__ = """A run's top-drive parameters and commands (top_drive.drive_step)."""
+Response = namedtuple("Response", (
+    "cursor", "doc", "t_top", "f_top", "v_new", "omega_new", "u_new", "phi_new", "w_f", "wob",
+    "tob", "mode", "stuck", "v_hook", "hook_int"))
+Response.__doc__ = """What a step computes on the bit's side before anything moves: the exact
+delay's cursor, the depth of cut, the string's torque and force at the top, the bit's new
+speeds, depth and angle, forces and mode (eqs. 29-33, C.1), the hook's speed and integral."""
+DriveStep = namedtuple("DriveStep", ("omega_s_next", "omega_ref", "integral", "motor"))
+DriveStep.__doc__ = """The drive over a step: its speed at the end, the setpoint in force, the
+speed loop's integral, the motor torque (top_drive.drive_step)."""
+
 STATUS_OK = 0
 STATUS_NONFINITE = 1
 STATUS_HISTORY_FULL = 2
@@ -191,58 +226,6 @@ def _accumulate(acc: np.ndarray, tau: float, tau_avg: float, mode: int, w_f: flo
 
 
 @njit(cache=True, inline="always")
-def _lumped_ends(psi: float, dt: float, phi_s: float, phi: float, v: float, omega: float,
-                 w_app: float) -> tuple[float, ...]:
-    """What RGD07's lumped string (eq. 25) presents over this step: at the bit, the affine
-    forms of the bit law (bit_rock) ``v0, kick_v, f_ext, omega0, kick_w, t_ext``, with the
-    spring torque PHI_S - PHI and psi dtau on the applied weight; at the top, the string
-    torque at the quill and the force at the hook (the applied weight)."""
-    t_pipe = phi_s - phi                      # pipe torque C (PHI_S - PHI), scaled
-    return v, psi * dt, w_app, omega, dt, t_pipe, t_pipe, w_app
-
-
-@njit(cache=True, inline="always")
-def _string_params(prm: np.ndarray, wave_i: np.ndarray | None) -> tuple:
-    """The distributed string's parameters for a run, read once (like :func:`_law_params`):
-    the torsional parts, all parts, the bit's lumped inertia, the hook's WOB loop gains, a
-    fixed hook (off bottom) and the torsional bottom's echo (0: anechoic, 1: the bit's)."""
-    return (int(prm[P_PARTS_T]), 0 if wave_i is None else wave_i.shape[1], prm[P_BIT_INERTIA],
-            prm[P_HOOK_KP], prm[P_HOOK_KI], prm[P_OFF_BOTTOM] != 0.0,
-            0.0 if prm[P_OFF_BOTTOM] == 2.0 else 1.0)
-
-
-@njit(cache=True, inline="always")
-def _distributed_ends(wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray,
-                      parts_t: int, parts: int, bit_inertia: float, dt: float,
-                      omega_s: float, v: float, omega: float,
-                      v_hook: float) -> tuple[float, ...]:
-    """The same for a distributed string (module string): the arriving waves and the end
-    impedances, with the bit's lumped inertia; at the top b + Z w with the drive's and the
-    hook's speeds."""
-    z = sg.W_Z                                # (in place: no row view, see sg.scatter)
-    b_top_t, a_bot_t = sg.arriving(wave, wave_i, 0, parts_t)
-    b_top_a, a_bot_a = sg.arriving(wave, wave_i, parts_t, parts)
-    v0, kick_v, f_ext = sg.bottom_end(a_bot_a, wave_f[z, parts - 1], 0.0, v, dt)
-    omega0, kick_w, t_ext = sg.bottom_end(a_bot_t, wave_f[z, parts_t - 1], bit_inertia,
-                                          omega, dt)
-    return (v0, kick_v, f_ext, omega0, kick_w, t_ext, b_top_t + wave_f[z, 0] * omega_s,
-            b_top_a + wave_f[z, parts_t] * v_hook)
-
-
-@njit(cache=True, inline="always")
-def _string_ends(wave: np.ndarray | None, wave_i: np.ndarray | None, wave_f: np.ndarray | None,
-                 parts_t: int, parts: int, bit_inertia: float, psi: float, dt: float,
-                 phi_s: float, phi: float, v: float, omega: float, w_app: float,
-                 omega_s: float, v_hook: float) -> tuple[float, ...]:
-    """What the string presents over this step: lumped (``wave`` None, compiled apart) or
-    distributed."""
-    if wave is None:
-        return _lumped_ends(psi, dt, phi_s, phi, v, omega, w_app)
-    return _distributed_ends(wave, wave_i, wave_f, parts_t, parts, bit_inertia, dt, omega_s,
-                             v, omega, v_hook)
-
-
-@njit(cache=True, inline="always")
 def _hook(kp: float, ki: float, fixed: bool, dt: float, w_app: float, f_top: float,
           integral: float) -> tuple[float, float]:
     """The hook's speed over the step: a PI loop (gains ``kp``, ``ki``) on the applied-WOB
@@ -265,20 +248,20 @@ def _cutting(cut_factor: float, off_bottom: bool, doc: float) -> float:
 
 
 @njit(cache=True, inline="always")
-def _write_row(out: np.ndarray, n_rows: int, tau: float, x: tuple) -> int:
-    """Sample row ``n_rows`` of ``out`` (columns C_*: tau, then ``x`` in column order), the
-    state at the start of the step; returns the rows written. Called only when a row is due:
-    an array handed to an inlined function costs a reference count (two calls, around which
-    every register spills), so ``out`` stays out of the per-step path."""
-    u, v, phi, omega, phi_s, omega_s, w_app, wob, tob, doc, w_f, t_top, mode, motor, \
-        omega_ref, f_top, omega_bha = x
-    r = out[n_rows]
-    r[C_TAU], r[C_U], r[C_V], r[C_PHI], r[C_OMEGA] = tau, u, v, phi, omega
-    r[C_PHI_S], r[C_OMEGA_S], r[C_W_APP] = phi_s, omega_s, w_app
-    r[C_WOB], r[C_TOB], r[C_DOC], r[C_WF] = wob, tob, doc, w_f
-    r[C_T_PIPE], r[C_MODE] = t_top, mode
-    r[C_MOTOR_TORQUE], r[C_OMEGA_REF] = motor, omega_ref
-    r[C_F_TOP], r[C_OMEGA_BHA] = f_top, omega_bha
+def _write_row(out: np.ndarray, n_rows: int, x: Loop, r: Response, d: DriveStep,
+               dt: float, omega_bha: float) -> int:
+    """Sample row ``n_rows`` of ``out`` (columns C_*): the state ``x`` at the start of the
+    step and what the step ``r``, ``d`` computed from it; returns the rows written. Called only
+    when a row is due: an array handed to an inlined function costs a reference count (two
+    calls, around which every register spills), so ``out`` stays out of the per-step path."""
+    row = out[n_rows]
+    row[C_TAU], row[C_U], row[C_V], row[C_PHI], row[C_OMEGA] = \
+        x.step * dt, x.u, x.v, x.phi, x.omega
+    row[C_PHI_S], row[C_OMEGA_S], row[C_W_APP] = x.phi_s, x.omega_s, x.w_app
+    row[C_WOB], row[C_TOB], row[C_DOC], row[C_WF] = r.wob, r.tob, r.doc, r.w_f
+    row[C_T_PIPE], row[C_MODE] = r.t_top, r.mode
+    row[C_MOTOR_TORQUE], row[C_OMEGA_REF] = d.motor, d.omega_ref
+    row[C_F_TOP], row[C_OMEGA_BHA] = r.f_top, omega_bha
     return n_rows + 1
 
 
@@ -297,74 +280,118 @@ def _steps(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarray
            hist: np.ndarray, meta: np.ndarray, acc: np.ndarray, out: np.ndarray,
            wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray,
            n_steps: int, every: int, exact: bool, dry: bool) -> tuple[int, int]:
-    """:func:`advance`; ``dry``: only the first step's sample row, then back: the state, the
-    profile or history, the string and the statistics are read, never written."""
-    u, v, phi, omega, phi_s, omega_s, w_app, stuck, node, frac, h_old, step, omega_ref, \
-        integral, motor, v_hook, hook_int, head, count, cursor = _unpack(st, meta)
-    dt, tau_avg, beta, lam, n_blades, psi, off_bottom, layer_u, cut_factor, sector, tgt_w, \
-        w_rate, inv_spacing, bha = _law_params(prm, tgt, profile)
-    td_mode, tgt_omega, tgt_torque, omega_rate, td_j, td_kp, td_ki, td_max, td_lag, _ = \
-        _drive_params(prm, tgt)
-    parts_t, parts, bit_inertia, hook_kp, hook_ki, hook_fixed, echo = _string_params(prm, wave_i)
-    countdown, n_rows, status, probe = _first_countdown(step, every), 0, STATUS_OK, 0.0
-    for _ in range(n_steps):
-        if exact:                     # the delay: U(tau - tau_n), eqs. 6-7, 26-28
-            surface, cursor = br.delayed_depth(hist[0], hist[1], head, count, cursor, phi - sector)
-        else:
-            surface = br.profile_surface(profile, node, frac, h_old)
-        doc = n_blades * (u - surface)          # delta = n (U - U(tau - tau_n)), eq. 8
-        v0, kick_v, f_ext, omega0, kick_w, t_ext, t_top, f_top = _string_ends(
-            wave, wave_i, wave_f, parts_t, parts, bit_inertia, psi, dt, phi_s, phi, v, omega,
-            w_app, omega_s, v_hook)
-        v_new, omega_new, w_f, wob, tob, mode, stuck = br.bit_response(
-            v0, kick_v, f_ext, omega0, kick_w, t_ext, _cutting(cut_factor, off_bottom, doc),
-            stuck, beta, lam)
-        omega_s_next, omega_ref, integral, motor = drive_step(   # the lag's last torque is
-            td_mode, omega_s, omega_ref, integral, st[S_MOTOR_TORQUE], t_top, tgt_omega,
-            tgt_torque, omega_rate, td_j, td_kp, td_ki, td_max, td_lag, dt)
-        probe += w_f + tob + motor              # (a NaN survives the contact logic)
+    """:func:`advance` (module doc); ``dry``: the first step's row only, nothing else written."""
+    x, law, drive, lay = _unpack(st, meta), *_run_params(prm, tgt, profile, wave_i)
+    countdown, n_rows, status, probe = _first_countdown(x.step, every), 0, STATUS_OK, 0.0
+    for _ in range(n_steps):      # the delay: U(tau - tau_n), eqs. 6-7, 26-28
+        surface, cursor = br.delayed_depth(hist[0], hist[1], x.head, x.count, x.cursor,
+            x.phi - law.sector) if exact else (br.profile_surface(profile, x.node, x.frac,
+                                                                   x.h_old), x.cursor)
+        r = _respond(x, law, surface, cursor, sg.ends(
+            wave, wave_i, wave_f, lay, law.psi, law.dt, x.phi_s, x.phi, x.v, x.omega, x.w_app,
+            x.omega_s, x.v_hook), wave is None)
+        d = _drive(x, drive, law.dt, st[S_MOTOR_TORQUE], r.t_top)  # the lag's last torque
         if countdown == 0 and n_rows < out.shape[0]:      # the sample at the step's start
-            n_rows = _write_row(out, n_rows, step * dt, (u, v, phi, omega, phi_s, omega_s, w_app,
-                wob, tob, doc, w_f, t_top, mode, motor, omega_ref, f_top,
-                omega if wave is None else sg.speed_at_top_of(wave, wave_i, wave_f, bha)))
+            n_rows = _write_row(out, n_rows, x, r, d, law.dt,
+                                sg.bha_speed(wave, wave_i, wave_f, lay, x.omega))
         countdown = every - 1 if countdown == 0 else countdown - 1
         if dry:                       # (nothing written before this line but the row)
             return STATUS_OK, n_rows
-        st[S_MOTOR_TORQUE] = motor    # read back from st: no register held through the bit law
-        _accumulate(acc, step * dt, tau_avg, mode, w_f, tob, doc, wob, omega, t_top, v)
-        if wave is not None:          # the hook's WOB loop, then the string one step on
-            v_hook, hook_int = _hook(hook_kp, hook_ki, hook_fixed, dt, w_app, f_top, hook_int)
-            sg.drive_line(wave, wave_i, wave_f, 0, parts_t, omega_s_next, omega_new, echo)
-            sg.drive_line(wave, wave_i, wave_f, parts_t, parts, v_hook, v_new, 1.0)
-        phi_s += (omega_s if wave is None and td_mode == TD_KINEMATIC else omega_s_next) * dt
-        omega_s = omega_s_next
-        u_new, phi_new = u + v_new * dt, phi + omega_new * dt     # symplectic Euler, eq. C.1
-        if exact:
-            head, count, cursor, ok = br.history_store(hist, head, count, cursor, phi,
-                                                       phi_new, u_new)
+        st[S_MOTOR_TORQUE] = d.motor      # (read back: no register held through the bit law)
+        probe += r.w_f + r.tob + d.motor
+        _accumulate(acc, x.step * law.dt, law.tau_avg, r.mode, r.w_f, r.tob, r.doc, r.wob,
+                    x.omega, r.t_top, x.v)
+        sg.advance(wave, wave_i, wave_f, lay, d.omega_s_next, r.v_hook, r.omega_new, r.v_new)
+        head, count, node, frac, h_old = x.head, x.count, x.node, x.frac, x.h_old
+        if exact:                     # the rock: the history stored, or re-cut under a blade
+            head, count, cursor, ok = br.history_store(hist, head, count, r.cursor, x.phi,
+                                                       r.phi_new, r.u_new)
         else:
-            node, frac, h_old, ok = br.profile_recut(profile, node, frac, h_old, u, u_new,
-                                                     (phi_new - phi) * inv_spacing)
-        u, v, phi, omega = u_new, v_new, phi_new, omega_new
-        w_app, step = ramp(w_app, tgt_w, w_rate, dt), step + 1
-        if not ok or u >= layer_u:
-            status = STATUS_LAYER if ok else (STATUS_HISTORY_FULL if exact else STATUS_RUNAWAY)
+            node, frac, h_old, ok = br.profile_recut(profile, node, frac, h_old, x.u, r.u_new,
+                                                     (r.phi_new - x.phi) * law.inv_spacing)
+        x = _moved(x, r, d, law, drive.mode == TD_KINEMATIC and wave is None, node, frac,
+                   h_old, head, count, cursor)
+        status = _stopped(ok, exact, x.u, law.layer_u)
+        if status != STATUS_OK:
             break
-    _pack(st, meta, u, v, phi, omega, phi_s, omega_s, w_app, stuck, node, frac, h_old, step,
-          omega_ref, integral, motor, v_hook, hook_int, dt, head, count, cursor)
-    return _finish(status, (u, v, phi, omega, omega_s, probe)), n_rows
+    _pack(st, meta, x, law.dt)
+    return _finish(status, (x.u, x.v, x.phi, x.omega, x.omega_s, probe)), n_rows
 
 
 @njit(cache=True, inline="always")
-def _law_params(prm: np.ndarray, tgt: np.ndarray, profile: np.ndarray) -> tuple:
-    """dtau, the statistics window start, beta, lambda, n, psi, off bottom, the next layer's
-    top, the cutting factor, the blade sector 2 pi / n, the applied weight's target and its
-    ramp rate, the profile's nodes per radian and the part whose top is the BHA, read once
-    for a run."""
+def _respond(x: Loop, law: Law, surface: float, cursor: int, ends: tuple,
+             lumped: bool) -> Response:
+    """The bit's side of a step from ``x``, given the rock surface under the bit and what
+    the string presents at its ends (string.ends): the depth of cut (eq. 8), the bit law
+    (eqs. 29-33) and the bit's new depth and angle (symplectic Euler, eq. C.1), and the
+    hook's WOB loop on the force at the top."""
+    doc = law.n_blades * (x.u - surface)        # delta = n (U - U(tau - tau_n)), eq. 8
+    v0, kick_v, f_ext, omega0, kick_w, t_ext, t_top, f_top = ends
+    v_new, omega_new, w_f, wob, tob, mode, stuck = br.bit_response(
+        v0, kick_v, f_ext, omega0, kick_w, t_ext, _cutting(law.cut_factor, law.off_bottom, doc),
+        x.stuck, law.beta, law.lam)
+    v_hook, hook_int = x.v_hook, x.hook_int
+    if not lumped:                # the hook's WOB loop
+        v_hook, hook_int = _hook(law.hook_kp, law.hook_ki, law.off_bottom, law.dt, x.w_app,
+                                 f_top, hook_int)
+    return Response(cursor, doc, t_top, f_top, v_new, omega_new, x.u + v_new * law.dt,
+                    x.phi + omega_new * law.dt, w_f, wob, tob, mode, stuck, v_hook, hook_int)
+
+
+@njit(cache=True, inline="always")
+def _drive(x: Loop, drive: Drive, dt: float, last_motor: float, t_top: float) -> DriveStep:
+    """The top drive over the step against the string torque at the quill ``t_top``, its
+    motor torque lagging from ``last_motor`` (top_drive.drive_step)."""
+    return DriveStep(*drive_step(drive.mode, x.omega_s, x.omega_ref, x.integral, last_motor,
+                                 t_top, drive.omega, drive.torque, drive.omega_rate,
+                                 drive.inertia, drive.kp, drive.ki, drive.max_torque,
+                                 drive.lag_alpha, dt))
+
+
+@njit(cache=True, inline="always")
+def _moved(x: Loop, r: Response, d: DriveStep, law: Law, lumped_kinematic: bool, node: int,
+           frac: float, h_old: float, head: int, count: int, cursor: int) -> Loop:
+    """The state after step ``r``, ``d`` over the rock's new bookkeeping: the bit moved
+    (eq. C.1), the drive's angle on (RGD07's kinematic drive on the lumped string turns at
+    the old speed), the applied weight ramped."""
+    phi_s = x.phi_s + (x.omega_s if lumped_kinematic else d.omega_s_next) * law.dt
+    return Loop(r.u_new, r.v_new, r.phi_new, r.omega_new, phi_s, d.omega_s_next,
+                ramp(x.w_app, law.tgt_w, law.w_rate, law.dt), r.stuck, node, frac, h_old,
+                x.step + 1, d.omega_ref, d.integral, d.motor, r.v_hook, r.hook_int, head,
+                count, cursor)
+
+
+@njit(cache=True, inline="always")
+def _string_layout(prm: np.ndarray, wave_i: np.ndarray | None) -> tuple:
+    """The distributed string's layout for a run (string.layout) from the parameters."""
+    return sg.layout(wave_i, int(prm[P_PARTS_T]), prm[P_BIT_INERTIA],
+                     0.0 if prm[P_OFF_BOTTOM] == 2.0 else 1.0, int(prm[P_BHA_PART]))
+
+
+@njit(cache=True, inline="always")
+def _stopped(ok: bool, exact: bool, u: float, layer_u: float) -> int:
+    """Whether a run stops after this step, and why: the next layer's top reached, a
+    runaway or a full history (STATUS_OK: it goes on)."""
+    if not ok:
+        return STATUS_HISTORY_FULL if exact else STATUS_RUNAWAY
+    return STATUS_LAYER if u >= layer_u else STATUS_OK
+
+
+@njit(cache=True, inline="always")
+def _run_params(prm: np.ndarray, tgt: np.ndarray, profile: np.ndarray,
+                wave_i: np.ndarray | None) -> tuple[Law, Drive, tuple]:
+    """A run's constants, read once: the bit law's and the hook's, the drive's, the
+    string's layout."""
+    return _law_params(prm, tgt, profile), _drive_params(prm, tgt), _string_layout(prm, wave_i)
+
+
+@njit(cache=True, inline="always")
+def _law_params(prm: np.ndarray, tgt: np.ndarray, profile: np.ndarray) -> Law:
+    """The run's constants of the bit law, the rock and the hook, read once (:class:`Law`)."""
     sector = 2.0 * math.pi / prm[P_N]
-    return (prm[P_DT], prm[P_TAU_AVG], prm[P_BETA], prm[P_LAM], prm[P_N], prm[P_PSI],
-            prm[P_OFF_BOTTOM] != 0.0, prm[P_LAYER_U], prm[P_CUT], sector, tgt[I_W_APP],
-            prm[P_W_RATE], profile.shape[0] / sector, int(prm[P_BHA_PART]))
+    return Law(prm[P_DT], prm[P_TAU_AVG], prm[P_BETA], prm[P_LAM], prm[P_N], prm[P_PSI],
+               prm[P_OFF_BOTTOM] != 0.0, prm[P_LAYER_U], prm[P_CUT], sector, tgt[I_W_APP],
+               prm[P_W_RATE], profile.shape[0] / sector, prm[P_HOOK_KP], prm[P_HOOK_KI])
 
 
 @njit(cache=True, inline="always")
@@ -378,37 +405,33 @@ def _finish(status: int, values: tuple) -> int:
 
 
 @njit(cache=True, inline="always")
-def _drive_params(prm: np.ndarray, tgt: np.ndarray) -> tuple:
+def _drive_params(prm: np.ndarray, tgt: np.ndarray) -> Drive:
     """The drive's parameters and commands for a run, read once (top_drive.drive_step)."""
-    return (int(prm[P_TD_MODE]), tgt[I_OMEGA_S], tgt[I_MOTOR_TORQUE], prm[P_OMEGA_RATE],
-            prm[P_TD_INERTIA], prm[P_TD_KP], prm[P_TD_KI], prm[P_TD_MAX_TORQUE],
-            prm[P_TD_LAG_ALPHA], prm[P_DT])
+    return Drive(int(prm[P_TD_MODE]), tgt[I_OMEGA_S], tgt[I_MOTOR_TORQUE], prm[P_OMEGA_RATE],
+                 prm[P_TD_INERTIA], prm[P_TD_KP], prm[P_TD_KI], prm[P_TD_MAX_TORQUE],
+                 prm[P_TD_LAG_ALPHA])
 
 
 @njit(cache=True, inline="always")
-def _unpack(st: np.ndarray, meta: np.ndarray) -> tuple:
-    """The state vector and the history's bookkeeping as the loop's locals."""
-    return (st[S_U], st[S_V], st[S_PHI], st[S_OMEGA], st[S_PHI_S], st[S_OMEGA_S],
-            st[S_W_APP], st[S_STUCK] != 0.0, int(st[S_NODE]), st[S_FRAC], st[S_H_OLD],
-            int(st[S_STEP]), st[S_OMEGA_REF], st[S_TD_INTEGRAL], st[S_MOTOR_TORQUE],
-            st[S_V_HOOK], st[S_HOOK_INTEGRAL], meta[0], meta[1], meta[2])
+def _unpack(st: np.ndarray, meta: np.ndarray) -> Loop:
+    """The state vector and the history's bookkeeping as the loop's state."""
+    return Loop(st[S_U], st[S_V], st[S_PHI], st[S_OMEGA], st[S_PHI_S], st[S_OMEGA_S],
+                st[S_W_APP], st[S_STUCK] != 0.0, int(st[S_NODE]), st[S_FRAC], st[S_H_OLD],
+                int(st[S_STEP]), st[S_OMEGA_REF], st[S_TD_INTEGRAL], st[S_MOTOR_TORQUE],
+                st[S_V_HOOK], st[S_HOOK_INTEGRAL], meta[0], meta[1], meta[2])
 
 
 @njit(cache=True, inline="always")
-def _pack(st: np.ndarray, meta: np.ndarray, u: float, v: float, phi: float, omega: float,
-          phi_s: float, omega_s: float, w_app: float, stuck: bool, node: int, frac: float,
-          h_old: float, step: int, omega_ref: float, integral: float, motor: float,
-          v_hook: float, hook_int: float, dt: float, head: int, count: int,
-          cursor: int) -> None:
-    """The loop's locals back into the state vector and the history's bookkeeping."""
-    meta[0], meta[1], meta[2] = head, count, cursor
-    st[S_U], st[S_V], st[S_PHI], st[S_OMEGA] = u, v, phi, omega
-    st[S_PHI_S], st[S_OMEGA_S], st[S_W_APP] = phi_s, omega_s, w_app
-    st[S_STUCK] = 1.0 if stuck else 0.0
-    st[S_NODE], st[S_FRAC], st[S_H_OLD] = node, frac, h_old
-    st[S_STEP], st[S_TAU] = step, step * dt
-    st[S_OMEGA_REF], st[S_TD_INTEGRAL], st[S_MOTOR_TORQUE] = omega_ref, integral, motor
-    st[S_V_HOOK], st[S_HOOK_INTEGRAL] = v_hook, hook_int
+def _pack(st: np.ndarray, meta: np.ndarray, x: Loop, dt: float) -> None:
+    """The loop's state back into the state vector and the history's bookkeeping."""
+    meta[0], meta[1], meta[2] = x.head, x.count, x.cursor
+    st[S_U], st[S_V], st[S_PHI], st[S_OMEGA] = x.u, x.v, x.phi, x.omega
+    st[S_PHI_S], st[S_OMEGA_S], st[S_W_APP] = x.phi_s, x.omega_s, x.w_app
+    st[S_STUCK] = 1.0 if x.stuck else 0.0
+    st[S_NODE], st[S_FRAC], st[S_H_OLD] = x.node, x.frac, x.h_old
+    st[S_STEP], st[S_TAU] = x.step, x.step * dt
+    st[S_OMEGA_REF], st[S_TD_INTEGRAL], st[S_MOTOR_TORQUE] = x.omega_ref, x.integral, x.motor
+    st[S_V_HOOK], st[S_HOOK_INTEGRAL] = x.v_hook, x.hook_int
 
 
 @njit(cache=True)

@@ -16,7 +16,7 @@ from __future__ import annotations
 import math
 import os
 import sys
-from dataclasses import dataclass, field
+from dataclasses import MISSING, Field, dataclass, field, fields
 from pathlib import Path
 from typing import Any
 
@@ -173,11 +173,12 @@ def rounded_as_before(drive: TopDrivePhysical, scales: Scales) -> TopDrivePhysic
     return drive.scaled(scales).physical(scales)
 
 
-SECTION_KEYS = ("outer_radius_m", "inner_radius_m", "length_m", "density_kg_m3",
-                "shear_modulus_pa", "youngs_modulus_pa", "torsional_damping_per_s",
-                "axial_damping_per_s")
-STRING_KEYS = ("model", "sections", "bit_inertia_kg_m2", "torsional_damping_per_s",
-               "axial_damping_per_s", "hook_wob_time_s", "damping_points")
+SECTION_FIELDS = {f.name: f for f in fields(Section)}
+SECTION_REQUIRED = tuple(name for name, f in SECTION_FIELDS.items() if f.default is MISSING)
+# a ``string`` block's keys: the spec's own, and the sections' damping (their default)
+STRING_DEFAULTED = ("torsional_damping_per_s", "axial_damping_per_s")
+STRING_FIELDS = {f.name: f for f in fields(StringSpec)}
+STRING_KEYS = (*STRING_FIELDS, *STRING_DEFAULTED)
 
 
 def _number(where: str, key: str, value: Any, low: float, high: float,
@@ -195,25 +196,62 @@ def _number(where: str, key: str, value: Any, low: float, high: float,
     return x
 
 
+def _field_value(where: str, key: str, value: Any, f: Field) -> float:
+    """``value`` checked against the range in the field's metadata (model.string)."""
+    return _number(where, key, value, *f.metadata["range"])
+
+
 def _section(where: str, values: Any, defaults: dict[str, float]) -> Section:
-    """One section mapping (SI keys of :class:`Section`), checked."""
+    """One section mapping (SI keys of :class:`Section`), checked; ``defaults`` (already
+    checked) fill the keys it does not give."""
     if not isinstance(values, dict):
-        raise ParameterError(f"'{where}' must be a mapping of {', '.join(SECTION_KEYS[:3])}")
-    check_known_keys(values, SECTION_KEYS, where)
-    missing = [key for key in SECTION_KEYS[:3] if key not in values]
+        raise ParameterError(f"'{where}' must be a mapping of {', '.join(SECTION_REQUIRED)}")
+    check_known_keys(values, tuple(SECTION_FIELDS), where)
+    missing = [key for key in SECTION_REQUIRED if key not in values]
     if missing:
         raise ParameterError(f"'{where}' needs {', '.join(missing)}")
-    merged = {**defaults, **values}
-    ranges = {"outer_radius_m": (0.0, 10.0, True), "inner_radius_m": (0.0, 10.0, False),
-              "length_m": (0.0, 1e5, True), "density_kg_m3": (0.0, 1e5, True),
-              "shear_modulus_pa": (0.0, 1e13, True), "youngs_modulus_pa": (0.0, 1e13, True),
-              "torsional_damping_per_s": (0.0, 1e3, False),
-              "axial_damping_per_s": (0.0, 1e3, False)}
-    x = {key: _number(where, key, merged[key], *ranges[key]) for key in SECTION_KEYS}
+    given = {key: _field_value(where, key, v, SECTION_FIELDS[key]) for key, v in values.items()}
+    x = {**defaults, **given}
     if x["inner_radius_m"] >= x["outer_radius_m"]:
         raise ParameterError(f"'{where}.inner_radius_m' = {x['inner_radius_m']!r} must be "
                              f"smaller than outer_radius_m = {x['outer_radius_m']!r}")
     return Section(**x)
+
+
+def _section_defaults(values: dict[str, Any], phys: PhysicalParams) -> dict[str, float]:
+    """What a section does not give: the ``physical`` material, the string's damping."""
+    damping = {key: _field_value("string", key, values[key], SECTION_FIELDS[key])
+               for key in STRING_DEFAULTED if key in values}
+    return {"density_kg_m3": phys.density_kg_m3, "shear_modulus_pa": phys.shear_modulus_pa,
+            "youngs_modulus_pa": phys.youngs_modulus_pa, **damping}
+
+
+def _raw_sections(values: dict[str, Any], phys: PhysicalParams) -> list[Any]:
+    """The ``sections`` list, or the two-section shorthand of the ``physical`` geometry."""
+    raw = values.get("sections")
+    if raw is None:
+        return [{"outer_radius_m": phys.pipe_outer_radius_m,
+                 "inner_radius_m": phys.pipe_inner_radius_m, "length_m": phys.pipe_length_m},
+                {"outer_radius_m": phys.bha_outer_radius_m,
+                 "inner_radius_m": phys.bha_inner_radius_m, "length_m": phys.bha_length_m}]
+    if not isinstance(raw, list) or len(raw) < 2:
+        raise ParameterError("'string.sections' must be a list of at least 2 sections, top "
+                             "to bottom (the bottom one is the BHA)")
+    return raw
+
+
+def _spec_scalars(values: dict[str, Any]) -> dict[str, float | int]:
+    """The string block's own numbers (:class:`StringSpec` fields), checked."""
+    out: dict[str, float | int] = {}
+    for key in ("bit_inertia_kg_m2", "hook_wob_time_s", "damping_points"):
+        if key in values:
+            out[key] = _field_value("string", key, values[key], STRING_FIELDS[key])
+    if "damping_points" in out:
+        if out["damping_points"] != int(out["damping_points"]):
+            raise ParameterError(f"'string.damping_points' = {values['damping_points']!r} "
+                                 "must be an integer")
+        out["damping_points"] = int(out["damping_points"])
+    return out
 
 
 def string_from_dict(values: Any, phys: PhysicalParams) -> StringSpec:
@@ -221,42 +259,14 @@ def string_from_dict(values: Any, phys: PhysicalParams) -> StringSpec:
     are the ``physical`` ones, the damping defaults the string's own keys."""
     if not isinstance(values, dict):
         raise ParameterError("'string' must be a mapping (model, sections, ...)")
-    unknown = sorted(set(values) - set(STRING_KEYS))
-    if unknown:
-        raise ParameterError(f"unknown key(s) {unknown} in 'string'; known: "
-                             f"{', '.join(STRING_KEYS)}")
+    check_known_keys(values, STRING_KEYS, "string")
     model = values.get("model", "lumped")
     if model not in STRING_MODELS:
         raise ParameterError(f"'string.model' = {model!r} must be one of {STRING_MODELS}")
-    defaults = {"density_kg_m3": phys.density_kg_m3, "shear_modulus_pa": phys.shear_modulus_pa,
-                "youngs_modulus_pa": phys.youngs_modulus_pa,
-                "torsional_damping_per_s": _number("string", "torsional_damping_per_s",
-                                                   values.get("torsional_damping_per_s", 0.0),
-                                                   0.0, 1e3),
-                "axial_damping_per_s": _number("string", "axial_damping_per_s",
-                                               values.get("axial_damping_per_s", 0.0),
-                                               0.0, 1e3)}
-    raw = values.get("sections")
-    if raw is None:                          # the two-section shorthand
-        raw = [{"outer_radius_m": phys.pipe_outer_radius_m,
-                "inner_radius_m": phys.pipe_inner_radius_m, "length_m": phys.pipe_length_m},
-               {"outer_radius_m": phys.bha_outer_radius_m,
-                "inner_radius_m": phys.bha_inner_radius_m, "length_m": phys.bha_length_m}]
-    elif not isinstance(raw, list) or len(raw) < 2:
-        raise ParameterError("'string.sections' must be a list of at least 2 sections, top "
-                             "to bottom (the bottom one is the BHA)")
+    defaults = _section_defaults(values, phys)
     sections = tuple(_section(f"string.sections[{i}]", sec, defaults)
-                     for i, sec in enumerate(raw))
-    points = _number("string", "damping_points", values.get("damping_points", 4), 1, 64)
-    if points != int(points):
-        raise ParameterError(f"'string.damping_points' = {points!r} must be an integer")
-    spec = StringSpec(model=model, sections=sections,
-                      bit_inertia_kg_m2=_number("string", "bit_inertia_kg_m2",
-                                                values.get("bit_inertia_kg_m2", 0.0), 0.0, 1e6),
-                      hook_wob_time_s=_number("string", "hook_wob_time_s",
-                                              values.get("hook_wob_time_s", 5.0), 0.0, 1e4,
-                                              low_open=True),
-                      damping_points=int(points))
+                     for i, sec in enumerate(_raw_sections(values, phys)))
+    spec = StringSpec(model=model, sections=sections, **_spec_scalars(values))
     if not spec.distributed and values.get("sections") is None:
         return StringSpec()                  # RGD07's lumped string of pipe_* / bha_*
     return spec
@@ -272,7 +282,7 @@ def load_preset(name_or_path: Any = DEFAULT_PRESET) -> Preset:
     try:
         return preset_from_dict(path.stem, data)
     except ParameterError as exc:
-        raise ParameterError(f"{path}: {exc}") from exc
+        raise ParameterError(f"preset file {path}: {exc}") from None
 
 
 def submerged_string_weight_n(preset: Preset | None,

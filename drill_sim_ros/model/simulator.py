@@ -208,10 +208,10 @@ class Simulator:
         """Both lines in steady motion (:func:`string.fill_steady`), and the drive's loop
         and torque command on the torque that this leaves at the top."""
         parts_t, parts = self._parts[0], self._wave_i.shape[1]
-        sg.fill_steady(self._wave, self._wave_i, self._wave_f, 0, parts_t, bit_torque, speed)
+        top_torque = sg.fill_steady(self._wave, self._wave_i, self._wave_f, 0, parts_t,
+                                    bit_torque, speed)
         sg.fill_steady(self._wave, self._wave_i, self._wave_f, parts_t, parts, bit_force,
                        axial_speed)
-        top_torque = bit_torque + speed * float(self._wave_f[sg.W_D, :parts_t].sum())
         st = self._state
         st[k.S_TD_INTEGRAL] = st[k.S_MOTOR_TORQUE] = top_torque
         self._targets[k.I_MOTOR_TORQUE] = top_torque

@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import functools
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from numba import njit
@@ -46,6 +46,12 @@ W_Z, W_D = 0, 1                         # float64 (2, segments): impedance, damp
 
 
 # ---- sections (SI) ------------------------------------------------------------------------
+def _bounds(low: float, high: float, low_open: bool = False) -> dict[str, tuple]:
+    """A field's allowed range, kept in its metadata: the preset reader checks every key of
+    a section or a string block against it (one definition of each range)."""
+    return {"range": (low, high, low_open)}
+
+
 @dataclass(frozen=True)
 class Section:
     """One uniform hollow section of the string, SI.
@@ -53,17 +59,21 @@ class Section:
     Radii and length in m; density kg/m^3; moduli Pa; damping rates in 1/s: the viscous
     force per unit length is ``rate x (mass or inertia per unit length) x local speed``, so
     a section moving rigidly would lose speed as exp(-rate t) and mode k of a uniform string
-    has the damping ratio rate / (2 omega_k).
+    has the damping ratio rate / (2 omega_k). The fields without a default are the ones a
+    preset must give; each field's metadata holds its allowed range.
     """
 
-    outer_radius_m: float
-    inner_radius_m: float
-    length_m: float
-    density_kg_m3: float = STEEL_DENSITY_KG_M3
-    shear_modulus_pa: float = STEEL_SHEAR_MODULUS_PA
-    youngs_modulus_pa: float = STEEL_YOUNGS_MODULUS_PA
-    torsional_damping_per_s: float = 0.0
-    axial_damping_per_s: float = 0.0
+    outer_radius_m: float = field(metadata=_bounds(0.0, 10.0, low_open=True))
+    inner_radius_m: float = field(metadata=_bounds(0.0, 10.0))
+    length_m: float = field(metadata=_bounds(0.0, 1e5, low_open=True))
+    density_kg_m3: float = field(default=STEEL_DENSITY_KG_M3,
+                                 metadata=_bounds(0.0, 1e5, low_open=True))
+    shear_modulus_pa: float = field(default=STEEL_SHEAR_MODULUS_PA,
+                                    metadata=_bounds(0.0, 1e13, low_open=True))
+    youngs_modulus_pa: float = field(default=STEEL_YOUNGS_MODULUS_PA,
+                                     metadata=_bounds(0.0, 1e13, low_open=True))
+    torsional_damping_per_s: float = field(default=0.0, metadata=_bounds(0.0, 1e3))
+    axial_damping_per_s: float = field(default=0.0, metadata=_bounds(0.0, 1e3))
 
     @property
     def polar_moment_m4(self) -> float:
@@ -121,9 +131,9 @@ class StringSpec:
 
     model: str = "lumped"
     sections: tuple[Section, ...] = ()
-    bit_inertia_kg_m2: float = 0.0
-    hook_wob_time_s: float = 5.0
-    damping_points: int = 4
+    bit_inertia_kg_m2: float = field(default=0.0, metadata=_bounds(0.0, 1e6))
+    hook_wob_time_s: float = field(default=5.0, metadata=_bounds(0.0, 1e4, low_open=True))
+    damping_points: int = field(default=4, metadata=_bounds(1, 64))
 
     @property
     def distributed(self) -> bool:
@@ -132,6 +142,12 @@ class StringSpec:
     @property
     def length_m(self) -> float:
         return sum(s.length_m for s in self.sections)
+
+    def undamped(self) -> StringSpec:
+        """The same string without losses (the exact wave tests and the instruments)."""
+        return replace(self, sections=tuple(
+            replace(s, torsional_damping_per_s=0.0, axial_damping_per_s=0.0)
+            for s in self.sections))
 
     @property
     def torsional_travel_s(self) -> float:
@@ -288,33 +304,32 @@ class WaveLine:
     length_m: tuple[float, ...] = ()
 
 
+def section_parts(rate_per_s: float, damping_points: int) -> tuple[tuple[float, ...], int]:
+    """How a section is cut into delay-line parts, the one rule: undamped, one part;
+    damped, ``damping_points`` point dampers, each at the middle of an equal share of the
+    section carrying that share's damping, and the lines run from damper to damper, so the
+    parts are a half share, ``damping_points - 1`` whole ones and a half (a junction with no
+    element between two equal lines would only pass the waves on, and cost a step's work).
+    Returns the parts' lengths in shares, and the shares in the section."""
+    if rate_per_s <= 0.0:
+        return (1.0,), 1
+    return (0.5, *([1.0] * (damping_points - 1)), 0.5), damping_points
+
+
 def wave_line(spec: StringSpec, axial: bool, time_s: float, z_unit: float,
               mass_unit: float) -> WaveLine:
-    """Parts of ``spec`` for one kind of wave. ``z_unit`` converts an SI impedance to
-    kernel units, ``mass_unit`` an SI damper (N m s/rad or N s/m) likewise (same factor).
-
-    With damping, each section is cut into ``damping_points`` equal parts, each with a point
-    damper at its middle that carries the part's damping (rate x inertia): the delay lines
-    run from damper to damper, so the section is a half part, ``damping_points - 1`` whole
-    ones and a half (a junction with no damper between two equal lines would only pass the
-    waves on, and cost a step's work)."""
+    """Parts of ``spec`` for one kind of wave (:func:`section_parts`). ``z_unit`` converts
+    an SI impedance to kernel units, ``mass_unit`` an SI damper (N m s/rad or N s/m)
+    likewise (same factor)."""
     travel, z, damper, length = [], [], [], []
     for s in spec.sections:
         props = line_properties(s, axial)
-        zi, rate = props.impedance / z_unit, props.damping_per_s
         t_tau = s.length_m / props.speed_m_s / time_s
-        if rate <= 0.0:
-            travel.append(t_tau)
-            z.append(zi)
-            damper.append(0.0)
-            length.append(s.length_m)
-            continue
-        points = spec.damping_points
-        d_part = rate * props.inertia_per_m * s.length_m / points / mass_unit
-        shares = [0.5] + [1.0] * (points - 1) + [0.5]      # of a part, damper to damper
+        shares, points = section_parts(props.damping_per_s, spec.damping_points)
+        d_share = props.damping_per_s * props.inertia_per_m * s.length_m / points / mass_unit
         travel += [share * t_tau / points for share in shares]
-        z += [zi] * (points + 1)
-        damper += [d_part] * points + [0.0]
+        z += [props.impedance / z_unit] * len(shares)
+        damper += [d_share] * (len(shares) - 1) + [0.0]
         length += [share * s.length_m / points for share in shares]
     return WaveLine(tuple(travel), tuple(z), tuple(damper), tuple(length))
 
@@ -343,16 +358,18 @@ def build_lines(lines: tuple[WaveLine, ...], dtau: float
 
 
 def fill_steady(wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray, lo: int, hi: int,
-                end_force: float, speed: float) -> None:
+                end_force: float, speed: float) -> float:
     """Parts ``lo..hi-1`` turning (moving) steadily at ``speed``: each carries the force at
     the bottom end, ``end_force``, plus the drag D x speed of every point damper below its
-    top (the damper below part j sits at its bottom), so no damper sheds a wave."""
+    top (the damper below part j sits at its bottom), so no damper sheds a wave. Returns
+    the force at the top, what the drive (hook) must hold."""
     drag_below = np.cumsum(wave_f[W_D, lo:hi][::-1])[::-1] * speed
     for j in range(lo, hi):
         n, off, z = wave_i[W_LEN, j], wave_i[W_OFF, j], wave_f[W_Z, j]
         force = end_force + float(drag_below[j - lo])
         wave[off:off + n] = force + z * speed
         wave[off + n:off + 2 * n] = force - z * speed
+    return end_force + speed * float(wave_f[W_D, lo:hi].sum())
 
 
 @dataclass(frozen=True)
@@ -389,15 +406,94 @@ def kernel_string(spec: StringSpec, time_s: float, torque_nm: float, length_m: f
     axial = wave_line(spec, True, time_s, z_axial, z_axial)
     stiffness = length_m / force_n / axial_compliance_m_per_n(spec)
     t_w = spec.hook_wob_time_s / time_s
-    bha_part = len(torsion.travel_tau) - _parts_of(spec, spec.sections[-1], False)
+    bha_rate = line_properties(spec.sections[-1], False).damping_per_s
+    bha_part = len(torsion.travel_tau) - len(section_parts(bha_rate, spec.damping_points)[0])
     return KernelString(STRING_DISTRIBUTED, (torsion, axial),
                         spec.bit_inertia_kg_m2 / (torque_nm * time_s**2),
                         2.0 / (t_w * stiffness), 1.0 / (t_w**2 * stiffness), bha_part, spec)
 
 
-def _parts_of(spec: StringSpec, section: Section, axial: bool) -> int:
-    rate = line_properties(section, axial).damping_per_s
-    return spec.damping_points + 1 if rate > 0.0 else 1
+# ---- compiled: the string's step (the kernel's seam) ------------------------------------
+# The kernel sees the string through three calls per step: ``ends`` (what the string
+# presents at the bit, in the bit law's affine form, and at the top), ``advance`` (one step
+# on between the new end speeds) and ``bha_speed`` (for the sample). ``lay`` is the
+# distributed string's layout for a run, from :func:`layout`. A lumped string (``wave``
+# None) is RGD07's spring, compiled apart. An element at the junctions (a point damper;
+# wall friction, a shock sub) is a row of ``wave_f`` and a term of :func:`junction_speed`.
+@njit(cache=True, inline="always")
+def layout(wave_i: np.ndarray | None, parts_t: int, bit_inertia: float, echo: float,
+           bha_part: int) -> tuple[int, int, float, float, int]:
+    """The distributed string's layout for a run: the torsional parts (the axial ones
+    follow), all parts, the bit's lumped inertia, the torsional bottom's echo (1: the bit;
+    0: anechoic) and the part at whose top the BHA speed is read."""
+    return (parts_t, 0 if wave_i is None else wave_i.shape[1], bit_inertia, echo, bha_part)
+
+
+@njit(cache=True, inline="always")
+def ends(wave: np.ndarray | None, wave_i: np.ndarray | None, wave_f: np.ndarray | None,
+         lay: tuple, psi: float, dt: float, phi_s: float, phi: float, v: float, omega: float,
+         w_app: float, omega_s: float, v_hook: float) -> tuple[float, ...]:
+    """What the string presents over this step: at the bit, the affine forms of the bit law
+    (bit_rock) ``v0, kick_v, f_ext, omega0, kick_w, t_ext``; at the top, the torque at the
+    quill and the force at the hook above the hanging weight."""
+    if wave is None:
+        return _lumped_ends(psi, dt, phi_s, phi, v, omega, w_app)
+    return _distributed_ends(wave, wave_i, wave_f, lay, dt, omega_s, v, omega, v_hook)
+
+
+@njit(cache=True, inline="always")
+def advance(wave: np.ndarray | None, wave_i: np.ndarray | None, wave_f: np.ndarray | None,
+            lay: tuple, omega_top: float, v_top: float, omega_bit: float,
+            v_bit: float) -> None:
+    """The string one step on between the speeds over the step at its ends (the drive's
+    and the hook's at the top, the bit's at the bottom); the lumped spring keeps no waves.
+    (No early return: in an inlined function it cost the distributed step 7 %, measured.)"""
+    if wave is not None:
+        drive_line(wave, wave_i, wave_f, 0, lay[0], omega_top, omega_bit, lay[3])
+        drive_line(wave, wave_i, wave_f, lay[0], lay[1], v_top, v_bit, 1.0)
+
+
+@njit(cache=True, inline="always")
+def bha_speed(wave: np.ndarray | None, wave_i: np.ndarray | None, wave_f: np.ndarray | None,
+              lay: tuple, omega: float) -> float:
+    """The BHA's angular speed now: the bit's ``omega`` in the lumped string, else the speed
+    at the top of the BHA's part."""
+    return omega if wave is None else speed_at_top_of(wave, wave_i, wave_f, lay[4])
+
+
+@njit(cache=True, inline="always")
+def _lumped_ends(psi: float, dt: float, phi_s: float, phi: float, v: float, omega: float,
+                 w_app: float) -> tuple[float, ...]:
+    """:func:`ends` of RGD07's lumped string (eq. 25): the spring torque PHI_S - PHI and
+    psi dtau on the applied weight at the bit; at the top the same torque and the applied
+    weight."""
+    t_pipe = phi_s - phi                      # pipe torque C (PHI_S - PHI), scaled
+    return v, psi * dt, w_app, omega, dt, t_pipe, t_pipe, w_app
+
+
+@njit(cache=True, inline="always")
+def _distributed_ends(wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray, lay: tuple,
+                      dt: float, omega_s: float, v: float, omega: float,
+                      v_hook: float) -> tuple[float, ...]:
+    """:func:`ends` of the wave guide: the arriving waves and the end impedances, with the
+    bit's lumped inertia; at the top b + Z w with the drive's and the hook's speeds."""
+    parts_t, parts, bit_inertia, _, _ = lay
+    b_top_t, a_bot_t = arriving(wave, wave_i, 0, parts_t)
+    b_top_a, a_bot_a = arriving(wave, wave_i, parts_t, parts)
+    v0, kick_v, f_ext = bottom_end(a_bot_a, wave_f[W_Z, parts - 1], 0.0, v, dt)
+    omega0, kick_w, t_ext = bottom_end(a_bot_t, wave_f[W_Z, parts_t - 1], bit_inertia,
+                                       omega, dt)
+    return (v0, kick_v, f_ext, omega0, kick_w, t_ext, b_top_t + wave_f[W_Z, 0] * omega_s,
+            b_top_a + wave_f[W_Z, parts_t] * v_hook)
+
+
+@njit(cache=True, inline="always")
+def junction_speed(wave_f: np.ndarray, j: int, a_in: float, b_in: float) -> float:
+    """The speed of the junction below part ``j``, from the waves arriving at it (``a_in``
+    from above, ``b_in`` from below): continuous across it, with the torques balanced on
+    its elements, the point damper D (torque D w):
+    (a_in - Z_j w) - (b_in + Z_j+1 w) = D w."""
+    return (a_in - b_in) / (wave_f[W_Z, j] + wave_f[W_Z, j + 1] + wave_f[W_D, j])
 
 
 # ---- compiled: one step of a line -------------------------------------------------------
@@ -427,14 +523,15 @@ def scatter(wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray, lo: int, h
     inner junction scatters what arrives (continuous speed, torques balanced with its point
     damper), and the delay lines move on by one step. Reads each slot before writing it.
     Indexes the layout arrays in place: row views would cost reference counting every step
-    (about a tenth of the distributed string's step, measured)."""
+    (about a tenth of the distributed string's step, measured). The junctions' law is
+    :func:`junction_speed`."""
     a_slot = wave_i[W_OFF, lo] + wave_i[W_POS, lo]
     a_in = wave[a_slot]                      # arriving at the bottom of part lo
     wave[a_slot] = a_top
     for j in range(lo, hi - 1):
         b_slot = wave_i[W_OFF, j + 1] + wave_i[W_LEN, j + 1] + wave_i[W_POS, j + 1]
         b_in = wave[b_slot]                  # arriving at the top of part j + 1
-        w = (a_in - b_in) / (wave_f[W_Z, j] + wave_f[W_Z, j + 1] + wave_f[W_D, j])
+        w = junction_speed(wave_f, j, a_in, b_in)
         wave[wave_i[W_OFF, j] + wave_i[W_LEN, j] + wave_i[W_POS, j]] = \
             a_in - 2.0 * wave_f[W_Z, j] * w
         a_slot = wave_i[W_OFF, j + 1] + wave_i[W_POS, j + 1]

@@ -83,8 +83,7 @@ def reflection_preset(preset: Preset) -> Preset:
     made anechoic by :meth:`Simulator.hang_off_bottom`), so the waves that come back down
     are the drive's reflection and nothing else. Scales, rock and drive are unchanged."""
     require_distributed(preset)
-    top = replace(preset.string.sections[0], torsional_damping_per_s=0.0,
-                  axial_damping_per_s=0.0)
+    top = preset.string.undamped().sections[0]
     return replace(preset, string=replace(preset.string, sections=(top, top),
                                           bit_inertia_kg_m2=0.0))
 
@@ -94,15 +93,10 @@ def off_bottom_simulator(preset: Preset, drive: TopDrive, dtau: float | None = N
     """A simulator of ``preset`` with the bit hanging free off bottom, the hook fixed, the
     string untwisted and turning at the preset's speed (no torque, no axial motion)."""
     require_distributed(preset)
-    spec = preset.string
     if undamped:
-        sections = tuple(replace(s, torsional_damping_per_s=0.0, axial_damping_per_s=0.0)
-                         for s in spec.sections)
-        spec = replace(spec, sections=sections)
-    sc = preset.scales
-    string = sg.kernel_string(spec, sc.time_s, sc.torque_nm, sc.length_m, sc.force_n)
+        preset = replace(preset, string=preset.string.undamped())
     sim = Simulator(preset.params, SimConfig(dtau=dtau or preset.dtau, n_nodes=64),
-                    top_drive=drive, scales=sc, string=string)
+                    top_drive=drive, scales=preset.scales, string=preset.kernel_string)
     sim.hang_off_bottom(anechoic)
     return sim
 

@@ -106,18 +106,13 @@ def check_preset_mapping(data: Any) -> None:
                                  f"{', '.join(MODES)}")
 
 
-def read_preset_file(path: Path) -> dict[str, Any]:
-    """The mapping of the preset file ``path``, read once and checked; the error names the
-    file."""
+def read_preset_file(path: Path) -> Any:
+    """The parsed YAML of the preset file ``path``, read once (checked by
+    :func:`check_preset_mapping` where it is built); the error names the file."""
     try:
-        data = yaml.safe_load(path.read_text())
+        return yaml.safe_load(path.read_text())
     except OSError as exc:
         raise ParameterError(f"preset file {path}: {exc.strerror or exc}") from None
     except yaml.YAMLError as exc:
         raise ParameterError(f"preset file {path} is not valid YAML: "
                              f"{' '.join(str(exc).split())}") from None
-    try:
-        check_preset_mapping(data)
-    except ParameterError as exc:
-        raise ParameterError(f"preset file {path}: {exc}") from None
-    return data
