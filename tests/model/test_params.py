@@ -17,7 +17,7 @@ from drill_sim_ros.model.params import (
     structure,
     unscale,
 )
-from drill_sim_ros.model.presets import available_presets, load_preset
+from drill_sim_ros.model.presets import available_presets, load_preset, string_from_dict
 
 STEEL = 7850.0
 
@@ -157,3 +157,15 @@ def test_a_preset_file_that_is_not_yaml_is_one_line_naming_it(tmp_path: Path) ->
         load_preset(str(path))
     message = str(caught.value)
     assert "\n" not in message and f"preset file {path} is not valid YAML" in message
+
+
+def test_a_string_value_that_is_not_a_yaml_number_is_one_line() -> None:
+    """The string block reads numbers as the shared checks do: ``true`` is not 1.0."""
+    phys = load_preset("field_8p5in_shale").physical
+    section = {"outer_radius_m": 0.06, "inner_radius_m": 0.05, "length_m": 100.0}
+    with pytest.raises(ParameterError, match=r"string.bit_inertia_kg_m2' = True"):
+        string_from_dict({"model": "distributed", "sections": [section, section],
+                          "bit_inertia_kg_m2": True}, phys)
+    spec = string_from_dict({"model": "distributed", "sections": [section, section],
+                             "bit_inertia_kg_m2": "2.5e1"}, phys)
+    assert spec.bit_inertia_kg_m2 == 25.0
