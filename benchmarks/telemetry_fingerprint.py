@@ -1,0 +1,78 @@
+"""Telemetry fingerprints: a short hash of each of 40 runs, to diff before and after a refactor.
+
+Every scenario with the three reference controllers (25 s), torque mode on both strings, the
+session on five presets with its string profiles, the exact delay, the string hung off
+bottom. A refactor that keeps the telemetry bit for bit prints the same lines. Prints only;
+no expected values are kept (they are what the code before the change prints). Clear the
+numba cache first (``rm -rf .cache/numba``): a cached kernel does not notice a change in an
+inlined function of another file.
+
+Usage: .venv/bin/python benchmarks/telemetry_fingerprint.py > before.txt  (then after, diff)
+"""
+from __future__ import annotations
+
+import hashlib
+import sys
+
+import numpy as np
+
+from drill_sim_ros.control.bench import run_in_process
+from drill_sim_ros.control.scenario import Scenario, load_scenario, scenario_path
+from drill_sim_ros.model.presets import load_preset
+from drill_sim_ros.model.session import SessionConfig, SimSession
+from drill_sim_ros.model.simulator import SimConfig, Simulator
+
+
+def h(a) -> str:
+    return hashlib.sha256(np.ascontiguousarray(a, dtype=np.float64).tobytes()).hexdigest()[:16]
+
+
+def bench_cases():
+    base = [("field_default", None), ("hard_streak", None), ("noisy_delayed_sensors", None),
+            ("tight_torque_limit", None), ("speed_ramp", None), ("wob_step", None),
+            ("long_string", None), ("low_speed_high_wob", None), ("field_60rpm", None)]
+    for name, _ in base:
+        sc = load_scenario(scenario_path(name))
+        for ctl in ("stiff", "soft_torque", "z_torque"):
+            yield f"{name}/{ctl}", sc.with_(controller=ctl, duration_s=25.0, enable_at_s=5.0)
+    lumped = Scenario(preset="field_8p5in_shale_lumped", duration_s=20.0, enable_at_s=5.0)
+    for ctl in ("stiff", "soft_torque", "z_torque"):
+        yield f"lumped/{ctl}", lumped.with_(controller=ctl)
+    yield "lumped/torque_mode", lumped.with_(controller="z_torque", mode="torque")
+    dist = Scenario(duration_s=20.0, enable_at_s=5.0)
+    yield "dist/torque_mode", dist.with_(controller="z_torque", mode="torque")
+
+
+def main() -> None:
+    for name, sc in bench_cases():
+        run = run_in_process(sc)
+        print(name, h(run.rows), h(run.accumulators), run.clamped_commands, flush=True)
+    for preset in ("fig5_8a", "fig9", "fig12", "field_8p5in_shale_lumped", "field_8p5in_shale"):
+        p = load_preset(preset)
+        s = SimSession(SessionConfig(preset=p, string_rate_hz=10.0))
+        blocks = [s.run(200) for _ in range(3)]
+        rows = np.concatenate([b.rows for b in blocks])
+        strings = [x for b in blocks for x in b.strings]
+        sh = hashlib.sha256()
+        for x in strings:
+            sh.update(np.ascontiguousarray(x.speed_rad_s).tobytes())
+            sh.update(np.ascontiguousarray(x.torque_nm).tobytes())
+            sh.update(str(x.stamp_ns).encode())
+        print("session", preset, h(rows), sh.hexdigest()[:16], len(strings), flush=True)
+    for preset in ("fig5_8a", "fig7"):
+        p = load_preset(preset)
+        sim = Simulator(p.params, SimConfig(dtau=p.dtau, method="exact"), top_drive=p.top_drive,
+                        scales=p.scales, string=p.kernel_string)
+        out = sim.advance(20000, every=10)
+        print("exact", preset, h(out.data if hasattr(out, "data") else out.rows), h(sim.state),
+              flush=True)
+    p = load_preset("field_8p5in_shale")
+    sim = Simulator(p.params, SimConfig(dtau=p.dtau), top_drive=p.top_drive, scales=p.scales,
+                    string=p.kernel_string)
+    sim.hang_off_bottom()
+    out = sim.advance(5000, every=10)
+    print("hang", h(sim.state), h(sim.string_profile()[0]), flush=True)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
