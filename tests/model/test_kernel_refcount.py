@@ -23,8 +23,9 @@ from drill_sim_ros.model.params import DimensionlessParams
 from drill_sim_ros.model.presets import load_preset
 from drill_sim_ros.model.simulator import SimConfig, Simulator
 
-# NRT calls on the loop's blocks, per string, with numba 0.6x as of issue 34
+# NRT calls on the loop's blocks, per string, as of issue 34, with this numba (major.minor)
 MAX_LOOP_NRT_CALLS = {"lumped": 8, "distributed": 18}
+MEASURED_WITH_NUMBA = "0.68"
 FIG8A = DimensionlessParams(n=6, psi=50.0, beta=0.3, lam=5.0, w0=7.0, omega0=5.0)
 
 
@@ -89,6 +90,9 @@ def test_the_cycle_finder_sees_a_loop_and_not_a_diamond() -> None:
 
 @pytest.mark.parametrize("kind", ["lumped", "distributed"])
 def test_no_new_reference_counting_in_the_step_loop(kind: str) -> None:
+    if not numba.__version__.startswith(MEASURED_WITH_NUMBA + "."):
+        pytest.skip(f"the counts were measured with numba {MEASURED_WITH_NUMBA}; re-measure "
+                    f"them for numba {numba.__version__} (loop_nrt_calls)")
     calls = loop_nrt_calls(kind)
     assert calls <= MAX_LOOP_NRT_CALLS[kind], (
         f"{calls} NRT calls on the {kind} step loop's blocks, {MAX_LOOP_NRT_CALLS[kind]} "
