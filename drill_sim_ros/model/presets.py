@@ -240,11 +240,11 @@ def _raw_sections(values: dict[str, Any], phys: PhysicalParams) -> list[Any]:
 
 
 def _spec_scalars(values: dict[str, Any]) -> dict[str, float | int]:
-    """The string block's own numbers (:class:`StringSpec` fields), checked."""
-    out: dict[str, float | int] = {}
-    for key in ("bit_inertia_kg_m2", "hook_wob_time_s", "damping_points"):
-        if key in values:
-            out[key] = _field_value("string", key, values[key], STRING_FIELDS[key])
+    """The string block's own numbers (the :class:`StringSpec` fields with a range),
+    checked."""
+    out: dict[str, float | int] = {key: _field_value("string", key, values[key], f)
+                                   for key, f in STRING_FIELDS.items()
+                                   if "range" in f.metadata and key in values}
     if "damping_points" in out:
         if out["damping_points"] != int(out["damping_points"]):
             raise ParameterError(f"'string.damping_points' = {values['damping_points']!r} "

@@ -419,7 +419,8 @@ def kernel_string(spec: StringSpec, time_s: float, torque_nm: float, length_m: f
 # on between the new end speeds) and ``bha_speed`` (for the sample). ``lay`` is the
 # distributed string's layout for a run, from :func:`layout`. A lumped string (``wave``
 # None) is RGD07's spring, compiled apart. An element at the junctions (a point damper;
-# wall friction, a shock sub) is a row of ``wave_f`` and a term of :func:`junction_speed`.
+# wall friction, a shock sub) is a row of ``wave_f``, a term of :func:`junction_speed` and
+# its share of the steady twist in :func:`fill_steady`.
 @njit(cache=True, inline="always")
 def layout(wave_i: np.ndarray | None, parts_t: int, bit_inertia: float, echo: float,
            bha_part: int) -> tuple[int, int, float, float, int]:
