@@ -78,9 +78,13 @@ P_BIT_INERTIA = 18  # distributed: lumped inertia at the bit / I
 P_HOOK_KP = 19      # distributed: hook speed per unit force error (WOB loop, P)
 P_HOOK_KI = 20      # distributed: hook speed per unit force error x tau (WOB loop, I)
 P_OFF_BOTTOM = 21   # 1: the bit hangs free off bottom (T = W = 0), the hook fixed; 2: and
-                    # the torsional line ends without reflection (an anechoic bottom)
+                    # the torsional line ends without reflection (an anechoic bottom);
+                    # OFF_BOTTOM_LIFTED: the hook picks the string up off bottom and holds it
 P_BHA_PART = 22     # distributed: the part at whose top the BHA speed is read
-N_PARAMS = 23
+P_PICKUP = 23       # distributed: the hook's pick-up speed off bottom (L* per t*)
+P_CLEARANCE = 24    # distributed: the bit's clearance above the rock it picks up to (L*)
+N_PARAMS = 25
+OFF_BOTTOM_LIFTED = 3.0
 
 # ---- surface targets (float64) ----------------------------------------------------------
 I_OMEGA_S = 0       # commanded top-drive speed (kinematic and speed modes)
@@ -155,11 +159,12 @@ Loop.__doc__ = """The loop-carried state of a run (the ``S_*`` slots and the his
 ``meta``: head, count, cursor)."""
 Law = namedtuple("Law", (
     "dt", "tau_avg", "beta", "lam", "n_blades", "psi", "off_bottom", "layer_u", "cut_factor",
-    "sector", "tgt_w", "w_rate", "inv_spacing", "hook_kp", "hook_ki"))
+    "sector", "tgt_w", "w_rate", "inv_spacing", "hook_kp", "hook_ki", "pickup", "clearance"))
 Law.__doc__ = """A run's constants of the bit law, the rock and the hook: dtau, the statistics
 window start, beta, lambda, n, psi, off bottom, the next layer's top, the cutting factor, the
 blade sector 2 pi / n, the applied weight's target and ramp rate, the profile's nodes per
-radian, the hook's WOB loop gains."""
+radian, the hook's WOB loop gains, its pick-up speed (0 on bottom) and the clearance it
+picks up to."""
 Drive = namedtuple("Drive", (
     "mode", "omega", "torque", "omega_rate", "inertia", "kp", "ki", "max_torque", "lag_alpha"))
 Drive.__doc__ = """A run's top-drive parameters and commands (top_drive.drive_step)."""
@@ -227,12 +232,17 @@ def _accumulate(acc: np.ndarray, tau: float, tau_avg: float, mode: int, w_f: flo
 
 @njit(cache=True, inline="always")
 def _hook(kp: float, ki: float, fixed: bool, dt: float, w_app: float, f_top: float,
-          integral: float) -> tuple[float, float]:
-    """The hook's speed over the step: a PI loop (gains ``kp``, ``ki``) on the applied-WOB
-    error, so the string force at the top (the applied WOB the rig infers from the hook
-    load) follows W_APP; zero when ``fixed`` (off bottom). Returns ``(speed, integral)``."""
+          integral: float, pickup: float, clearance_left: float) -> tuple[float, float]:
+    """The hook's speed over the step (down positive): a PI loop (gains ``kp``, ``ki``) on
+    the applied-WOB error, so the string force at the top (the applied WOB the rig infers
+    from the hook load) follows W_APP; zero when ``fixed`` (hung off bottom). Picking up
+    off bottom (``pickup`` > 0), it rises at ``pickup`` until the bit's clearance above the
+    rock lacks nothing (``clearance_left`` <= 0), then holds; the loop's integral is kept
+    for the tag. Returns ``(speed, integral)``."""
     if fixed:
         return 0.0, integral
+    if pickup > 0.0:
+        return (-pickup if clearance_left > 0.0 else 0.0), integral
     err = w_app - f_top
     integral += ki * err * dt
     return kp * err + integral, integral
@@ -333,7 +343,8 @@ def _respond(x: Loop, law: Law, surface: float, cursor: int, ends: tuple,
     v_hook, hook_int = x.v_hook, x.hook_int
     if not lumped:                # the hook's WOB loop
         v_hook, hook_int = _hook(law.hook_kp, law.hook_ki, law.off_bottom, law.dt, x.w_app,
-                                 f_top, hook_int)
+                                 f_top, hook_int, law.pickup,
+                                 law.clearance + doc / law.n_blades)
     return Response(cursor, doc, t_top, f_top, v_new, omega_new, x.u + v_new * law.dt,
                     x.phi + omega_new * law.dt, w_f, wob, tob, mode, stuck, v_hook, hook_int)
 
@@ -389,9 +400,11 @@ def _run_params(prm: np.ndarray, tgt: np.ndarray, profile: np.ndarray,
 def _law_params(prm: np.ndarray, tgt: np.ndarray, profile: np.ndarray) -> Law:
     """The run's constants of the bit law, the rock and the hook, read once (:class:`Law`)."""
     sector = 2.0 * math.pi / prm[P_N]
+    lifted = prm[P_OFF_BOTTOM] == OFF_BOTTOM_LIFTED
     return Law(prm[P_DT], prm[P_TAU_AVG], prm[P_BETA], prm[P_LAM], prm[P_N], prm[P_PSI],
-               prm[P_OFF_BOTTOM] != 0.0, prm[P_LAYER_U], prm[P_CUT], sector, tgt[I_W_APP],
-               prm[P_W_RATE], profile.shape[0] / sector, prm[P_HOOK_KP], prm[P_HOOK_KI])
+               prm[P_OFF_BOTTOM] != 0.0 and not lifted, prm[P_LAYER_U], prm[P_CUT], sector,
+               tgt[I_W_APP], prm[P_W_RATE], profile.shape[0] / sector, prm[P_HOOK_KP],
+               prm[P_HOOK_KI], prm[P_PICKUP] if lifted else 0.0, prm[P_CLEARANCE])
 
 
 @njit(cache=True, inline="always")

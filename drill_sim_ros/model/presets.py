@@ -16,7 +16,7 @@ from __future__ import annotations
 import math
 import os
 import sys
-from dataclasses import MISSING, Field, dataclass, field, fields
+from dataclasses import MISSING, Field, dataclass, field, fields, replace
 from pathlib import Path
 from typing import Any
 
@@ -42,6 +42,7 @@ from drill_sim_ros.model.string import (
 )
 from drill_sim_ros.model.top_drive import TopDrive, TopDrivePhysical, top_drive_from_dict
 from drill_sim_ros.model.validate_input import check_preset_mapping, read_preset_file
+from drill_sim_ros.model.well import well_from_dict
 
 DEFAULT_PRESET = "field_8p5in_shale"
 GRAVITY_M_S2 = 9.80665
@@ -146,10 +147,12 @@ def preset_from_dict(name: str, data: dict[str, Any]) -> Preset:
             raise ParameterError(f"preset '{name}': physical {', '.join(shorthand)} would be "
                                  "ignored: string.sections defines the string (give one)")
         params, scales = scale(physical, string)
+        string = _with_well(name, data, string)
     else:
-        if "string" in data:
-            raise ParameterError(f"preset '{name}': 'string' needs a 'physical' preset (a "
-                                 "dimensionless one is RGD07's lumped string)")
+        for key in ("string", "well"):
+            if key in data:
+                raise ParameterError(f"preset '{name}': '{key}' needs a 'physical' preset (a "
+                                     "dimensionless one is RGD07's lumped string)")
         params, scales = dimensionless_from_dict(data["dimensionless"]), UNIT_SCALES
     n_nodes = numerics.get("n_nodes")
     section = data.get("top_drive")
@@ -161,6 +164,17 @@ def preset_from_dict(name: str, data: dict[str, Any]) -> Preset:
                   dtau=float(numerics.get("dtau", 1e-4)),
                   n_nodes=None if n_nodes is None else int(n_nodes), drive=drive,
                   string=string)
+
+
+def _with_well(name: str, data: dict[str, Any], string: StringSpec) -> StringSpec:
+    """``string`` in the preset's ``well`` (model.well), which needs the distributed string
+    (the wall holds the string along its length); no ``well``: a vertical hole."""
+    if data.get("well") is None:
+        return string
+    if not string.distributed:
+        raise ParameterError(f"preset '{name}': 'well' needs string.model: distributed (the "
+                             "wall's friction acts along the string)")
+    return replace(string, well=well_from_dict(data["well"]))
 
 
 def rounded_as_before(drive: TopDrivePhysical, scales: Scales) -> TopDrivePhysical:
@@ -178,7 +192,7 @@ SECTION_REQUIRED = tuple(name for name, f in SECTION_FIELDS.items() if f.default
 # a ``string`` block's keys: the spec's own, and the sections' damping (their default)
 STRING_DEFAULTED = ("torsional_damping_per_s", "axial_damping_per_s")
 STRING_FIELDS = {f.name: f for f in fields(StringSpec)}
-STRING_KEYS = (*STRING_FIELDS, *STRING_DEFAULTED)
+STRING_KEYS = (*(key for key in STRING_FIELDS if key != "well"), *STRING_DEFAULTED)
 
 
 def _number(where: str, key: str, value: Any, low: float, high: float,
@@ -285,10 +299,15 @@ def load_preset(name_or_path: Any = DEFAULT_PRESET) -> Preset:
 
 
 def submerged_string_weight_n(preset: Preset | None,
-                              mud_density_kg_m3: float = MUD_DENSITY_KG_M3) -> float:
-    """Buoyed weight of pipe + BHA: steel mass x g x (1 - rho_mud / rho_steel); 0 if none."""
+                              mud_density_kg_m3: float | None = None) -> float:
+    """Buoyed weight of pipe + BHA: steel mass x g x (1 - rho_mud / rho_steel); 0 if none.
+    The mud is the preset's well's, else ``MUD_DENSITY_KG_M3`` (a hook-load estimate: the
+    string hangs straight; in a deviated well the wall carries part of it)."""
     if preset is None or preset.physical is None:
         return 0.0
+    if mud_density_kg_m3 is None:
+        well = preset.string.well
+        mud_density_kg_m3 = MUD_DENSITY_KG_M3 if well is None else well.mud_density_kg_m3
     phys = preset.physical
     if preset.string.sections:
         return sum(s.mass_kg * GRAVITY_M_S2 * (1.0 - mud_density_kg_m3 / s.density_kg_m3)

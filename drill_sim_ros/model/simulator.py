@@ -75,6 +75,8 @@ class Snapshot:
     wave: np.ndarray | None = None
     wave_pos: np.ndarray | None = None
     layer_index: int = -1
+    junctions: np.ndarray | None = None     # the junctions' state rows (W_LAST, W_WORK)
+    off_bottom: float = 0.0
 
 
 @dataclass
@@ -161,6 +163,8 @@ class Simulator:
         self._prm[k.P_HOOK_KP] = s.hook_kp
         self._prm[k.P_HOOK_KI] = s.hook_ki
         self._prm[k.P_BHA_PART] = s.bha_part
+        self._prm[k.P_PICKUP] = s.pickup
+        self._prm[k.P_CLEARANCE] = s.clearance
 
     def _fill_drive(self, drive: td.TopDrive) -> None:
         """The drive's inertia ratio, gains, torque limit and lag into the parameters (its
@@ -209,9 +213,10 @@ class Simulator:
         and torque command on the torque that this leaves at the top."""
         parts_t, parts = self._parts[0], self._wave_i.shape[1]
         top_torque = sg.fill_steady(self._wave, self._wave_i, self._wave_f, 0, parts_t,
-                                    bit_torque, speed)
+                                    bit_torque, speed, axial_speed, parts_t)
         sg.fill_steady(self._wave, self._wave_i, self._wave_f, parts_t, parts, bit_force,
-                       axial_speed)
+                       axial_speed, speed, -parts_t)
+        self._wave_f[sg.W_WORK] = 0.0
         st = self._state
         st[k.S_TD_INTEGRAL] = st[k.S_MOTOR_TORQUE] = top_torque
         self._targets[k.I_MOTOR_TORQUE] = top_torque
@@ -243,6 +248,8 @@ class Simulator:
         self._unchecked_steps = 0
         self._init_profile(triv)
         self._init_history(triv)
+        if self._prm[k.P_OFF_BOTTOM] == k.OFF_BOTTOM_LIFTED:
+            self._prm[k.P_OFF_BOTTOM] = 0.0  # the trivial solution drills on bottom
         self._init_wave(triv)
         self.set_formation(self._layers)
         self.fault: str | None = None
@@ -596,6 +603,39 @@ class Simulator:
         if self.distributed:                 # twisted only by its dampers' drag
             self._fill_steady(0.0, st[k.S_OMEGA_S], 0.0, 0.0)
 
+    def start_at_rest(self) -> None:
+        """The string hung off bottom as :meth:`hang_off_bottom`, but at rest and untwisted:
+        drive, string and bit still, the speed loop's setpoint, integral and torque zero,
+        every wall junction stuck (``drill_sim startup`` starts here; set the speed target
+        and its ramp rate to start rotating)."""
+        self._state[k.S_OMEGA_S] = 0.0
+        self._targets[k.I_OMEGA_S] = 0.0
+        self.hang_off_bottom()
+        self._state[k.S_OMEGA_REF] = 0.0
+
+    def set_off_bottom(self, off: bool) -> None:
+        """Pick the bit up off bottom (``True``): the hook rises at the string's pick-up
+        speed until the bit is its clearance above the rock, and holds it; the bit leaves
+        the rock through the bit law's own contact (eq. 31). ``False``: tag bottom again,
+        the hook back on its WOB loop lowering the string until the bit cuts (the law's
+        own transition from off bottom, no jump). Needs the distributed string's hook."""
+        if not self.distributed:
+            raise ParameterError("off bottom needs the distributed string (a hook that "
+                                 "holds it); RGD07's lumped string is always on bottom")
+        self._prm[k.P_OFF_BOTTOM] = k.OFF_BOTTOM_LIFTED if off else 0.0
+
+    @property
+    def off_bottom(self) -> bool:
+        """Whether the bit is picked up (or hung) off bottom, as set."""
+        return bool(self._prm[k.P_OFF_BOTTOM] != 0.0)
+
+    def wall_work(self) -> float:
+        """The work the wall's friction has taken from the string since the start (reset,
+        :meth:`hang_off_bottom`), kernel units (both lines; 0 without a well)."""
+        if not self.distributed:
+            return 0.0
+        return float(self._wave_f[sg.W_WORK].sum()) * self.config.dtau
+
     def string_arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, tuple[int, ...]]:
         """The delay lines as they are (wave, layout int, layout float, parts per line), for
         instruments that send a pulse into the string; writes to ``wave`` are the state."""
@@ -609,7 +649,9 @@ class Simulator:
                         None if self._meta is None else self._meta.copy(),
                         self._depth_offset, self._angle_offset, float(self._prm[k.P_TD_MODE]),
                         *((self._wave.copy(), self._wave_i[sg.W_POS].copy())
-                          if self.distributed else (None, None)), self._layer_index)
+                          if self.distributed else (None, None)), self._layer_index,
+                        self._wave_f[sg.W_LAST:].copy() if self.distributed else None,
+                        float(self._prm[k.P_OFF_BOTTOM]))
 
     def restore(self, snap: Snapshot) -> None:
         """Resume from a :meth:`snapshot` of a simulator with the same settings."""
@@ -631,6 +673,9 @@ class Simulator:
                 raise ParameterError("snapshot string layout differs from this simulator's")
             self._wave = snap.wave.copy()
             self._wave_i[sg.W_POS] = snap.wave_pos
+            if snap.junctions is not None:
+                self._wave_f[sg.W_LAST:] = snap.junctions
+        self._prm[k.P_OFF_BOTTOM] = snap.off_bottom
         self.fault = None
 
     @property

@@ -32,6 +32,8 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 from numba import njit
 
+from drill_sim_ros.model.well import Well
+
 STRING_LUMPED = 0
 STRING_DISTRIBUTED = 1
 STRING_MODELS = ("lumped", "distributed")
@@ -42,7 +44,13 @@ STEEL_YOUNGS_MODULUS_PA = 206.0e9
 
 # rows of the integer and float layout arrays of the delay lines
 W_LEN, W_OFF, W_POS = 0, 1, 2          # int64 (3, segments): steps, buffer offset, slot
-W_Z, W_D = 0, 1                         # float64 (2, segments): impedance, damper below
+# float64 (W_ROWS, segments), per part, of the junction below it: impedance, point damper,
+# the wall's static and dynamic friction limits (0: no wall contact), the stick band, the
+# surface slip (m / t*) per unit of the line's speed (r_o; L*), and two rows of state: the
+# junction's speed last step (the stick band's memory) and the friction power summed over
+# the steps (x dtau: the work the wall took)
+W_Z, W_D, W_FS, W_FD, W_VS, W_SLIP, W_LAST, W_WORK = 0, 1, 2, 3, 4, 5, 6, 7
+W_ROWS = 8
 
 
 # ---- sections (SI) ------------------------------------------------------------------------
@@ -127,13 +135,20 @@ class StringSpec:
     is the BHA for the lumped equivalent. ``bit_inertia_kg_m2``: lumped inertia at the bit
     beyond the sections. ``hook_wob_time_s``: time constant of the hook's WOB loop (the
     driller's brake / autodriller holding the top so that the weight on bit follows the
-    applied-WOB command). ``damping_points``: point dampers per section."""
+    applied-WOB command). ``damping_points``: point dampers (and wall-friction points) per
+    section. Off bottom the hook picks the string up at ``hook_pickup_m_s`` until the bit
+    is ``off_bottom_clearance_m`` above the rock, and holds it there. ``well``: the hole
+    around the string (:mod:`drill_sim_ros.model.well`; None: vertical, no wall contact)."""
 
     model: str = "lumped"
     sections: tuple[Section, ...] = ()
     bit_inertia_kg_m2: float = field(default=0.0, metadata=_bounds(0.0, 1e6))
     hook_wob_time_s: float = field(default=5.0, metadata=_bounds(0.0, 1e4, low_open=True))
     damping_points: int = field(default=4, metadata=_bounds(1, 64))
+    off_bottom_clearance_m: float = field(default=0.5, metadata=_bounds(0.0, 100.0,
+                                                                        low_open=True))
+    hook_pickup_m_s: float = field(default=0.05, metadata=_bounds(0.0, 10.0, low_open=True))
+    well: Well | None = None
 
     @property
     def distributed(self) -> bool:
@@ -296,42 +311,86 @@ def analytic_modes_hz(spec: StringSpec, count: int = 3, axial: bool = False,
 @dataclass(frozen=True)
 class WaveLine:
     """One kind of wave (torsional or axial) along the string, in kernel units: per part
-    (top to bottom) its travel time in tau, impedance, and the point damper below it."""
+    (top to bottom) its travel time in tau, impedance, the point damper below it, its length
+    in m, and the wall friction at the junction below it: the static and dynamic limits of
+    its torque (force), the stick band and the surface slip per unit speed (the rows of
+    ``wave_f``; empty: no wall contact)."""
 
     travel_tau: tuple[float, ...]
     impedance: tuple[float, ...]
     damper_below: tuple[float, ...]
     length_m: tuple[float, ...] = ()
+    static_below: tuple[float, ...] = ()
+    dynamic_below: tuple[float, ...] = ()
+    stick_speed: tuple[float, ...] = ()
+    slip_per_speed: tuple[float, ...] = ()
 
 
-def section_parts(rate_per_s: float, damping_points: int) -> tuple[tuple[float, ...], int]:
-    """How a section is cut into delay-line parts, the one rule: undamped, one part;
-    damped, ``damping_points`` point dampers, each at the middle of an equal share of the
-    section carrying that share's damping, and the lines run from damper to damper, so the
-    parts are a half share, ``damping_points - 1`` whole ones and a half (a junction with no
-    element between two equal lines would only pass the waves on, and cost a step's work).
-    Returns the parts' lengths in shares, and the shares in the section."""
-    if rate_per_s <= 0.0:
+def section_parts(lossy: bool, damping_points: int) -> tuple[tuple[float, ...], int]:
+    """How a section is cut into delay-line parts, the one rule: lossless, one part; with
+    losses (damping, wall friction), ``damping_points`` junction elements, each at the
+    middle of an equal share of the section carrying that share's damping and friction, and
+    the lines run from element to element, so the parts are a half share,
+    ``damping_points - 1`` whole ones and a half (a junction with no element between two
+    equal lines would only pass the waves on, and cost a step's work). Returns the parts'
+    lengths in shares, and the shares in the section."""
+    if not lossy:
         return (1.0,), 1
     return (0.5, *([1.0] * (damping_points - 1)), 0.5), damping_points
 
 
+def section_cut(spec: StringSpec, s: Section, axial: bool) -> tuple[tuple[float, ...], int]:
+    """:func:`section_parts` of ``s`` in ``spec``: lossy if damped for this kind of wave or
+    in contact with a wall that holds a friction (both lines are then cut alike, so a
+    torsional junction and the axial one at its depth share their part's index)."""
+    walled = spec.well is not None and spec.well.has_friction
+    return section_parts(walled or line_properties(s, axial).damping_per_s > 0.0,
+                         spec.damping_points)
+
+
+def _wall_friction(spec: StringSpec, s: Section, top_m: float, points: int,
+                   axial: bool) -> tuple[list[float], list[float], float, float]:
+    """The wall's friction limits at the ``points`` elements of ``s`` (its top at measured
+    depth ``top_m``), SI: static and dynamic torque r_o mu N (axial: force mu N) of each
+    element's share of the normal force (:meth:`Well.normal_force_n`), the stick band
+    (rad/s; axial: r_o omega_s m/s) and the surface slip per unit speed (r_o; 1)."""
+    well = spec.well
+    if well is None or not well.has_friction:
+        return [0.0] * points, [0.0] * points, 0.0, 0.0
+    arm = 1.0 if axial else s.outer_radius_m
+    share = s.length_m / points
+    normal = [well.normal_force_n(top_m + i * share, top_m + (i + 1) * share, s.area_m2,
+                                  s.density_kg_m3) for i in range(points)]
+    mu = well.side_friction
+    band = mu.stick_speed_rad_s * (s.outer_radius_m if axial else 1.0)
+    return ([arm * mu.static * n for n in normal], [arm * mu.dynamic * n for n in normal],
+            band, 1.0 if axial else s.outer_radius_m)
+
+
 def wave_line(spec: StringSpec, axial: bool, time_s: float, z_unit: float,
-              mass_unit: float) -> WaveLine:
-    """Parts of ``spec`` for one kind of wave (:func:`section_parts`). ``z_unit`` converts
-    an SI impedance to kernel units, ``mass_unit`` an SI damper (N m s/rad or N s/m)
-    likewise (same factor)."""
-    travel, z, damper, length = [], [], [], []
+              force_unit: float, length_unit: float) -> WaveLine:
+    """Parts of ``spec`` for one kind of wave (:func:`section_cut`). ``z_unit`` converts an
+    SI impedance (and a damper, N m s/rad or N s/m) to kernel units, ``force_unit`` a torque
+    (force), ``length_unit`` a length (the axial speed's unit L* / t*)."""
+    travel, z, damper, length, fs, fd, band, slip = [], [], [], [], [], [], [], []
+    top_m, speed_unit = 0.0, (length_unit if axial else 1.0) / time_s
     for s in spec.sections:
         props = line_properties(s, axial)
         t_tau = s.length_m / props.speed_m_s / time_s
-        shares, points = section_parts(props.damping_per_s, spec.damping_points)
-        d_share = props.damping_per_s * props.inertia_per_m * s.length_m / points / mass_unit
+        shares, points = section_cut(spec, s, axial)
+        d_share = props.damping_per_s * props.inertia_per_m * s.length_m / points / z_unit
+        static, dynamic, band_si, slip_si = _wall_friction(spec, s, top_m, points, axial)
         travel += [share * t_tau / points for share in shares]
         z += [props.impedance / z_unit] * len(shares)
         damper += [d_share] * (len(shares) - 1) + [0.0]
         length += [share * s.length_m / points for share in shares]
-    return WaveLine(tuple(travel), tuple(z), tuple(damper), tuple(length))
+        fs += [x / force_unit for x in static[:len(shares) - 1]] + [0.0]
+        fd += [x / force_unit for x in dynamic[:len(shares) - 1]] + [0.0]
+        band += [band_si / speed_unit] * len(shares)
+        slip += [slip_si * speed_unit * time_s] * len(shares)
+        top_m += s.length_m
+    return WaveLine(tuple(travel), tuple(z), tuple(damper), tuple(length), tuple(fs),
+                    tuple(fd), tuple(band), tuple(slip))
 
 
 def line_steps(line: WaveLine, dtau: float) -> np.ndarray:
@@ -341,35 +400,75 @@ def line_steps(line: WaveLine, dtau: float) -> np.ndarray:
     return np.diff(np.concatenate(([0], edges)))
 
 
+def _rows(line: WaveLine, name: str) -> np.ndarray:
+    """A per-part tuple of ``line`` as an array (zeros where the line has none)."""
+    values = getattr(line, name)
+    return np.asarray(values, dtype=float) if values else np.zeros(len(line.travel_tau))
+
+
 def build_lines(lines: tuple[WaveLine, ...], dtau: float
                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, tuple[int, ...]]:
     """The layout of the delay lines of ``lines`` (torsional first): ``(wave_i, wave_f,
-    counts)`` with ``wave_i`` int64 (3, parts) rows W_LEN, W_OFF, W_POS, ``wave_f``
-    float64 (2, parts) rows W_Z, W_D, and the parts per line; plus an empty buffer."""
+    wave, counts)`` with ``wave_i`` int64 (3, parts) rows W_LEN, W_OFF, W_POS, ``wave_f``
+    float64 (W_ROWS, parts) rows W_Z .. W_WORK (the state rows zero), an empty buffer,
+    and the parts per line."""
     lens = np.concatenate([line_steps(line, dtau) for line in lines])
     wave_i = np.zeros((3, lens.size), dtype=np.int64)
     wave_i[W_LEN] = lens
     wave_i[W_OFF] = np.concatenate(([0], np.cumsum(2 * lens)[:-1]))
-    wave_f = np.zeros((2, lens.size))
-    wave_f[W_Z] = np.concatenate([line.impedance for line in lines])
-    wave_f[W_D] = np.concatenate([line.damper_below for line in lines])
+    wave_f = np.zeros((W_ROWS, lens.size))
+    for row, name in ((W_Z, "impedance"), (W_D, "damper_below"), (W_FS, "static_below"),
+                      (W_FD, "dynamic_below"), (W_VS, "stick_speed"),
+                      (W_SLIP, "slip_per_speed")):
+        wave_f[row] = np.concatenate([_rows(line, name) for line in lines])
     return wave_i, wave_f, np.zeros(int(2 * lens.sum())), tuple(len(x.travel_tau)
                                                                  for x in lines)
 
 
+@njit(cache=True, inline="always")
+def wall_share(wave_f: np.ndarray, j: int, pair: int, own_speed: float,
+               other_speed: float) -> float:
+    """The share of the wall's friction at junction ``j`` that acts along its own line:
+    u / sqrt(u^2 + o^2), u and o the surface slip of its own motion (at least the stick
+    band's) and of the other line's at the same junction ``pair`` (the sliding force lies
+    along the surface slip velocity; 1 when the other line is still)."""
+    u = max(abs(own_speed), wave_f[W_VS, j]) * wave_f[W_SLIP, j]
+    o = abs(other_speed) * wave_f[W_SLIP, pair]
+    return 1.0 if o == 0.0 else u / math.sqrt(u * u + o * o)
+
+
+def steady_friction(wave_f: np.ndarray, j: int, pair: int, speed: float,
+                    other_speed: float) -> float:
+    """The wall's friction at junction ``j`` moving steadily at ``speed`` (the other line
+    at ``other_speed``): none at rest, the static limit within the stick band (Karnopp),
+    the dynamic one outside it, along the motion, times :func:`wall_share`."""
+    if speed == 0.0 or wave_f[W_FS, j] == 0.0:
+        return 0.0
+    limit = wave_f[W_FS, j] if abs(speed) <= wave_f[W_VS, j] else wave_f[W_FD, j]
+    return math.copysign(limit * wall_share(wave_f, j, pair, speed, other_speed), speed)
+
+
 def fill_steady(wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray, lo: int, hi: int,
-                end_force: float, speed: float) -> float:
-    """Parts ``lo..hi-1`` turning (moving) steadily at ``speed``: each carries the force at
-    the bottom end, ``end_force``, plus the drag D x speed of every point damper below its
-    top (the damper below part j sits at its bottom), so no damper sheds a wave. Returns
-    the force at the top, what the drive (hook) must hold."""
-    drag_below = np.cumsum(wave_f[W_D, lo:hi][::-1])[::-1] * speed
+                end_force: float, speed: float, other_speed: float = 0.0,
+                shift: int = 0) -> float:
+    """Parts ``lo..hi-1`` turning (moving) steadily at ``speed``, the other line at
+    ``other_speed`` (its junction ``j + shift`` beside junction ``j``): each part carries
+    the force at the bottom end, ``end_force``, plus the drag D x speed of every point
+    damper and the wall's friction (:func:`steady_friction`) of every junction below its
+    top (the elements below part j sit at its bottom), so no element sheds a wave. Every
+    junction's speed memory is ``speed``. Returns the force at the top, what the drive (the
+    hook) must hold."""
+    wall = np.array([steady_friction(wave_f, j, j + shift, speed, other_speed)
+                     for j in range(lo, hi)])
+    drag_below = (np.cumsum(wave_f[W_D, lo:hi][::-1])[::-1] * speed
+                  + np.cumsum(wall[::-1])[::-1])
     for j in range(lo, hi):
         n, off, z = wave_i[W_LEN, j], wave_i[W_OFF, j], wave_f[W_Z, j]
         force = end_force + float(drag_below[j - lo])
         wave[off:off + n] = force + z * speed
         wave[off + n:off + 2 * n] = force - z * speed
-    return end_force + speed * float(wave_f[W_D, lo:hi].sum())
+    wave_f[W_LAST, lo:hi] = speed
+    return end_force + speed * float(wave_f[W_D, lo:hi].sum()) + float(wall.sum())
 
 
 @dataclass(frozen=True)
@@ -379,7 +478,8 @@ class KernelString:
     ``model``: STRING_LUMPED or STRING_DISTRIBUTED; ``lines``: (torsional, axial);
     ``bit_inertia``: J_bit / I; ``hook_kp``, ``hook_ki``: the WOB loop's gains (hook speed
     per unit force error, and per unit force error and tau); ``bha_part``: the torsional
-    part at whose top the BHA speed is read; ``spec``: the SI description."""
+    part at whose top the BHA speed is read; ``spec``: the SI description; ``pickup``,
+    ``clearance``: the hook's pick-up speed off bottom and the bit's clearance then."""
 
     model: int
     lines: tuple[WaveLine, ...] = ()
@@ -388,6 +488,8 @@ class KernelString:
     hook_ki: float = 0.0
     bha_part: int = 0
     spec: StringSpec | None = None
+    pickup: float = 0.0
+    clearance: float = 0.0
 
 
 LUMPED = KernelString(STRING_LUMPED)
@@ -402,15 +504,16 @@ def kernel_string(spec: StringSpec, time_s: float, torque_nm: float, length_m: f
         return KernelString(STRING_LUMPED, spec=spec)
     z_torsion = torque_nm * time_s                     # N m s/rad per kernel unit
     z_axial = force_n * time_s / length_m               # N s/m per kernel unit
-    torsion = wave_line(spec, False, time_s, z_torsion, z_torsion)
-    axial = wave_line(spec, True, time_s, z_axial, z_axial)
+    torsion = wave_line(spec, False, time_s, z_torsion, torque_nm, length_m)
+    axial = wave_line(spec, True, time_s, z_axial, force_n, length_m)
     stiffness = length_m / force_n / axial_compliance_m_per_n(spec)
     t_w = spec.hook_wob_time_s / time_s
-    bha_rate = line_properties(spec.sections[-1], False).damping_per_s
-    bha_part = len(torsion.travel_tau) - len(section_parts(bha_rate, spec.damping_points)[0])
+    bha_part = len(torsion.travel_tau) - len(section_cut(spec, spec.sections[-1], False)[0])
     return KernelString(STRING_DISTRIBUTED, (torsion, axial),
                         spec.bit_inertia_kg_m2 / (torque_nm * time_s**2),
-                        2.0 / (t_w * stiffness), 1.0 / (t_w**2 * stiffness), bha_part, spec)
+                        2.0 / (t_w * stiffness), 1.0 / (t_w**2 * stiffness), bha_part, spec,
+                        spec.hook_pickup_m_s * time_s / length_m,
+                        spec.off_bottom_clearance_m / length_m)
 
 
 # ---- compiled: the string's step (the kernel's seam) ------------------------------------
@@ -489,12 +592,39 @@ def _distributed_ends(wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray, 
 
 
 @njit(cache=True, inline="always")
-def junction_speed(wave_f: np.ndarray, j: int, a_in: float, b_in: float) -> float:
+def junction_speed(wave_f: np.ndarray, j: int, a_in: float, b_in: float,
+                   pair: int) -> float:
     """The speed of the junction below part ``j``, from the waves arriving at it (``a_in``
     from above, ``b_in`` from below): continuous across it, with the torques balanced on
-    its elements, the point damper D (torque D w):
-    (a_in - Z_j w) - (b_in + Z_j+1 w) = D w."""
-    return (a_in - b_in) / (wave_f[W_Z, j] + wave_f[W_Z, j + 1] + wave_f[W_D, j])
+    its elements, the point damper D (torque D w) and the wall's friction F:
+    (a_in - Z_j w) - (b_in + Z_j+1 w) = D w + F. Without wall contact (W_FS 0) that is
+    w = (a_in - b_in) / (Z_j + Z_j+1 + D), the lossless scattering and its damper."""
+    if wave_f[W_FS, j] == 0.0:
+        return (a_in - b_in) / (wave_f[W_Z, j] + wave_f[W_Z, j + 1] + wave_f[W_D, j])
+    return wall_junction(wave_f, j, a_in - b_in, pair)
+
+
+@njit(cache=True, inline="always")
+def wall_junction(wave_f: np.ndarray, j: int, push: float, pair: int) -> float:
+    """:func:`junction_speed` with the wall's Coulomb friction (model.well), set-valued and
+    implicit in the new speed, as the bit's stick (eq. 32): the junction is held still while
+    the unbalanced torque ``push`` = a_in - b_in is within the limit, and else slides with
+    w (Z_j + Z_j+1 + D) = push - limit sign(push). The limit is the static one while the
+    junction's last speed is within the stick band, the dynamic one outside it (Karnopp),
+    times the share along this line (the surface slip's direction, with the other line's
+    junction ``pair``; :func:`wall_share`). Keeps the speed for the band, and the friction
+    power (limit |w|) summed in W_WORK. (Compiled apart, not inlined: the string without
+    a wall keeps its step.)"""
+    last = wave_f[W_LAST, j]
+    limit = wave_f[W_FS, j] if abs(last) <= wave_f[W_VS, j] else wave_f[W_FD, j]
+    limit *= wall_share(wave_f, j, pair, last, wave_f[W_LAST, pair])
+    w = 0.0
+    if abs(push) > limit:
+        w = (push - math.copysign(limit, push)) / (
+            wave_f[W_Z, j] + wave_f[W_Z, j + 1] + wave_f[W_D, j])
+    wave_f[W_LAST, j] = w
+    wave_f[W_WORK, j] += limit * abs(w)
+    return w
 
 
 # ---- compiled: one step of a line -------------------------------------------------------
@@ -506,7 +636,7 @@ def drive_line(wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray, lo: int
     bottom (``echo`` 1; 0: an anechoic bottom that sends nothing back)."""
     b_top, a_bottom = arriving(wave, wave_i, lo, hi)
     scatter(wave, wave_i, wave_f, lo, hi, b_top + 2.0 * wave_f[W_Z, lo] * w_top,
-            (a_bottom - 2.0 * wave_f[W_Z, hi - 1] * w_bottom) * echo)
+            (a_bottom - 2.0 * wave_f[W_Z, hi - 1] * w_bottom) * echo, hi if lo == 0 else -lo)
 
 
 @njit(cache=True, inline="always")
@@ -519,20 +649,21 @@ def arriving(wave: np.ndarray, wave_i: np.ndarray, lo: int, hi: int) -> tuple[fl
 
 @njit(cache=True, inline="always")
 def scatter(wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray, lo: int, hi: int,
-            a_top: float, b_bottom: float) -> None:
+            a_top: float, b_bottom: float, shift: int) -> None:
     """One step of a line: ``a_top`` enters at the top, ``b_bottom`` at the bottom, every
     inner junction scatters what arrives (continuous speed, torques balanced with its point
     damper), and the delay lines move on by one step. Reads each slot before writing it.
     Indexes the layout arrays in place: row views would cost reference counting every step
     (about a tenth of the distributed string's step, measured). The junctions' law is
-    :func:`junction_speed`."""
+    :func:`junction_speed`; the other line's junction beside junction j is j + ``shift``
+    (the torsional line first, both cut alike where a wall holds them)."""
     a_slot = wave_i[W_OFF, lo] + wave_i[W_POS, lo]
     a_in = wave[a_slot]                      # arriving at the bottom of part lo
     wave[a_slot] = a_top
     for j in range(lo, hi - 1):
         b_slot = wave_i[W_OFF, j + 1] + wave_i[W_LEN, j + 1] + wave_i[W_POS, j + 1]
         b_in = wave[b_slot]                  # arriving at the top of part j + 1
-        w = junction_speed(wave_f, j, a_in, b_in)
+        w = junction_speed(wave_f, j, a_in, b_in, j + shift)
         wave[wave_i[W_OFF, j] + wave_i[W_LEN, j] + wave_i[W_POS, j]] = \
             a_in - 2.0 * wave_f[W_Z, j] * w
         a_slot = wave_i[W_OFF, j + 1] + wave_i[W_POS, j + 1]

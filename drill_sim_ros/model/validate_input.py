@@ -24,7 +24,8 @@ from drill_sim_ros.model.params import DimensionlessParams, PhysicalParams
 from drill_sim_ros.model.top_drive import MODES, TopDrive, TopDrivePhysical
 
 PRESET_SECTIONS = ("description", "physical", "dimensionless", "numerics", "top_drive",
-                   "string")      # 'string' is checked by model.presets (string_from_dict)
+                   "string", "well")  # 'string' and 'well': checked by model.presets and
+                                      # model.well
 # the lumped string's geometry: given by ``string.sections`` when the preset has them
 GEOMETRY_KEYS = ("pipe_outer_radius_m", "pipe_inner_radius_m", "pipe_length_m",
                  "bha_outer_radius_m", "bha_inner_radius_m", "bha_length_m")
