@@ -137,8 +137,15 @@ class Bench:
         self.preset = scenario.load_preset() if preset is None else preset
         self.rig = rig_physics(self.preset)
         self.schedule = scenario.setpoints(self.preset)
+        if (self.schedule.off_bottom_changes or self.schedule.off_bottom0) and \
+                not self.preset.string.distributed:
+            raise ParameterError(f"scenario: off_bottom in the schedule needs a distributed "
+                                 f"string (a hook); preset '{self.preset.name}' is lumped")
         self.limits = command_limits(self.preset, self.rig)
         self.session = SimSession(session_config(scenario, self.preset))
+        self._off_bottom = self.schedule.off_bottom0   # the driller's last action
+        if self._off_bottom:         # a start-up: picked up, at rest and untwisted
+            self.session.start_at_rest()
         self.periods = scenario.periods
         self.rows = np.empty((self.periods + 1, N_FIELDS))
         self.rows[0] = self.session.current().rows[0]
@@ -166,12 +173,22 @@ class Bench:
         for applied, why in apply_command(self.session, command, self.limits):
             if not applied:
                 raise ParameterError(f"the controller commanded {why}; commands must be finite")
+        self._driller()
         self.session.command_stamp_ns = self.stamp_ns
         block = self.session.run(1)
         self.period += 1
         self.rows[self.period] = block.rows[0]
         self.stamp_ns = int(block.stamps_ns[0])
         return self.rows[self.period]
+
+
+    def _driller(self) -> None:
+        """The driller's own action of the schedule: the bit picked up off bottom or tagged
+        again from this period on (not the controller's to command)."""
+        off = self.schedule.off_bottom_at(self.period * self.scenario.period_s)
+        if off != self._off_bottom:
+            self.session.set_off_bottom(off)
+            self._off_bottom = off
 
 
 def run_in_process(scenario: Scenario,

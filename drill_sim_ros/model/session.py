@@ -327,6 +327,26 @@ class SimSession:
         drive applies it within its limit (``top_drive.within_limit``)."""
         self._input(self.sim.set_motor_torque_nm, torque_nm)
 
+    def set_off_bottom(self, off: bool) -> None:
+        """Pick the bit up off bottom (True) or tag bottom again (False), from now plus the
+        command delay (Simulator.set_off_bottom; ParameterError on the lumped string, now)."""
+        if not self.sim.distributed:
+            self.sim.set_off_bottom(off)            # raises: the lumped string has no hook
+        self._input(self._set_off_bottom, 1.0 if off else 0.0)
+
+    def start_at_rest(self) -> None:
+        """The bit picked up off bottom with everything at rest and untwisted, now
+        (Simulator.start_at_rest: a start-up after a connection)."""
+        self.sim.start_at_rest()
+
+    def _set_off_bottom(self, off: float) -> None:
+        self.sim.set_off_bottom(off == 1.0)
+
+    @property
+    def off_bottom(self) -> bool:
+        """Whether the bit is picked up off bottom (as last applied)."""
+        return self.sim.off_bottom
+
     def _set_rpm(self, rpm: float) -> None:
         self.sim.set_inputs(omega_s=self.scales.omega_from_rpm(rpm))
 

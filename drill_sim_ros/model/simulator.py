@@ -604,14 +604,24 @@ class Simulator:
             self._fill_steady(0.0, st[k.S_OMEGA_S], 0.0, 0.0)
 
     def start_at_rest(self) -> None:
-        """The string hung off bottom as :meth:`hang_off_bottom`, but at rest and untwisted:
-        drive, string and bit still, the speed loop's setpoint, integral and torque zero,
-        every wall junction stuck (``drill_sim startup`` starts here; set the speed target
-        and its ramp rate to start rotating)."""
+        """The bit picked up off bottom, the string at rest and untwisted, hanging from the
+        hook: drive, string and bit still, the speed loop's setpoint, integral and torque
+        zero, every wall junction stuck, the rock the string's clearance below the bit (as
+        :meth:`set_off_bottom` leaves it; ``False`` then tags bottom through the bit law).
+        ``drill_sim startup`` starts here; set the speed target and its ramp rate to start
+        rotating. Needs the distributed string."""
+        self.set_off_bottom(True)
         self._state[k.S_OMEGA_S] = 0.0
         self._targets[k.I_OMEGA_S] = 0.0
         self.hang_off_bottom()
+        self._prm[k.P_OFF_BOTTOM] = k.OFF_BOTTOM_LIFTED
         self._state[k.S_OMEGA_REF] = 0.0
+        st = self._state                           # the rock a clearance below the bit
+        drop = self.string.clearance + st[k.S_U] - min(self._profile.min(), st[k.S_H_OLD])
+        self._profile += drop
+        st[k.S_H_OLD] += drop
+        if self._hist is not None:
+            self._hist[1] += drop
 
     def set_off_bottom(self, off: bool) -> None:
         """Pick the bit up off bottom (``True``): the hook rises at the string's pick-up

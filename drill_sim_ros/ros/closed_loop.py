@@ -171,6 +171,11 @@ def run_over_dds(scenario: Scenario,
         raise DrillSimError("over DDS, a scenario's 'overrides' do not reach sim_node: put "
                             "them in a preset file and name it in 'preset'")
     preset = scenario.load_preset()
+    schedule = scenario.setpoints(preset)
+    if schedule.off_bottom_changes or schedule.off_bottom0:
+        raise DrillSimError("over DDS, the schedule's off_bottom actions are the driller's: "
+                            "run the scenario in process, or call sim_node's ~/off_bottom "
+                            "service (std_srvs/SetBool) yourself")
     periods = scenario.periods
     timeout_s = timeout_s or 120.0 + periods / 50.0
     env = ros_environment()

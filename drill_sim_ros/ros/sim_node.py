@@ -223,6 +223,7 @@ class SimNode(Node):
         """``~/reset``, ``~/pause`` and ``~/step``, and the lockstep handshake of ``~/step``."""
         self.create_service(Trigger, "~/reset", self._on_reset)
         self.create_service(SetBool, "~/pause", self._on_pause)
+        self.create_service(SetBool, "~/off_bottom", self._on_off_bottom)
         step = self.create_service(Trigger, "~/step", self._on_step)
         self._handshake = Handshake(self.get_logger(), self._command_names[topics.CMD_TOP_DRIVE],
                                     self.resolve_service_name(step.srv_name),
@@ -592,6 +593,23 @@ class SimNode(Node):
         response.message = (f"model reset to its initial state at t = {time_s:.3f} s "
                             f"(sim time runs on)")
         self.get_logger().info(response.message)
+        return response
+
+    def _on_off_bottom(self, request: SetBool.Request, response: SetBool.Response
+                       ) -> SetBool.Response:
+        """The driller's pick-up (true) and tag (false): from the next period, through the
+        command delay (SimSession.set_off_bottom); refused on the lumped string."""
+        with self._lock.urgent():
+            if self._session is None:
+                response.success, response.message = False, "not started"
+                return response
+            try:
+                self._session.set_off_bottom(bool(request.data))
+            except ParameterError as exc:
+                response.success, response.message = False, str(exc)
+                return response
+        response.success = True
+        response.message = "picking up off bottom" if request.data else "tagging bottom"
         return response
 
     def _on_pause(self, request: SetBool.Request, response: SetBool.Response
