@@ -70,9 +70,22 @@ class Well:
         """The wall's normal force on the string between measured depths ``top_m`` and
         ``bottom_m``: the integral of (rho - rho_mud) A g sin(inc) ds (midpoint rule on
         ``pieces`` pieces, exact where the inclination is constant)."""
+        return self._buoyed_integral(math.sin, top_m, bottom_m, area_m2, density_kg_m3,
+                                     pieces)
+
+    def axial_weight_n(self, top_m: float, bottom_m: float, area_m2: float,
+                       density_kg_m3: float, pieces: int = 64) -> float:
+        """The buoyed weight along the hole's axis between ``top_m`` and ``bottom_m``: the
+        integral of (rho - rho_mud) A g cos(inc) ds, what the string hangs from the hook
+        with it when nothing drags (the hook load at rest off bottom)."""
+        return self._buoyed_integral(math.cos, top_m, bottom_m, area_m2, density_kg_m3,
+                                     pieces)
+
+    def _buoyed_integral(self, along: Any, top_m: float, bottom_m: float, area_m2: float,
+                         density_kg_m3: float, pieces: int) -> float:
         w_b = (density_kg_m3 - self.mud_density_kg_m3) * area_m2 * GRAVITY_M_S2
         ds = (bottom_m - top_m) / pieces
-        return w_b * ds * sum(math.sin(self.inclination_rad(top_m + (i + 0.5) * ds))
+        return w_b * ds * sum(along(self.inclination_rad(top_m + (i + 0.5) * ds))
                               for i in range(pieces))
 
     @property
