@@ -83,7 +83,8 @@ P_OFF_BOTTOM = 21   # 1: the bit hangs free off bottom (T = W = 0), the hook fix
 P_BHA_PART = 22     # distributed: the part at whose top the BHA speed is read
 P_PICKUP = 23       # distributed: the hook's pick-up speed off bottom (L* per t*)
 P_CLEARANCE = 24    # distributed: the bit's clearance above the rock it picks up to (L*)
-N_PARAMS = 25
+P_TAG_SPEED = 25    # distributed: the hook's lowering speed cap, L* per t* (inf until a tag)
+N_PARAMS = 26
 OFF_BOTTOM_LIFTED = 3.0
 
 # ---- surface targets (float64) ----------------------------------------------------------
@@ -159,12 +160,13 @@ Loop.__doc__ = """The loop-carried state of a run (the ``S_*`` slots and the his
 ``meta``: head, count, cursor)."""
 Law = namedtuple("Law", (
     "dt", "tau_avg", "beta", "lam", "n_blades", "psi", "off_bottom", "layer_u", "cut_factor",
-    "sector", "tgt_w", "w_rate", "inv_spacing", "hook_kp", "hook_ki", "pickup", "clearance"))
+    "sector", "tgt_w", "w_rate", "inv_spacing", "hook_kp", "hook_ki", "pickup", "clearance",
+    "tag_speed"))
 Law.__doc__ = """A run's constants of the bit law, the rock and the hook: dtau, the statistics
 window start, beta, lambda, n, psi, off bottom, the next layer's top, the cutting factor, the
 blade sector 2 pi / n, the applied weight's target and ramp rate, the profile's nodes per
-radian, the hook's WOB loop gains, its pick-up speed (0 on bottom) and the clearance it
-picks up to."""
+radian, the hook's WOB loop gains, its pick-up speed (0 on bottom), the clearance it picks
+up to and its lowering speed's cap (the tag speed; inf until a tag)."""
 Drive = namedtuple("Drive", (
     "mode", "omega", "torque", "omega_rate", "inertia", "kp", "ki", "max_torque", "lag_alpha"))
 Drive.__doc__ = """A run's top-drive parameters and commands (top_drive.drive_step)."""
@@ -231,21 +233,26 @@ def _accumulate(acc: np.ndarray, tau: float, tau_avg: float, mode: int, w_f: flo
 
 
 @njit(cache=True, inline="always")
-def _hook(kp: float, ki: float, fixed: bool, dt: float, w_app: float, f_top: float,
-          integral: float, pickup: float, clearance_left: float) -> tuple[float, float]:
-    """The hook's speed over the step (down positive): a PI loop (gains ``kp``, ``ki``) on
-    the applied-WOB error, so the string force at the top (the applied WOB the rig infers
-    from the hook load) follows W_APP; zero when ``fixed`` (hung off bottom). Picking up
-    off bottom (``pickup`` > 0), it rises at ``pickup`` until the bit's clearance above the
-    rock lacks nothing (``clearance_left`` <= 0), then holds; the loop's integral is kept
-    for the tag. Returns ``(speed, integral)``."""
-    if fixed:
+def _hook(law: Law, w_app: float, f_top: float, integral: float,
+          clearance_left: float) -> tuple[float, float]:
+    """The hook's speed over the step (down positive): a PI loop (gains ``hook_kp``,
+    ``hook_ki``) on the applied-WOB error, so the string force at the top (the applied WOB
+    the rig infers from the hook load) follows W_APP, lowering at most at the tag speed
+    (its integral then held); zero when hung off bottom. Picking up off bottom
+    (``pickup`` > 0), it rises at ``pickup`` until the bit's clearance above the rock lacks
+    nothing (``clearance_left`` <= 0), then holds; the loop's integral is kept for the tag.
+    Returns ``(speed, integral)``."""
+    if law.off_bottom:
         return 0.0, integral
-    if pickup > 0.0:
-        return (-pickup if clearance_left > 0.0 else 0.0), integral
+    if law.pickup > 0.0:
+        return (-law.pickup if clearance_left > 0.0 else 0.0), integral
     err = w_app - f_top
-    integral += ki * err * dt
-    return kp * err + integral, integral
+    held = integral
+    integral += law.hook_ki * err * law.dt
+    speed = law.hook_kp * err + integral
+    if speed > law.tag_speed:            # slacking off onto the rock: the driller's speed
+        return law.tag_speed, held
+    return speed, integral
 
 
 @njit(cache=True, inline="always")
@@ -342,8 +349,7 @@ def _respond(x: Loop, law: Law, surface: float, cursor: int, ends: tuple,
         x.stuck, law.beta, law.lam)
     v_hook, hook_int = x.v_hook, x.hook_int
     if not lumped:                # the hook's WOB loop
-        v_hook, hook_int = _hook(law.hook_kp, law.hook_ki, law.off_bottom, law.dt, x.w_app,
-                                 f_top, hook_int, law.pickup,
+        v_hook, hook_int = _hook(law, x.w_app, f_top, hook_int,
                                  law.clearance + doc / law.n_blades)
     return Response(cursor, doc, t_top, f_top, v_new, omega_new, x.u + v_new * law.dt,
                     x.phi + omega_new * law.dt, w_f, wob, tob, mode, stuck, v_hook, hook_int)
@@ -404,7 +410,8 @@ def _law_params(prm: np.ndarray, tgt: np.ndarray, profile: np.ndarray) -> Law:
     return Law(prm[P_DT], prm[P_TAU_AVG], prm[P_BETA], prm[P_LAM], prm[P_N], prm[P_PSI],
                prm[P_OFF_BOTTOM] != 0.0 and not lifted, prm[P_LAYER_U], prm[P_CUT], sector,
                tgt[I_W_APP], prm[P_W_RATE], profile.shape[0] / sector, prm[P_HOOK_KP],
-               prm[P_HOOK_KI], prm[P_PICKUP] if lifted else 0.0, prm[P_CLEARANCE])
+               prm[P_HOOK_KI], prm[P_PICKUP] if lifted else 0.0, prm[P_CLEARANCE],
+               prm[P_TAG_SPEED])
 
 
 @njit(cache=True, inline="always")

@@ -165,6 +165,7 @@ class Simulator:
         self._prm[k.P_BHA_PART] = s.bha_part
         self._prm[k.P_PICKUP] = s.pickup
         self._prm[k.P_CLEARANCE] = s.clearance
+        self._prm[k.P_TAG_SPEED] = math.inf       # the WOB loop unbounded until a tag
 
     def _fill_drive(self, drive: td.TopDrive) -> None:
         """The drive's inertia ratio, gains, torque limit and lag into the parameters (its
@@ -633,6 +634,8 @@ class Simulator:
             raise ParameterError("off bottom needs the distributed string (a hook that "
                                  "holds it); RGD07's lumped string is always on bottom")
         self._prm[k.P_OFF_BOTTOM] = k.OFF_BOTTOM_LIFTED if off else 0.0
+        if not off:                  # the driller slacks off onto the rock at the tag speed
+            self._prm[k.P_TAG_SPEED] = self.string.tag_speed
 
     @property
     def off_bottom(self) -> bool:

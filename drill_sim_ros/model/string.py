@@ -137,7 +137,8 @@ class StringSpec:
     driller's brake / autodriller holding the top so that the weight on bit follows the
     applied-WOB command). ``damping_points``: point dampers (and wall-friction points) per
     section. Off bottom the hook picks the string up at ``hook_pickup_m_s`` until the bit
-    is ``off_bottom_clearance_m`` above the rock, and holds it there. ``well``: the hole
+    is ``off_bottom_clearance_m`` above the rock, and holds it there; tagging bottom again
+    it lowers at most at ``hook_tag_m_s`` (the driller's slack-off). ``well``: the hole
     around the string (:mod:`drill_sim_ros.model.well`; None: vertical, no wall contact)."""
 
     model: str = "lumped"
@@ -148,6 +149,7 @@ class StringSpec:
     off_bottom_clearance_m: float = field(default=0.5, metadata=_bounds(0.0, 100.0,
                                                                         low_open=True))
     hook_pickup_m_s: float = field(default=0.05, metadata=_bounds(0.0, 10.0, low_open=True))
+    hook_tag_m_s: float = field(default=0.02, metadata=_bounds(0.0, 10.0, low_open=True))
     well: Well | None = None
 
     @property
@@ -479,7 +481,8 @@ class KernelString:
     ``bit_inertia``: J_bit / I; ``hook_kp``, ``hook_ki``: the WOB loop's gains (hook speed
     per unit force error, and per unit force error and tau); ``bha_part``: the torsional
     part at whose top the BHA speed is read; ``spec``: the SI description; ``pickup``,
-    ``clearance``: the hook's pick-up speed off bottom and the bit's clearance then."""
+    ``clearance``: the hook's pick-up speed off bottom and the bit's clearance then;
+    ``tag_speed``: its lowering speed's cap when it tags bottom again."""
 
     model: int
     lines: tuple[WaveLine, ...] = ()
@@ -490,6 +493,7 @@ class KernelString:
     spec: StringSpec | None = None
     pickup: float = 0.0
     clearance: float = 0.0
+    tag_speed: float = 0.0
 
 
 LUMPED = KernelString(STRING_LUMPED)
@@ -513,7 +517,8 @@ def kernel_string(spec: StringSpec, time_s: float, torque_nm: float, length_m: f
                         spec.bit_inertia_kg_m2 / (torque_nm * time_s**2),
                         2.0 / (t_w * stiffness), 1.0 / (t_w**2 * stiffness), bha_part, spec,
                         spec.hook_pickup_m_s * time_s / length_m,
-                        spec.off_bottom_clearance_m / length_m)
+                        spec.off_bottom_clearance_m / length_m,
+                        spec.hook_tag_m_s * time_s / length_m)
 
 
 # ---- compiled: the string's step (the kernel's seam) ------------------------------------

@@ -45,3 +45,20 @@ def test_errors_name_the_bad_input(data, names) -> None:
         scenario = scenario_from_dict(data)
         scenario.setpoints(scenario.load_preset())
         scenario.rig_sensors()
+
+
+def test_off_bottom_is_an_action_at_its_time() -> None:
+    s = schedule_from_list([{"t_s": 0, "rpm": 0, "off_bottom": True},
+                            {"t_s": 1, "rpm": 60, "ramp_s": 10},
+                            {"t_s": 40, "off_bottom": False, "ramp_s": 5},
+                            {"t_s": 50, "off_bottom": True}], 35.0, 6e4)
+    assert [s.off_bottom_at(t) for t in (0, 39.99, 40, 42, 49.9, 50, 99)] == \
+        [True, True, False, False, False, True, True]
+    assert s.rpm_at(6.0) == pytest.approx(30.0)          # the rpm ramps; the action does not
+    assert not schedule_from_list([{"t_s": 3, "rpm": 50}], 35.0, 6e4).off_bottom_at(9.0)
+
+
+@pytest.mark.parametrize("value", [1, "yes", None])
+def test_off_bottom_must_be_true_or_false(value) -> None:
+    with pytest.raises(ParameterError, match=r"'off_bottom' = .* must be true or false"):
+        schedule_from_list([{"t_s": 5, "off_bottom": value}], 35.0, 6e4)

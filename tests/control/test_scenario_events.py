@@ -190,3 +190,42 @@ def test_a_scenario_motor_lag_reaches_the_drive() -> None:
     )
     with pytest.raises(ParameterError, match="command_delay_s"):
         scenario_from_dict({"drive": {"command_delay_s": -1.0}})
+
+
+def test_a_start_up_scenario_starts_off_bottom_at_rest_and_the_tag_drills() -> None:
+    """The driller's schedule on the bench: picked up at t = 0 (everything still, no weight
+    on the bit), rotation ramped by the schedule, then a tag: the hook slacks off at the tag
+    speed v and the bit meets the rock after clearance / v, through the bit law's own
+    contact: at first contact the weight on bit is the collars' impact force, at most their
+    axial impedance A sqrt(E rho) times v (an elastic line meeting a wall), not a jump to
+    the applied weight; then it drills."""
+    preset = load_preset("field_8p5in_shale")
+    spec = preset.string
+    collars = spec.sections[-1]
+    area_m2 = math.pi * (collars.outer_radius_m**2 - collars.inner_radius_m**2)
+    impact_n = area_m2 * math.sqrt(collars.youngs_modulus_pa * collars.density_kg_m3) \
+        * spec.hook_tag_m_s
+    scenario = scenario_from_dict({
+        "preset": "field_8p5in_shale", "duration_s": 45, "enable_at_s": 0,
+        "controller": "none", "schedule": [
+            {"t_s": 0, "rpm": 0, "wob_n": 60000, "off_bottom": True},
+            {"t_s": 0.5, "rpm": 40, "ramp_s": 5}, {"t_s": 10, "off_bottom": False}]})
+    rows = run_in_process(scenario).rows
+    t, wob = times(rows), rows[:, F["wob_n"]]
+    first = rows[0]
+    assert first[F["bit_rpm"]] == 0.0 and first[F["surface_rpm"]] == 0.0
+    assert first[F["wob_n"]] == 0.0 and first[F["surface_torque_nm"]] == 0.0
+    contact = int(np.argmax(wob > 0.0))
+    tag_s = spec.off_bottom_clearance_m / spec.hook_tag_m_s
+    assert 10.0 + 0.9 * tag_s < t[contact] < 10.0 + 1.1 * tag_s
+    assert 0.0 < wob[contact] <= 1.2 * impact_n
+    assert np.mean(wob[t > t[contact] + 5.0]) > 0.5 * 60000.0        # drilling again
+
+
+def test_off_bottom_on_the_lumped_string_is_refused_in_one_line() -> None:
+    scenario = scenario_from_dict({
+        "preset": "field_8p5in_shale_lumped", "duration_s": 5, "enable_at_s": 0,
+        "controller": "none",
+        "schedule": [{"t_s": 1, "off_bottom": True}]})
+    with pytest.raises(ParameterError, match="needs a distributed string"):
+        Bench(scenario)
