@@ -3,6 +3,9 @@ from the definitions in the module's docstring; and the inputs it refuses."""
 
 from __future__ import annotations
 
+import math
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -15,6 +18,7 @@ from drill_sim_ros.model.startup import (
     startup_scores,
     stuck_spans,
 )
+from tests.model.helpers import SMALL_DEVIATED
 
 DT_S = 0.1
 N = 201                      # t = 0 .. 20 s; the second half: t >= 10 s, samples 100 .. 200
@@ -134,3 +138,37 @@ def test_inputs_out_of_range_are_named(rpm: float, ramp_s: float, seconds: float
                                        named: str) -> None:
     with pytest.raises(ParameterError, match=named):
         run_startup(load_preset("field_8p5in_shale"), rpm, ramp_s, seconds)
+
+
+def _wall_torque_nm(mu: float) -> float:
+    """The wall's Coulomb torque on the whole of SMALL_DEVIATED at friction ``mu``, by hand:
+    r_o mu w_b S per section, w_b = (rho - rho_mud) A g the buoyed weight per metre and S the
+    integral of sin(inclination) over the section. The pipe: 500 m built linearly from 0
+    to pi/3 gives 500 (1 - cos 60 deg) / (pi / 3), then 200 m at 60 deg; the collars: 100 m
+    at 60 deg."""
+    buoyed_n_m3 = (7850.0 - 1200.0) * 9.80665
+    s_pipe_m = 500.0 * 0.5 / (math.pi / 3.0) + 200.0 * math.sin(math.pi / 3.0)
+    s_collar_m = 100.0 * math.sin(math.pi / 3.0)
+    total = 0.0
+    for r_o, r_i, s_m in ((0.0635, 0.0543, s_pipe_m), (0.0857, 0.0357, s_collar_m)):
+        total += r_o * mu * buoyed_n_m3 * math.pi * (r_o**2 - r_i**2) * s_m
+    return total
+
+
+def test_a_short_start_up_in_a_deviated_well(tmp_path: Path) -> None:
+    """From rest the drive winds the string up before the bit moves: at break-away the
+    string torque at the top lies between the wall's dynamic and static torque on the whole
+    string (3.76 and 5.26 kN m by hand; the upper part slides while the collars still hold),
+    within 10 % for the waves and the string's inertia, and the bit has not yet turned."""
+    path = tmp_path / "deviated.yaml"
+    path.write_text(SMALL_DEVIATED)
+    run = run_startup(load_preset(str(path)), 60.0, 5.0, 10.0)
+    assert run.t_s[0] == 0.0 and run.t_s[-1] == pytest.approx(10.0, abs=0.01)
+    assert np.all(np.diff(run.t_s) > 0.0)
+    s = startup_scores(run)
+    assert s["breakaway_s"] > 0.0
+    assert 0.9 * _wall_torque_nm(0.25) < s["breakaway_torque_nm"] < 1.1 * _wall_torque_nm(0.35)
+    turns = s["breakaway_turns"]
+    i = int(np.searchsorted(run.t_s, s["breakaway_s"]))
+    assert run.twist_turns[i] == pytest.approx(turns, rel=0.01)    # the bit barely moved
+    assert run.setpoint_rpm[-1] == pytest.approx(60.0)
