@@ -44,7 +44,7 @@ def cmd_modes(args: Any) -> int:
     if not 1 <= args.count <= 6:
         raise ParameterError(f"--count = {args.count} must be in [1, 6]")
     modes = si.identify_modes(load_preset(args.params), count=args.count).as_dict()
-    out = {kind: {key: [_rounded(v) for v in values] for key, values in d.items()}
+    out = {kind: {key: [rounded(v) for v in values] for key, values in d.items()}
            for kind, d in modes.items()}
     if not args.json:
         print("mode  kind        identified Hz  analytic Hz    error  identified zeta  "
@@ -56,7 +56,7 @@ def cmd_modes(args: Any) -> int:
     return 0
 
 
-def _rounded(value: float | None) -> float | None:
+def rounded(value: float | None) -> float | None:
     """6 decimals, no negative zero; None stays None (JSON null)."""
     return None if value is None else round(float(value), 6) + 0.0
 
@@ -79,7 +79,7 @@ def cmd_reflection(args: Any) -> int:
     if not 20.0 <= args.seconds <= 3600.0:
         raise ParameterError(f"--seconds = {args.seconds!r} must be in [20, 3600]")
     if args.plot is not None:
-        _check_plot_path(args.plot)
+        check_plot_path(args.plot)
     preset = load_preset(args.params)
     si.require_distributed(preset)
     curves: dict[str, list[float]] = {}
@@ -112,7 +112,8 @@ def cmd_reflection(args: Any) -> int:
     return 0
 
 
-def _check_plot_path(path: Path) -> None:
+def check_plot_path(path: Path) -> None:
+    """``--plot``: a new .png in a directory that exists (checked before the run)."""
     if path.suffix.lower() != ".png":
         raise ParameterError(f"--plot {path}: the picture is a .png")
     if path.is_dir() or path.exists():

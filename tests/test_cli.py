@@ -11,6 +11,9 @@ from pathlib import Path
 
 import pytest
 
+from tests.model.helpers import SMALL_DEVIATED
+from tests.robust.helpers import one_error_line, run_cli
+
 REQUIRED = ("first_stick_tau", "bounce_tau", "stick_fraction", "kappa", "kappa_from_depth",
             "mean_torque", "mean_depth_of_cut", "mean_wob", "omega_min", "omega_max",
             "trivial_torque", "trivial_depth_of_cut", "critical_delay", "growth_rate", "steps",
@@ -149,3 +152,51 @@ def test_modes_reports_damping_ratios(tmp_path: Path) -> None:
         expected = [rate / (4 * math.pi * f) for f in d["analytic_hz"]]
         assert d["analytic_damping_ratio"] == pytest.approx(expected, abs=2e-6)
         assert d["identified_damping_ratio"] == pytest.approx(expected, rel=0.10)
+
+
+STARTUP_KEYS = {"breakaway_s", "breakaway_turns", "breakaway_torque_nm", "first_slip_s",
+                "peak_motor_torque_nm", "stick_slip", "period_s", "stick_fraction",
+                "bit_rpm_max", "motor_torque_nm", "twist_turns"}
+
+
+@pytest.mark.parametrize(("args", "names"), [
+    (("--rpm", "0"), ("--rpm = 0.0", "(0, 300]")),
+    (("--rpm", "301"), ("--rpm = 301.0", "(0, 300]")),
+    (("--ramp-s", "-1"), ("--ramp-s = -1.0", "[0, 3600]")),
+    (("--seconds", "0"), ("--seconds = 0.0", "(0, 3600]")),
+    (("--params", "field_8p5in_shale_lumped"), ("field_8p5in_shale_lumped", "lumped",
+                                                "distributed")),
+    (("--params", "fig8b"), ("fig8b", "dimensionless")),
+    (("--params", "no_such_preset"), ("no_such_preset", "not found")),
+])
+def test_startup_refuses_bad_input_in_one_line(capsys: pytest.CaptureFixture[str],
+                                               args: tuple[str, ...],
+                                               names: tuple[str, ...]) -> None:
+    rc, out, err = run_cli(capsys, "startup", "--seconds", "5", *args)
+    one_error_line(rc, err, *names)
+    assert out == ""
+
+
+def test_startup_in_a_small_deviated_well(capsys: pytest.CaptureFixture[str],
+                                          tmp_path: Path) -> None:
+    """A real run of 10 s: --json is one line with every key, the bit breaks away; without
+    --json the summary comes first and the same JSON line last, and --plot writes a PNG."""
+    preset = tmp_path / "deviated.yaml"
+    preset.write_text(SMALL_DEVIATED)
+    args = ("startup", "--params", str(preset), "--rpm", "60", "--ramp-s", "5", "--seconds",
+            "10")
+    rc, out, err = run_cli(capsys, *args, "--json")
+    assert rc == 0, err
+    assert len(out.splitlines()) == 1
+    scores = json.loads(out)
+    assert set(scores) == STARTUP_KEYS
+    assert scores["breakaway_s"] > 0.0
+    assert set(scores["motor_torque_nm"]) == set(scores["twist_turns"]) == {"mean", "min",
+                                                                            "max"}
+    plot = tmp_path / "startup.png"
+    rc, out, err = run_cli(capsys, *args, "--plot", str(plot))
+    assert rc == 0, err
+    lines = out.splitlines()
+    assert "break-away" in out and "stick-slip" in out
+    assert json.loads(lines[-1]) == scores
+    assert plot.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

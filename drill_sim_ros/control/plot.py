@@ -82,7 +82,9 @@ def schedule_events(schedule: Schedule) -> tuple[tuple[float, str], ...]:
     return tuple(sorted(out))
 
 
-def _pyplot() -> Any:
+def pyplot() -> Any:
+    """matplotlib's pyplot on the Agg backend (files only), or one line saying how to
+    install it."""
     try:
         import matplotlib
         matplotlib.use("Agg")
@@ -94,7 +96,7 @@ def _pyplot() -> Any:
 
 def plot_runs(path: Path, runs: Sequence[PlotRun], ctx: PlotContext) -> None:
     """Write the PNG of ``runs`` side by side (module doc)."""
-    plt = _pyplot()
+    plt = pyplot()
     ncols = len(runs)
     fig, axes = plt.subplots(6, ncols, figsize=(4.2 * ncols + 1.5, 14.0), sharey="row",
                              squeeze=False)

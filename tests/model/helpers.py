@@ -54,3 +54,29 @@ def whole_cycle_averages(p: DimensionlessParams, cycles: int, settle_tau: float 
     for _ in range(cycles):
         assert advance_to_stick_onset(sim, sim.tau + 50.0)
     return an.cycle_averages(p, sim.accumulators)
+
+
+# A small deviated well for the start-up (a run of 10 s takes about a second): 900 m of
+# 5-in pipe on 100 m of 6.75-in collars, vertical to 200 m, built at a constant rate to
+# 60 deg at 700 m and held; mud of 1200 kg/m^3; side friction 0.35 static, 0.25 dynamic.
+SMALL_DEVIATED = """\
+description: 900 m of 5-in pipe on 100 m of collars, a well built to 60 deg
+physical: {density_kg_m3: 7850.0, shear_modulus_pa: 79.3e9, youngs_modulus_pa: 206.0e9,
+  bit_radius_m: 0.108, n_blades: 6, intrinsic_specific_energy_pa: 230.0e6, zeta: 0.729,
+  mu_gamma: 0.48, contact_stress_times_wearflat_n_per_m: 1.0e5, applied_wob_n: 60000.0,
+  surface_rpm: 35.0}
+string:
+  model: distributed
+  sections:
+    - {outer_radius_m: 0.0635, inner_radius_m: 0.0543, length_m: 900.0}
+    - {outer_radius_m: 0.0857, inner_radius_m: 0.0357, length_m: 100.0}
+  bit_inertia_kg_m2: 0.3
+well:
+  survey: [{md_m: 0, inclination_deg: 0}, {md_m: 200, inclination_deg: 0},
+           {md_m: 700, inclination_deg: 60}]
+  mud_density_kg_m3: 1200
+  side_friction: {static: 0.35, dynamic: 0.25, stick_speed_rad_s: 0.05}
+top_drive: {mode: speed, inertia_kg_m2: 2900.0, kp_nm_s: 23200.0, ki_nm: 46400.0,
+  max_torque_nm: 50000.0}
+numerics: {dtau: 5.0e-5}
+"""
