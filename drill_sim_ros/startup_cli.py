@@ -12,6 +12,7 @@ from pathlib import Path
 from typing import Any
 
 from drill_sim_ros.model import startup
+from drill_sim_ros.model.checks import number_in
 from drill_sim_ros.model.defaults import MAX_SURFACE_RPM
 from drill_sim_ros.model.presets import DEFAULT_PRESET, load_preset
 from drill_sim_ros.string_cli import check_plot_path, rounded
@@ -48,9 +49,9 @@ def add_parser(sub: Any) -> None:
 
 def _check_args(args: Any) -> None:
     """Each bad argument one line naming it and its range, before anything runs."""
-    startup.require_in("--rpm", args.rpm, 0.0, MAX_SURFACE_RPM, low_open=True)
-    startup.require_in("--ramp-s", args.ramp_s, 0.0, startup.MAX_RAMP_S)
-    startup.require_in("--seconds", args.seconds, 0.0, startup.MAX_SECONDS, low_open=True)
+    number_in("--rpm", args.rpm, 0.0, MAX_SURFACE_RPM, low_open=True)
+    number_in("--ramp-s", args.ramp_s, 0.0, startup.MAX_RAMP_S)
+    number_in("--seconds", args.seconds, 0.0, startup.MAX_SECONDS, low_open=True)
     if args.plot is not None:
         check_plot_path(args.plot)
 

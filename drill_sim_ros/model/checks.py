@@ -6,6 +6,7 @@ each error is one :class:`ParameterError` line naming the place, the value and w
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable
 from typing import Any
 
@@ -42,3 +43,16 @@ def check_known_keys(values: dict[Any, Any], known: tuple[str, ...], where: str 
         place = f" in '{where}'" if where else ""
         raise ParameterError(f"unknown key(s) {', '.join(unknown)}{place}; known: "
                              f"{', '.join(known)}")
+
+
+def number_in(label: str, value: Any, low: float, high: float, low_open: bool = False) -> float:
+    """``value`` as a float in [low, high] ((low, high] with ``low_open``), or one
+    ParameterError line: ``<label> = <value> must be a number in [low, high]`` (``label`` as
+    the reader names the input: ``'well.survey[0].md_m'``, ``--rpm``)."""
+    number = as_number(value)
+    x = math.nan if number is None else float(number)
+    if not (math.isfinite(x) and (x > low if low_open else x >= low) and x <= high):
+        bracket = "(" if low_open else "["
+        raise ParameterError(f"{label} = {value!r} must be a number in {bracket}{low:g}, "
+                             f"{high:g}]")
+    return x

@@ -20,7 +20,7 @@ from dataclasses import MISSING, Field, dataclass, field, fields, replace
 from pathlib import Path
 from typing import Any
 
-from drill_sim_ros.model.checks import as_number, check_known_keys
+from drill_sim_ros.model.checks import check_known_keys, number_in
 from drill_sim_ros.model.errors import ParameterError
 from drill_sim_ros.model.formation import Rock
 from drill_sim_ros.model.params import (
@@ -199,14 +199,7 @@ def _number(where: str, key: str, value: Any, low: float, high: float,
             low_open: bool = False) -> float:
     """A float in range, or ParameterError naming ``where.key``, the value and the range
     (a YAML number, as the shared checks read one: not ``true``, not ``abc``)."""
-    number = as_number(value)
-    x = math.nan if number is None else float(number)
-    ok = math.isfinite(x) and (x > low if low_open else x >= low) and x <= high
-    if not ok:
-        bracket = "(" if low_open else "["
-        raise ParameterError(f"'{where}.{key}' = {value!r} must be a number in "
-                             f"{bracket}{low:g}, {high:g}]")
-    return x
+    return number_in(f"'{where}.{key}'", value, low, high, low_open)
 
 
 def _field_value(where: str, key: str, value: Any, f: Field) -> float:

@@ -32,6 +32,7 @@ from typing import Any
 import numpy as np
 
 from drill_sim_ros.model import kernel as k
+from drill_sim_ros.model.checks import number_in
 from drill_sim_ros.model.defaults import MAX_SURFACE_RPM
 from drill_sim_ros.model.errors import ParameterError
 from drill_sim_ros.model.presets import Preset
@@ -66,18 +67,6 @@ class StartupRun:
     drive_turns: np.ndarray
 
 
-def require_in(name: str, value: float, low: float, high: float,
-               low_open: bool = False) -> float:
-    """``value`` as a float in [low, high] ((low, high] with ``low_open``); else one line
-    naming ``name``, the value and the range."""
-    x = float(value)
-    above = x > low if low_open else x >= low
-    if not (math.isfinite(x) and above and x <= high):
-        bracket = "(" if low_open else "["
-        raise ParameterError(f"{name} = {value!r} must be in {bracket}{low:g}, {high:g}]")
-    return x
-
-
 def require_startup_preset(preset: Preset) -> None:
     """A physical preset with a distributed string (the hook and the wall need one)."""
     if not preset.is_physical:
@@ -92,8 +81,8 @@ def startup_simulator(preset: Preset, rpm: float, ramp_s: float) -> Simulator:
     """The string of ``preset`` at rest off bottom, the speed loop's target ``rpm`` reached
     through a linear ramp of ``ramp_s`` (module doc)."""
     require_startup_preset(preset)
-    rpm = require_in("rpm", rpm, 0.0, MAX_SURFACE_RPM, low_open=True)
-    ramp_s = require_in("ramp_s", ramp_s, 0.0, MAX_RAMP_S)
+    rpm = number_in("rpm", rpm, 0.0, MAX_SURFACE_RPM, low_open=True)
+    ramp_s = number_in("ramp_s", ramp_s, 0.0, MAX_RAMP_S)
     sc = preset.scales
     omega = sc.omega_from_rpm(rpm)
     rate = omega / (ramp_s / sc.time_s) if ramp_s > 0.0 else math.inf
@@ -113,8 +102,8 @@ def run_startup(preset: Preset, rpm: float, ramp_s: float, seconds: float,
     """Start ``preset``'s string from rest off bottom (module doc) and sample it for
     ``seconds`` of simulated time, at about ``sample_hz`` (a whole number of steps apart),
     from t = 0 to t = ``seconds``. ``on_progress(fraction done)`` is called between chunks."""
-    seconds = require_in("seconds", seconds, 0.0, MAX_SECONDS, low_open=True)
-    sample_hz = require_in("sample_hz", sample_hz, *SAMPLE_HZ_RANGE)
+    seconds = number_in("seconds", seconds, 0.0, MAX_SECONDS, low_open=True)
+    sample_hz = number_in("sample_hz", sample_hz, *SAMPLE_HZ_RANGE)
     sim = startup_simulator(preset, rpm, ramp_s)
     step_s = preset.dtau * preset.scales.time_s
     every = max(1, round(1.0 / (sample_hz * step_s)))

@@ -27,7 +27,7 @@ import math
 from dataclasses import dataclass, field
 from typing import Any
 
-from drill_sim_ros.model.checks import as_number, check_known_keys
+from drill_sim_ros.model.checks import check_known_keys, number_in
 from drill_sim_ros.model.errors import ParameterError
 
 GRAVITY_M_S2 = 9.80665
@@ -94,11 +94,7 @@ class Well:
 
 
 def _number(where: str, value: Any, low: float, high: float) -> float:
-    number = as_number(value)
-    x = math.nan if number is None else float(number)
-    if not (math.isfinite(x) and low <= x <= high):
-        raise ParameterError(f"'{where}' = {value!r} must be a number in [{low:g}, {high:g}]")
-    return x
+    return number_in(f"'{where}'", value, low, high)
 
 
 def _survey(raw: Any) -> tuple[tuple[float, float], ...]:

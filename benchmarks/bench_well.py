@@ -1,0 +1,71 @@
+"""The deviated well's cost: the closed-loop bench with and without the wall (issue 32).
+
+Prints, no asserts. In process, soft_torque in speed mode, 180 s at 100 Hz on the deviated
+field preset, against the same preset with its ``well`` block removed (the vertical hole,
+the model as before), alternated in one process so both see the same machine; and the
+kernel's step alone on each (the string stepped with a row every 100 steps).
+Target: the bench on the deviated preset >= 100x real time, and as fast as without the well.
+Usage: .venv/bin/python benchmarks/bench_well.py [--preset field_8p5in_deviated] [--rounds 3]
+"""
+
+from __future__ import annotations
+
+import argparse
+import tempfile
+import time
+from dataclasses import replace
+from pathlib import Path
+
+import yaml
+
+from drill_sim_ros.control.bench import run_in_process
+from drill_sim_ros.control.scenario import Scenario
+from drill_sim_ros.model.presets import Preset, load_preset, preset_path
+from drill_sim_ros.model.simulator import SimConfig, Simulator
+
+
+def kernel_ns_per_step(preset: Preset, steps: int = 400_000) -> float:
+    """ns per step of the kernel alone on ``preset`` (a row every 100 steps), best of 3."""
+    best = float("inf")
+    for _ in range(3):
+        sim = Simulator(preset.params, SimConfig(dtau=preset.dtau, n_nodes=2048),
+                        top_drive=preset.top_drive, scales=preset.scales,
+                        string=preset.kernel_string)
+        start = time.perf_counter()
+        sim.advance(steps, 100)
+        best = min(best, (time.perf_counter() - start) / steps * 1e9)
+    return best
+
+
+def bench_rate(scenario: Scenario) -> float:
+    """Periods per second of the in-process closed loop."""
+    run = run_in_process(scenario)
+    return scenario.periods / run.wall_s
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--preset", default="field_8p5in_deviated")
+    parser.add_argument("--rounds", type=int, default=3)
+    args = parser.parse_args()
+    walled = load_preset(args.preset)
+    vertical = replace(walled, string=replace(walled.string, well=None))
+    scenario = Scenario(preset=args.preset, controller="soft_torque", duration_s=180.0,
+                        enable_at_s=60.0)
+    run_in_process(scenario.with_(duration_s=1.0, enable_at_s=0.0))     # compile, warm up
+    for name, preset in (("with the well", walled), ("without it", vertical)):
+        print(f"kernel, {name}: {kernel_ns_per_step(preset):.0f} ns/step")
+    data = yaml.safe_load(preset_path(args.preset).read_text())
+    data.pop("well")
+    vertical_path = Path(tempfile.mkdtemp(prefix="bench_well_")) / "vertical.yaml"
+    vertical_path.write_text(yaml.safe_dump(data))
+    plain = scenario.with_(preset=str(vertical_path))
+    for i in range(args.rounds):
+        for name, sc in (("with the well", scenario), ("without it", plain)):
+            rate = bench_rate(sc)
+            print(f"round {i + 1}, bench {name}: {rate:,.0f} periods/s "
+                  f"({rate / 100:.0f}x real time)", flush=True)
+
+
+if __name__ == "__main__":
+    main()
