@@ -617,8 +617,9 @@ class Simulator:
         self.hang_off_bottom()
         self._prm[k.P_OFF_BOTTOM] = k.OFF_BOTTOM_LIFTED
         self._state[k.S_OMEGA_REF] = 0.0
-        st = self._state                           # the rock a clearance below the bit
-        drop = self.string.clearance + st[k.S_U] - min(self._profile.min(), st[k.S_H_OLD])
+        st = self._state            # the rock a clearance below the bit (and a millionth
+        clearance = self.string.clearance * (1.0 + 1e-6)   # more: the hook holds, no ulp off)
+        drop = clearance + st[k.S_U] - min(self._profile.min(), st[k.S_H_OLD])
         self._profile += drop
         st[k.S_H_OLD] += drop
         if self._hist is not None:
