@@ -15,7 +15,7 @@ From a physical preset (RGD07 eq. 1 and the top drive of ``model.top_drive``):
 * the first three torsional natural frequencies of the string as sections (fixed top, free
   bit with its lumped inertia; ``string.analytic_modes_hz``; of a lumped preset: of the
   two sections its ``pipe_*`` / ``bha_*`` keys describe), and the scorecard's cut-off
-  between stick-slip and the collars' ringing, twice the third (:func:`cutoff_of`).
+  between stick-slip and the collars' ringing, twice the third (:func:`analysis.cutoff_of`).
 """
 
 from __future__ import annotations
@@ -23,14 +23,12 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from drill_sim_ros.model.analysis import MODE_COUNT, cutoff_of
 from drill_sim_ros.model.defaults import MAX_SURFACE_RPM
 from drill_sim_ros.model.errors import ParameterError
 from drill_sim_ros.model.params import PhysicalParams, structure
 from drill_sim_ros.model.presets import Preset, string_from_dict
 from drill_sim_ros.model.string import StringSpec, analytic_modes_hz
-
-MODE_COUNT = 3          # torsional modes kept on RigPhysics
-CUTOFF_PER_MODE = 2.0   # the cut-off, in units of the highest mode kept
 
 
 @dataclass(frozen=True)
@@ -85,16 +83,3 @@ def sections_of(string: StringSpec, phys: PhysicalParams) -> StringSpec:
     if string.distributed:
         return string
     return string_from_dict({"model": "distributed"}, phys)
-
-
-def cutoff_of(modes_hz: tuple[float, ...]) -> float:
-    """The cut-off between the string's stick-slip and the collars' ringing (Hz): twice
-    the highest of the first MODE_COUNT torsional modes (inf when fewer were found).
-
-    Stick-slip has its fundamental at 1/(1 to 2.5 T1), T1 the first mode's period, and
-    needs about a dozen harmonics to keep the shape of its stick phases, which reach past
-    the third mode; the collars ring (high-frequency torsional oscillation) an order of
-    magnitude higher, 16 Hz on the field preset. Twice f3 lies between the two."""
-    if len(modes_hz) < MODE_COUNT:
-        return math.inf
-    return CUTOFF_PER_MODE * modes_hz[MODE_COUNT - 1]

@@ -288,3 +288,21 @@ def spectral_peak(signal: ArrayLike, sample_period_s: float,
         return None
     peak = int(np.argmax(amplitude[above]))
     return float(freq_hz[above][peak]), float(amplitude[above][peak])
+
+
+MODE_COUNT = 3          # torsional modes that set the stick-slip cut-off
+CUTOFF_PER_MODE = 2.0   # the cut-off, in units of the highest of them
+
+
+def cutoff_of(modes_hz: tuple[float, ...]) -> float:
+    """The cut-off between the string's stick-slip and the collars' ringing (Hz): twice
+    the highest of the first MODE_COUNT torsional modes (inf when fewer were found).
+
+    Stick-slip has its fundamental at 1/(1 to 2.5 T1), T1 the first mode's period, and
+    needs about a dozen harmonics to keep the shape of its stick phases, which reach past
+    the third mode; the collars ring (high-frequency torsional oscillation) an order of
+    magnitude higher, 16 Hz on the field preset. Twice f3 lies between the two. The one
+    cut-off of the scorecard, its picture and the start-up's scores."""
+    if len(modes_hz) < MODE_COUNT:
+        return math.inf
+    return CUTOFF_PER_MODE * modes_hz[MODE_COUNT - 1]

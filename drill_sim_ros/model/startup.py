@@ -6,7 +6,9 @@ inertia) ramps its setpoint linearly from 0 to ``rpm`` in ``ramp_s`` (0: a step)
 deviated ``well:`` block the wall's Coulomb friction holds the string until the twist the
 drive winds in overcomes it; without one the bit follows at once.
 
-Definitions of :func:`startup_scores` (the bit speed in rev/min):
+Definitions of :func:`startup_scores` (the bit speed in rev/min, judged below the cut-off
+between stick-slip and ringing, twice the string's third torsional mode, zero-phase:
+:func:`judged_rpm`; ``bit_rpm_max`` is the raw speed's):
 
 * the bit *turns* above ``TURNING_RPM`` (1 rpm); it is *stuck* while |bit speed| is below it;
 * the bit *slips* above ``SLIP_RPM`` (30 rpm);
@@ -32,11 +34,13 @@ from typing import Any
 import numpy as np
 
 from drill_sim_ros.model import kernel as k
+from drill_sim_ros.model.analysis import MODE_COUNT, cutoff_of, lowpass
 from drill_sim_ros.model.checks import number_in
 from drill_sim_ros.model.defaults import MAX_SURFACE_RPM
 from drill_sim_ros.model.errors import ParameterError
 from drill_sim_ros.model.presets import Preset
 from drill_sim_ros.model.simulator import Samples, SimConfig, Simulator
+from drill_sim_ros.model.string import analytic_modes_hz
 
 TURNING_RPM = 1.0        # the bit turns above this; |bit speed| below it: stuck
 SLIP_RPM = 30.0          # the bit slips above this
@@ -65,6 +69,7 @@ class StartupRun:
     surface_torque_nm: np.ndarray
     twist_turns: np.ndarray
     drive_turns: np.ndarray
+    cutoff_hz: float = math.inf      # what the stick and slip are judged below (inf: raw)
 
 
 def require_startup_preset(preset: Preset) -> None:
@@ -131,12 +136,13 @@ def _series(blocks: list[Samples], preset: Preset) -> StartupRun:
         return col(index) / sc.time_s * RPM_PER_RAD_S
 
     phi_s = col(k.C_PHI_S)
+    cutoff_hz = cutoff_of(tuple(analytic_modes_hz(preset.string, MODE_COUNT)))
     return StartupRun(t_s=col(k.C_TAU) * sc.time_s, bit_rpm=rpm(k.C_OMEGA),
                       drive_rpm=rpm(k.C_OMEGA_S), setpoint_rpm=rpm(k.C_OMEGA_REF),
                       motor_torque_nm=col(k.C_MOTOR_TORQUE) * sc.torque_nm,
                       surface_torque_nm=col(k.C_T_PIPE) * sc.torque_nm,
                       twist_turns=(phi_s - col(k.C_PHI)) / RAD_PER_TURN,
-                      drive_turns=(phi_s - phi_s[0]) / RAD_PER_TURN)
+                      drive_turns=(phi_s - phi_s[0]) / RAD_PER_TURN, cutoff_hz=cutoff_hz)
 
 
 # ---- scores -------------------------------------------------------------------------------
@@ -148,7 +154,7 @@ def startup_scores(run: StartupRun) -> dict[str, Any]:
     ``peak_motor_torque_nm`` (max |motor torque|). Over the second half: ``stick_slip``,
     ``period_s``, ``stick_fraction``, ``bit_rpm_max``, and the mean, min and max of
     ``motor_torque_nm`` and ``twist_turns``."""
-    t, bit = run.t_s, run.bit_rpm
+    t, bit = run.t_s, judged_rpm(run)
     turning = _first_index(bit > TURNING_RPM)
     slip = _first_index(bit > SLIP_RPM)
     half = t >= 0.5 * (t[0] + t[-1])
@@ -162,10 +168,21 @@ def startup_scores(run: StartupRun) -> dict[str, Any]:
         "stick_slip": bool(onsets),
         "period_s": float(np.mean(np.diff(onsets))) if len(onsets) >= 2 else None,
         "stick_fraction": float(np.mean(np.abs(bit[half]) < TURNING_RPM)),
-        "bit_rpm_max": float(np.max(bit[half])),
+        "bit_rpm_max": float(np.max(run.bit_rpm[half])),
         "motor_torque_nm": _spread(run.motor_torque_nm[half]),
         "twist_turns": _spread(run.twist_turns[half]),
+        "cutoff_hz": run.cutoff_hz if math.isfinite(run.cutoff_hz) else None,
     }
+
+
+def judged_rpm(run: StartupRun) -> np.ndarray:
+    """The bit speed the sticks and slips are judged on: below the run's cut-off (twice the
+    string's third torsional mode, :func:`analysis.cutoff_of`, zero-phase), so the ringing of
+    a free bit end between the wall's contacts, and a wave's blip through a stuck bit, do
+    not split a stick or pass for a break-away (the closed-loop scorecard's rule)."""
+    if not math.isfinite(run.cutoff_hz) or run.t_s.size < 2:
+        return run.bit_rpm
+    return lowpass(run.bit_rpm, float(np.median(np.diff(run.t_s))), run.cutoff_hz)
 
 
 def _first_index(mask: np.ndarray) -> int | None:
