@@ -82,7 +82,8 @@ def test_scores_of_a_record_built_by_hand() -> None:
     assert s["twist_turns"] == pytest.approx({"mean": 302 / 101, "min": 2.0, "max": 4.0})
     assert set(s) == {"breakaway_s", "breakaway_turns", "breakaway_torque_nm",
                       "first_slip_s", "peak_motor_torque_nm", "stick_slip", "period_s",
-                      "stick_fraction", "bit_rpm_max", "motor_torque_nm", "twist_turns"}
+                      "stick_fraction", "bit_rpm_max", "motor_torque_nm", "twist_turns",
+                      "cutoff_hz"}
 
 
 def test_the_sticks_and_the_slips_that_follow_them() -> None:

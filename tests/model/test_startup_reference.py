@@ -101,8 +101,8 @@ def test_off_bottom_stick_slip_and_its_period_match_the_reference() -> None:
     the other): which one a run reaches depends on its transient, so the reference at 1 m
     elements rotates steadily here, while at 2 m (its default, the size its closed-form
     checks pass at) it sticks and slips, as the package does at 32, 64 and 128 junctions
-    (period 5.07 s at 64). Measured 2026-12-03; docs/string.md#side-friction-along-a-
-    deviated-well."""
+    (period 5.07 s at 64). Measured 2026-12-03 (docs/string.md, "Side friction along a
+    deviated well")."""
     ours, ref = both(20.0, 5.0, 120.0)
     assert ref["stick_slip"] and ours["stick_slip"]
     assert ours["period_s"] == pytest.approx(ref["period_s"], rel=0.10)
