@@ -428,26 +428,33 @@ def build_lines(lines: tuple[WaveLine, ...], dtau: float
 
 
 @njit(cache=True, inline="always")
-def wall_share(wave_f: np.ndarray, j: int, pair: int, own_speed: float,
+def wall_limit(wave_f: np.ndarray, j: int, pair: int, own_speed: float,
                other_speed: float) -> float:
-    """The share of the wall's friction at junction ``j`` that acts along its own line:
-    u / sqrt(u^2 + o^2), u and o the surface slip of its own motion (at least the stick
-    band's) and of the other line's at the same junction ``pair`` (the sliding force lies
-    along the surface slip velocity; 1 when the other line is still)."""
-    u = max(abs(own_speed), wave_f[W_VS, j]) * wave_f[W_SLIP, j]
+    """The wall's friction limit at junction ``j`` along its own line, its speed
+    ``own_speed`` and the other line's at the same junction ``pair`` ``other_speed``. The
+    contact sticks or slides as one: within the stick band while the surface slip
+    sqrt(u^2 + o^2) (u, o the slips of the two motions, m per t*) is within r_o omega_s,
+    where the static limit holds (Karnopp), else the dynamic one. The sliding force lies
+    along the slip velocity, so this line takes the share u / sqrt(u^2 + o^2) of it, u at
+    least the band's (a string that rotates drags little axially, and the other way round;
+    1 when the other line is still: the Coulomb law of one line)."""
+    u = abs(own_speed) * wave_f[W_SLIP, j]
     o = abs(other_speed) * wave_f[W_SLIP, pair]
-    return 1.0 if o == 0.0 else u / math.sqrt(u * u + o * o)
+    band = wave_f[W_VS, j] * wave_f[W_SLIP, j]
+    limit = wave_f[W_FS, j] if u * u + o * o <= band * band else wave_f[W_FD, j]
+    if o == 0.0:
+        return limit
+    u = max(u, band)
+    return limit * u / math.sqrt(u * u + o * o)
 
 
 def steady_friction(wave_f: np.ndarray, j: int, pair: int, speed: float,
                     other_speed: float) -> float:
     """The wall's friction at junction ``j`` moving steadily at ``speed`` (the other line
-    at ``other_speed``): none at rest, the static limit within the stick band (Karnopp),
-    the dynamic one outside it, along the motion, times :func:`wall_share`."""
+    at ``other_speed``): none at rest, else :func:`wall_limit` along the motion."""
     if speed == 0.0 or wave_f[W_FS, j] == 0.0:
         return 0.0
-    limit = wave_f[W_FS, j] if abs(speed) <= wave_f[W_VS, j] else wave_f[W_FD, j]
-    return math.copysign(limit * wall_share(wave_f, j, pair, speed, other_speed), speed)
+    return math.copysign(wall_limit(wave_f, j, pair, speed, other_speed), speed)
 
 
 def fill_steady(wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray, lo: int, hi: int,
@@ -614,15 +621,13 @@ def wall_junction(wave_f: np.ndarray, j: int, push: float, pair: int) -> float:
     """:func:`junction_speed` with the wall's Coulomb friction (model.well), set-valued and
     implicit in the new speed, as the bit's stick (eq. 32): the junction is held still while
     the unbalanced torque ``push`` = a_in - b_in is within the limit, and else slides with
-    w (Z_j + Z_j+1 + D) = push - limit sign(push). The limit is the static one while the
-    junction's last speed is within the stick band, the dynamic one outside it (Karnopp),
-    times the share along this line (the surface slip's direction, with the other line's
-    junction ``pair``; :func:`wall_share`). Keeps the speed for the band, and the friction
+    w (Z_j + Z_j+1 + D) = push - limit sign(push). The limit (:func:`wall_limit`) is the
+    static one while the contact's last slip, with the other line's junction ``pair``, is
+    within the stick band, the dynamic one outside it (Karnopp), times the share along
+    this line. Keeps the speed for the band, and the friction
     power (limit |w|) summed in W_WORK. (Compiled apart, not inlined: the string without
     a wall keeps its step.)"""
-    last = wave_f[W_LAST, j]
-    limit = wave_f[W_FS, j] if abs(last) <= wave_f[W_VS, j] else wave_f[W_FD, j]
-    limit *= wall_share(wave_f, j, pair, last, wave_f[W_LAST, pair])
+    limit = wall_limit(wave_f, j, pair, wave_f[W_LAST, j], wave_f[W_LAST, pair])
     w = 0.0
     if abs(push) > limit:
         w = (push - math.copysign(limit, push)) / (
