@@ -7,7 +7,8 @@ Three panels against simulated time, sharing it:
 3. the string's twist, turns.
 
 The break-away (the bit first above 1 rpm) is a red dashed line on every panel, its time in
-the legend; spans where the bit is stuck (|bit speed| below 1 rpm) are shaded. The legends
+the legend; spans where the bit is stuck (|bit speed| below 1 rpm) are shaded; both judged,
+as the scores are, on the bit speed below the cut-off (drawn navy over the raw speed). The legends
 stand right of the panels, off the curves.
 """
 
@@ -19,7 +20,7 @@ from typing import Any
 import numpy as np
 
 from drill_sim_ros.control.plot import pyplot
-from drill_sim_ros.model.startup import TURNING_RPM, StartupRun
+from drill_sim_ros.model.startup import TURNING_RPM, StartupRun, judged_rpm
 
 KN_PER_N = 1e-3
 
@@ -29,8 +30,11 @@ def plot_startup(path: Path, run: StartupRun, title: str, breakaway_s: float | N
     plt = pyplot()
     fig, (ax_speed, ax_torque, ax_twist) = plt.subplots(3, 1, figsize=(11.0, 8.0),
                                                         sharex=True)
-    t = run.t_s
-    ax_speed.plot(t, run.bit_rpm, color="tab:blue", lw=0.6, label="bit")
+    t, judged = run.t_s, judged_rpm(run)
+    ax_speed.plot(t, run.bit_rpm, color="tab:blue", lw=0.5, alpha=0.6, label="bit")
+    if judged is not run.bit_rpm:
+        ax_speed.plot(t, judged, color="navy", lw=1.2,
+                      label=f"bit below the cut-off ({run.cutoff_hz:.2f} Hz)")
     ax_speed.plot(t, run.drive_rpm, color="tab:green", lw=1.2, label="drive")
     ax_speed.plot(t, run.setpoint_rpm, color="black", lw=0.8, ls="--",
                   label="drive setpoint (ramp)")
@@ -43,7 +47,7 @@ def plot_startup(path: Path, run: StartupRun, title: str, breakaway_s: float | N
     ax_twist.plot(t, run.twist_turns, color="tab:purple", lw=0.8, label="twist")
     ax_twist.set_ylabel("twist of the string [turns]")
     ax_twist.set_xlabel("simulated time [s]")
-    stuck = np.abs(run.bit_rpm) < TURNING_RPM
+    stuck = np.abs(judged) < TURNING_RPM
     for ax in (ax_speed, ax_torque, ax_twist):
         _mark(ax, t, stuck, breakaway_s)
         ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8, frameon=False)

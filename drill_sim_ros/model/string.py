@@ -428,33 +428,29 @@ def build_lines(lines: tuple[WaveLine, ...], dtau: float
 
 
 @njit(cache=True, inline="always")
-def wall_limit(wave_f: np.ndarray, j: int, pair: int, own_speed: float,
-               other_speed: float) -> float:
-    """The wall's friction limit at junction ``j`` along its own line, its speed
-    ``own_speed`` and the other line's at the same junction ``pair`` ``other_speed``. The
-    contact sticks or slides as one: within the stick band while the surface slip
-    sqrt(u^2 + o^2) (u, o the slips of the two motions, m per t*) is within r_o omega_s,
-    where the static limit holds (Karnopp), else the dynamic one. The sliding force lies
-    along the slip velocity, so this line takes the share u / sqrt(u^2 + o^2) of it, u at
-    least the band's (a string that rotates drags little axially, and the other way round;
-    1 when the other line is still: the Coulomb law of one line)."""
+def wall_slips(wave_f: np.ndarray, j: int, pair: int, own_speed: float,
+               other_speed: float) -> tuple[float, float, bool]:
+    """The surface slips (m per t*) of junction ``j``'s own motion and of the other line's
+    at the same junction ``pair``, and whether the contact slides: the two motions share one
+    contact, which is stuck while its total slip sqrt(u^2 + o^2) is within the stick band
+    r_o omega_s (Karnopp) and slides outside it."""
     u = abs(own_speed) * wave_f[W_SLIP, j]
     o = abs(other_speed) * wave_f[W_SLIP, pair]
     band = wave_f[W_VS, j] * wave_f[W_SLIP, j]
-    limit = wave_f[W_FS, j] if u * u + o * o <= band * band else wave_f[W_FD, j]
-    if o == 0.0:
-        return limit
-    u = max(u, band)
-    return limit * u / math.sqrt(u * u + o * o)
+    return u, o, u * u + o * o > band * band
 
 
 def steady_friction(wave_f: np.ndarray, j: int, pair: int, speed: float,
                     other_speed: float) -> float:
     """The wall's friction at junction ``j`` moving steadily at ``speed`` (the other line
-    at ``other_speed``): none at rest, else :func:`wall_limit` along the motion."""
+    at ``other_speed``): none at rest; within the stick band the static limit; sliding, the
+    dynamic force's share along this line, u / sqrt(u^2 + o^2) (:func:`wall_slips`)."""
     if speed == 0.0 or wave_f[W_FS, j] == 0.0:
         return 0.0
-    return math.copysign(wall_limit(wave_f, j, pair, speed, other_speed), speed)
+    u, o, sliding = wall_slips(wave_f, j, pair, speed, other_speed)
+    if not sliding:
+        return math.copysign(wave_f[W_FS, j], speed)
+    return math.copysign(wave_f[W_FD, j] * u / math.sqrt(u * u + o * o), speed)
 
 
 def fill_steady(wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray, lo: int, hi: int,
@@ -618,22 +614,34 @@ def junction_speed(wave_f: np.ndarray, j: int, a_in: float, b_in: float,
 
 @njit(cache=True, inline="always")
 def wall_junction(wave_f: np.ndarray, j: int, push: float, pair: int) -> float:
-    """:func:`junction_speed` with the wall's Coulomb friction (model.well), set-valued and
-    implicit in the new speed, as the bit's stick (eq. 32): the junction is held still while
-    the unbalanced torque ``push`` = a_in - b_in is within the limit, and else slides with
-    w (Z_j + Z_j+1 + D) = push - limit sign(push). The limit (:func:`wall_limit`) is the
-    static one while the contact's last slip, with the other line's junction ``pair``, is
-    within the stick band, the dynamic one outside it (Karnopp), times the share along
-    this line. Keeps the speed for the band, and the friction
-    power (limit |w|) summed in W_WORK. (Compiled apart, not inlined: the string without
-    a wall keeps its step.)"""
-    limit = wall_limit(wave_f, j, pair, wave_f[W_LAST, j], wave_f[W_LAST, pair])
-    w = 0.0
-    if abs(push) > limit:
-        w = (push - math.copysign(limit, push)) / (
-            wave_f[W_Z, j] + wave_f[W_Z, j + 1] + wave_f[W_D, j])
+    """:func:`junction_speed` with the wall's Coulomb friction (model.well), implicit in the
+    new speed w, with Z = Z_j + Z_j+1 + D. The contact (:func:`wall_slips`, from the last
+    speeds of this junction and the other line's ``pair``):
+
+    * within the stick band, or sliding with the other line still: set-valued, as the bit's
+      stick (eq. 32): held still while the unbalanced torque ``push`` = a_in - b_in is
+      within the limit (static in the band, dynamic outside it: Karnopp), else
+      w Z = push - limit sign(push);
+    * sliding with both lines moving: the dynamic force lies along the slip velocity, so
+      this line feels F = F_d u / sqrt(u^2 + o^2) = c w, c = F_d s / sqrt(u^2 + o^2) (s the
+      slip per unit speed), taken with the last slip in the root: w = push / (Z + c). A
+      string that rotates drags axially as a viscous c = F_d / (r_o omega), and the other
+      way round.
+
+    Keeps the speed for the band, and the friction power summed in W_WORK."""
+    u, o, sliding = wall_slips(wave_f, j, pair, wave_f[W_LAST, j], wave_f[W_LAST, pair])
+    z = wave_f[W_Z, j] + wave_f[W_Z, j + 1] + wave_f[W_D, j]
+    if sliding and o > 0.0:
+        c = wave_f[W_FD, j] * wave_f[W_SLIP, j] / math.sqrt(u * u + o * o)
+        w = push / (z + c)
+        wave_f[W_WORK, j] += c * w * w
+    else:
+        limit = wave_f[W_FD, j] if sliding else wave_f[W_FS, j]
+        w = 0.0
+        if abs(push) > limit:
+            w = (push - math.copysign(limit, push)) / z
+        wave_f[W_WORK, j] += limit * abs(w)
     wave_f[W_LAST, j] = w
-    wave_f[W_WORK, j] += limit * abs(w)
     return w
 
 
