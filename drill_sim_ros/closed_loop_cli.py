@@ -18,7 +18,7 @@ from drill_sim_ros.archive.output import (
 from drill_sim_ros.control.bench import ClosedLoopRun, run_in_process
 from drill_sim_ros.control.controllers import CONTROL_MODES
 from drill_sim_ros.control.rig import RigPhysics, rig_physics
-from drill_sim_ros.control.scenario import Scenario, load_scenario
+from drill_sim_ros.control.scenario import Scenario, load_scenario, scenario_path
 from drill_sim_ros.control.schedule import Schedule
 from drill_sim_ros.control.scorecard import SCORE_FIELDS, score, status_text
 from drill_sim_ros.model.errors import DrillSimError
@@ -50,8 +50,9 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--t-end", type=float, help="simulated seconds (default 180)")
     p.add_argument("--enable-at", type=float, help="switch-on time, s (default 60, or a third "
                    "of a shorter --t-end)")
-    p.add_argument("--scenario", type=Path, help="scenario YAML (see "
-                   "drill_sim_ros/control/scenario.py); the options above override it")
+    p.add_argument("--scenario", help="a scenario of config/scenarios by name, or a YAML "
+                   "file (see drill_sim_ros/control/scenario.py); the options above "
+                   "override it")
     p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
                    help="a controller parameter, e.g. --set impedance_factor=1.5 (repeatable)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
@@ -69,7 +70,7 @@ def add_parser(sub: Any) -> None:
 
 
 def _scenario(args: argparse.Namespace) -> Scenario:
-    base = load_scenario(args.scenario) if args.scenario else Scenario()
+    base = load_scenario(scenario_path(args.scenario)) if args.scenario else Scenario()
     params = dict(base.params)
     for item in args.set:
         name, sep, value = item.partition("=")
