@@ -156,7 +156,7 @@ def test_modes_reports_damping_ratios(tmp_path: Path) -> None:
 
 STARTUP_KEYS = {"breakaway_s", "breakaway_turns", "breakaway_torque_nm", "first_slip_s",
                 "peak_motor_torque_nm", "stick_slip", "period_s", "stick_fraction",
-                "bit_rpm_max", "motor_torque_nm", "twist_turns"}
+                "bit_rpm_max", "motor_torque_nm", "twist_turns", "cutoff_hz"}
 
 
 @pytest.mark.parametrize(("args", "names"), [
