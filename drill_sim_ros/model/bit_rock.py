@@ -132,7 +132,7 @@ def profile_recut(profile: np.ndarray, node: int, frac: float, h_old: float, u: 
 
 
 # ---- the delay, from the exact time history (reference path, RGD07 Appendix C) -----------
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")    # as kernel._steps
 def delayed_depth(hist_phi: np.ndarray, hist_u: np.ndarray, head: int, count: int,
                   cursor: int, phi_target: float) -> tuple[float, int]:
     """U at the latest time the bit angle was ``phi_target`` (eq. 7), by interpolation.

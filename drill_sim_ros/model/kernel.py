@@ -33,7 +33,12 @@ weight on bit in steady drilling.
 
 ``advance`` with ``exact=True`` is the reference path of RGD07 Appendix C for the delay.
 Kernels never raise: they return a status code (``STATUS_*``); no loop in them is unbounded
-whatever the state (a step that would pass a whole blade sector is a runaway).
+whatever the state (a step that would pass a whole blade sector is a runaway). The loop is
+compiled with numba's ``error_model="numpy"``: a division by zero gives inf or nan, which
+the simulator's finite check reports as a fault, where the default (Python) error model
+tests every divisor and would raise ZeroDivisionError. The results are the same bit for bit
+for every nonzero divisor; the tests cost about 30 % of the distributed string's step
+(docs/benchmarks.md, issue 32).
 """
 
 from __future__ import annotations
@@ -292,7 +297,7 @@ def advance(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarra
                   every, exact, False)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _steps(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarray,
            hist: np.ndarray, meta: np.ndarray, acc: np.ndarray, out: np.ndarray,
            wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray,

@@ -626,15 +626,19 @@ def wall_junction(wave_f: np.ndarray, j: int, push: float, pair: int) -> float:
       this line feels F = F_d u / sqrt(u^2 + o^2) = c w, c = F_d s / sqrt(u^2 + o^2) (s the
       slip per unit speed), taken with the last slip in the root: w = push / (Z + c). A
       string that rotates drags axially as a viscous c = F_d / (r_o omega), and the other
-      way round.
+      way round. Written with one division, the step's dearest operation: with
+      k = F_d s and r = sqrt(u^2 + o^2), w = push r / (Z r + k), and the power
+      c w^2 = k w push / (Z r + k).
 
     Keeps the speed for the band, and the friction power summed in W_WORK."""
     u, o, sliding = wall_slips(wave_f, j, pair, wave_f[W_LAST, j], wave_f[W_LAST, pair])
     z = wave_f[W_Z, j] + wave_f[W_Z, j + 1] + wave_f[W_D, j]
     if sliding and o > 0.0:
-        c = wave_f[W_FD, j] * wave_f[W_SLIP, j] / math.sqrt(u * u + o * o)
-        w = push / (z + c)
-        wave_f[W_WORK, j] += c * w * w
+        k = wave_f[W_FD, j] * wave_f[W_SLIP, j]
+        r = math.sqrt(u * u + o * o)
+        per_z = push / (z * r + k)
+        w = per_z * r
+        wave_f[W_WORK, j] += k * w * per_z
     else:
         limit = wave_f[W_FD, j] if sliding else wave_f[W_FS, j]
         w = 0.0
