@@ -126,6 +126,7 @@ MIXED = {"drive_speed_rad_s": SignalSpec(noise_std=0.02, quantum=0.001),
     [1] * 300,                                       # a sample per call, as the gym measures
     [1, 1, 4094, 1, 1, 5000, 3],                     # across and beyond the noise blocks
     [NOISE_BLOCK_SAMPLES * 3 + 5],                   # one block longer than the noise block
+    [1000, 3500, 2000],                              # refills that keep an undrawn tail
 ])
 def test_the_sensors_give_the_reference_measurements_bit_for_bit(cuts: list[int]) -> None:
     """The compiled sensors against the plain block-by-block path (measurement_reference),
