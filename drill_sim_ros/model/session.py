@@ -27,12 +27,12 @@ from drill_sim_ros.model.params import GROUPS
 from drill_sim_ros.model.presets import Preset
 from drill_sim_ros.model.simulator import SimConfig, Simulator
 from drill_sim_ros.model.telemetry import (
+    MEASURED_COLUMNS,
     NO_COMMAND_S,
     NS_PER_S,
     field_scales,
-    set_measured,
+    set_wob_estimate,
     stamped_si_rows,
-    surface_truth,
 )
 from drill_sim_ros.model.top_drive import TopDrivePhysical, check_speed_loop
 
@@ -254,8 +254,8 @@ class SimSession:
                                           first_index * self.period_ns, self.period_ns,
                                           float(self.submerged_weight_n), command_s)
         if not self._perfect_sensors:          # si_rows gives the truth, perfect sensors
-            set_measured(rows, self.sensors.measure(surface_truth(rows)),
-                         float(self.submerged_weight_n))
+            self.sensors.measure_into(rows, MEASURED_COLUMNS)     # in place
+            set_wob_estimate(rows, float(self.submerged_weight_n))
         if not self._taken:
             return Block(rows, stamps_ns, offsets)
         strings, self._taken = self._taken, []

@@ -104,6 +104,8 @@ _TIME, _HOOK, _COMMAND = F["sim_time_s"], F["hook_load_n"], F["command_stamp_s"]
 _APPLIED_WOB = F["applied_wob_n"]
 _SURFACE_RPM, _MOTOR, _STRING = F["surface_rpm"], F["motor_torque_nm"], F["surface_torque_nm"]
 _MEASURED = np.array(MEASURED, dtype=np.int64)
+MEASURED_COLUMNS = _MEASURED    # for RigSensors.measure_into, SIGNALS order
+_HOOK_MEASURED = F["hook_load_measured_n"]
 _ANGLE_FIELDS = np.array(_ANGLES, dtype=np.int64)
 
 
@@ -162,8 +164,9 @@ def surface_truth(rows: np.ndarray) -> np.ndarray:
                             rows[:, F["hook_load_n"]]])
 
 
-def set_measured(rows: np.ndarray, measured: np.ndarray, submerged_weight_n: float) -> None:
-    """Write the measured surface signals (shape (rows, 4), ``SIGNALS`` order) into SI
-    ``rows`` and the applied-WOB estimate from the measured hook load."""
-    rows[:, MEASURED] = measured
-    rows[:, _WOB_ESTIMATE] = submerged_weight_n - rows[:, F["hook_load_measured_n"]]
+@njit(cache=True)
+def set_wob_estimate(rows: np.ndarray, submerged_weight_n: float) -> None:
+    """The applied-WOB estimate of SI ``rows`` (N) from their measured hook load, in place
+    (after ``model.measurement`` has measured the :data:`MEASURED_COLUMNS`)."""
+    for i in range(rows.shape[0]):
+        rows[i, _WOB_ESTIMATE] = submerged_weight_n - rows[i, _HOOK_MEASURED]

@@ -70,14 +70,19 @@ def _on_cycles(blocks: dict[str, list[str]]) -> set[str]:
     return found
 
 
+def nrt_calls_on_loops(compiled: numba.core.dispatcher.Dispatcher) -> int:
+    """NRT calls on the blocks of the loops of ``compiled``'s one compiled signature."""
+    (ir,) = compiled.inspect_llvm().values()
+    blocks = _blocks(ir[ir.index("define"):])
+    return sum("@NRT_" in line for b in _on_cycles(blocks) for line in blocks[b])
+
+
 def loop_nrt_calls(kind: str) -> int:
     sim = _simulator(kind)
     fresh = numba.njit(k._steps.py_func)           # compiled here, never from the cache
     out = np.empty((2, k.N_COLS))
     fresh(*sim._kernel_arrays(), out, *sim._wave_arrays(), 1, 1, sim.exact, False)
-    (ir,) = fresh.inspect_llvm().values()
-    blocks = _blocks(ir[ir.index("define"):])
-    return sum("@NRT_" in line for b in _on_cycles(blocks) for line in blocks[b])
+    return nrt_calls_on_loops(fresh)
 
 
 def test_the_cycle_finder_sees_a_loop_and_not_a_diamond() -> None:
@@ -98,3 +103,32 @@ def test_no_new_reference_counting_in_the_step_loop(kind: str) -> None:
         f"{calls} NRT calls on the {kind} step loop's blocks, {MAX_LOOP_NRT_CALLS[kind]} "
         "before: an array handed to an inlined helper, or an early return in one? "
         "(docs/contributing.md)")
+
+
+def _indexed_in_place(a: np.ndarray, n: int) -> float:
+    total = 0.0
+    for step in range(n):
+        for j in range(a.shape[1]):
+            total += a[step % a.shape[0], j]
+    return total
+
+
+def _a_copy_per_step(a: np.ndarray, n: int) -> float:   # the mutant: an array per step
+    total = 0.0
+    for step in range(n):
+        row = a[step % a.shape[0]].copy()
+        for j in range(row.size):
+            total += row[j]
+    return total
+
+
+def test_the_counter_sees_nrt_calls_a_mutant_brings_into_a_loop() -> None:
+    """The counter itself can fail: a loop that makes an array every step (NRT allocation
+    and reference counting) has NRT calls on its blocks, the same loop indexing in place
+    none. (A row view alone, as ``a[i]`` in such a small loop, numba's reference-count
+    pruning removes; in the step loop it does not, docs/benchmarks.md, issue 35.)"""
+    a = np.arange(6.0).reshape(2, 3)
+    plain, mutant = numba.njit(_indexed_in_place), numba.njit(_a_copy_per_step)
+    assert plain(a, 4) == mutant(a, 4)
+    assert nrt_calls_on_loops(plain) == 0
+    assert nrt_calls_on_loops(mutant) > 0

@@ -3,15 +3,23 @@ delay, and the same measurements whatever the blocks the samples come in."""
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 import pytest
 
 from drill_sim_ros.model import kernel as k
 from drill_sim_ros.model.errors import ParameterError
-from drill_sim_ros.model.measurement import SIGNALS, RigSensors, SignalSpec
+from drill_sim_ros.model.measurement import (
+    NOISE_BLOCK_SAMPLES,
+    SIGNALS,
+    RigSensors,
+    SignalSpec,
+)
 from drill_sim_ros.model.presets import load_preset
 from drill_sim_ros.model.simulator import SimConfig, Simulator
 from drill_sim_ros.model.telemetry import field_scales, si_rows, surface_truth
+from tests.model.measurement_reference import ReferenceSensors
 
 
 def _truth(rows: int = 20_000) -> np.ndarray:
@@ -106,3 +114,44 @@ def test_hook_load_and_the_wob_estimate_of_a_session() -> None:
                                weight_n - noisy[:, F["hook_load_measured_n"]], rtol=1e-15)
     np.testing.assert_array_equal(noisy[:, F["string_torque_measured_nm"]],
                                   noisy[:, F["surface_torque_nm"]])      # the others perfect
+
+
+MIXED = {"drive_speed_rad_s": SignalSpec(noise_std=0.02, quantum=0.001),
+         "motor_torque_nm": SignalSpec(noise_std=100.0, delay_periods=1),
+         "string_torque_nm": SignalSpec(noise_std=150.0, quantum=25.0, delay_periods=7),
+         "hook_load_n": SignalSpec(quantum=500.0, delay_periods=3)}
+
+
+@pytest.mark.parametrize("cuts", [
+    [1] * 300,                                       # a sample per call, as the gym measures
+    [1, 1, 4094, 1, 1, 5000, 3],                     # across and beyond the noise blocks
+    [NOISE_BLOCK_SAMPLES * 3 + 5],                   # one block longer than the noise block
+    [1000, 3500, 2000],                              # refills that keep an undrawn tail
+])
+def test_the_sensors_give_the_reference_measurements_bit_for_bit(cuts: list[int]) -> None:
+    """The compiled sensors against the plain block-by-block path (measurement_reference),
+    whatever the blocks: the same noise stream, rounding and delay, to the last bit."""
+    truth = _truth(sum(cuts))
+    fast, slow = RigSensors(MIXED, seed=5), ReferenceSensors(MIXED, seed=5)
+    edges = np.cumsum([0, *cuts])
+    for a, b in itertools.pairwise(edges):
+        np.testing.assert_array_equal(fast.measure(truth[a:b]), slow.measure(truth[a:b]))
+
+
+def test_reset_restarts_the_noise_and_the_delay_lines() -> None:
+    truth = _truth(50)
+    sensors = RigSensors(MIXED, seed=5)
+    first = sensors.measure(truth)
+    sensors.measure(truth[::-1])
+    sensors.reset()
+    np.testing.assert_array_equal(sensors.measure(truth), first)
+
+
+def test_measure_into_measures_the_named_columns_in_place() -> None:
+    truth = _truth(40)
+    rows = np.zeros((40, 9))
+    columns = np.array([8, 2, 5, 0], dtype=np.int64)
+    rows[:, columns] = truth
+    RigSensors(MIXED, seed=1).measure_into(rows, columns)
+    np.testing.assert_array_equal(rows[:, columns], ReferenceSensors(MIXED, seed=1).measure(truth))
+    assert not rows[:, [1, 3, 4, 6, 7]].any()
