@@ -100,6 +100,7 @@ class GatewayNode(Node):
             "Step returns BadTimeout after this many wall seconds without the sample [s]",
             10.0)).value
         self.on_sample = None
+        self.latest_sample: tuple[dict[str, float], int] | None = None   # (before on_sample)
         self._latest_ns = -1
         self._pub = self.create_publisher(JointState, topics.node_relative(
             topics.CMD_TOP_DRIVE), LOCKSTEP_QOS)
@@ -109,6 +110,7 @@ class GatewayNode(Node):
     def _on_sample(self, msg: JointState) -> None:
         values, time_ns = sample_values(msg)
         self._latest_ns = max(self._latest_ns, time_ns)
+        self.latest_sample = (values, time_ns)
         if self.on_sample is not None:
             self.on_sample(values, time_ns)
 
@@ -145,6 +147,8 @@ async def serve(node: GatewayNode, settings: RigSettings) -> None:
     await rig.start()
     node.on_sample = lambda values, time_ns: loop.call_soon_threadsafe(
         samples.put_nowait, (values, time_ns))
+    if node.latest_sample is not None:      # received while sim_node's parameters came
+        samples.put_nowait(node.latest_sample)
     executor = SingleThreadedExecutor()
     executor.add_node(node)
     threading.Thread(target=_spin, args=(executor,), daemon=True).start()

@@ -1,0 +1,259 @@
+"""The OPC UA gateway against a real asyncua client, with sim_node and opcua_gateway as
+processes over loopback (issue 33).
+
+- The address space: the rig object, its BrowseNames, units (EUInformation, UNECE) and
+  EURanges, source timestamps in simulated time.
+- Bad writes (NaN, inf, out of range, wrong type, read-only, a counter out of turn) are
+  refused with their Bad status codes, counted, and never advance the sim.
+- A PI law closes the loop through the counters, the client goes away (the sim waits) and
+  another one comes back through ``Step``: the recorded telemetry equals the in-process
+  bench of the same law, bit for bit. The client uses asyncua and the law only.
+- An off-loopback endpoint is refused at start in one line.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import math
+import signal
+import socket
+import subprocess
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Any
+
+import pytest
+from asyncua import Client, ua
+
+from drill_sim_ros.control.bench import run_in_process, sim_node_parameters
+from drill_sim_ros.control.scenario import Scenario
+from drill_sim_ros.ros.closed_loop import read_telemetry
+from tests.archive.helpers import BIN, running, stop
+from tests.ros.opcua_pi_law import pi_step
+
+pytestmark = pytest.mark.ros
+SCENARIO = Scenario(controller="tests.ros.opcua_pi_law:PiLaw", duration_s=6.0,
+                    enable_at_s=0.0)
+PERIODS = 600
+NAMESPACE_URI = "urn:drill_sim_ros"
+START_TIMEOUT_S = 60.0        # sim_node's start (kernel cache load) and the gateway's
+RUN_TIMEOUT_S = 120.0
+DOUBLE, UINT32 = ua.VariantType.Double, ua.VariantType.UInt32
+
+
+def free_port() -> int:
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        return probe.getsockname()[1]
+
+
+def sim_command(record: Path | None) -> list[str]:
+    values = {"lockstep": True, "lockstep_trigger": "command", "status_line": False,
+              "publish_clock": False, **sim_node_parameters(SCENARIO, SCENARIO.load_preset())}
+    if record is not None:
+        values["record.path"] = str(record)
+    args = []
+    for name, value in values.items():
+        text = ("true" if value else "false") if isinstance(value, bool) else str(value)
+        args += ["-p", f"{name}:={text}"]
+    return ["sim_node", "--ros-args", *args]
+
+
+@contextmanager
+def sim_and_gateway(tmp_path: Path, record: Path | None = None
+                    ) -> Iterator[tuple[subprocess.Popen, subprocess.Popen, str]]:
+    url = f"opc.tcp://127.0.0.1:{free_port()}/drill_sim/"
+    with running(sim_command(record), tmp_path / "sim.log") as sim, \
+            running(["opcua_gateway", "--ros-args", "-p", f"endpoint:={url}"],
+                    tmp_path / "gateway.log") as gateway:
+        yield sim, gateway, url
+
+
+class Rig:
+    """A connected client's view of the rig object: its children by BrowseName."""
+
+    def __init__(self, client: Client, index: int, obj: Any, nodes: dict[str, Any]) -> None:
+        self.client, self.index, self.obj, self.nodes = client, index, obj, nodes
+
+    async def value(self, name: str) -> Any:
+        return await self.nodes[name].read_value()
+
+    async def write(self, **values: ua.Variant) -> None:
+        """One write request of several variables."""
+        await self.client.write_values([self.nodes[n] for n in values], list(values.values()))
+
+    async def step(self) -> int:
+        return await self.obj.call_method(f"{self.index}:Step")
+
+
+async def connect(url: str, deadline_s: float = START_TIMEOUT_S) -> tuple[Client, Rig]:
+    """A client connected to the gateway once its Status is running (bounded)."""
+    loop = asyncio.get_running_loop()
+    end = loop.time() + deadline_s
+    while True:
+        client = Client(url, timeout=5)
+        client.session_timeout = 600_000        # (the server's maximum)
+        try:
+            await client.connect()
+            index = await client.get_namespace_index(NAMESPACE_URI)
+            obj = await client.nodes.objects.get_child(f"{index}:Rig")
+            nodes = {(await n.read_browse_name()).Name: n for n in await obj.get_children()}
+            rig = Rig(client, index, obj, nodes)
+            if await rig.value("Status") == "running":
+                return client, rig
+            await client.disconnect()
+        except (OSError, asyncio.TimeoutError, ua.UaError):
+            pass
+        assert loop.time() < end, f"the gateway at {url} did not run in {deadline_s} s"
+        await asyncio.sleep(0.2)
+
+
+async def wait_sample(rig: Rig, counter: int, timeout_s: float = 10.0) -> None:
+    """Poll SampleCounter until it equals ``counter``, as a PLC does (bounded)."""
+    end = asyncio.get_running_loop().time() + timeout_s
+    while await rig.value("SampleCounter") != counter:
+        assert asyncio.get_running_loop().time() < end, f"no sample for command {counter}"
+
+
+def run(coroutine: Any, timeout_s: float = RUN_TIMEOUT_S) -> Any:
+    return asyncio.run(asyncio.wait_for(coroutine, timeout_s))
+
+
+# ---- the address space and bad writes -----------------------------------------------------
+
+EXPECTED_UNITS = {"DriveSpeed": ("rad/s", "2A"), "MotorTorque": ("N·m", "NU"),
+                  "QuillTorque": ("N·m", "NU"), "HookLoad": ("N", "NEW"),
+                  "WobEstimate": ("N", "NEW"), "BitDepth": ("m", "MTR"), "Rop": ("m/s", "MTS"),
+                  "SimTime": ("s", "SEC"), "SpeedSetpoint": ("rad/s", "2A"),
+                  "TorqueCommand": ("N·m", "NU"), "WobSetpoint": ("N", "NEW")}
+OTHERS = {"DriveMode", "CommandCounter", "SampleCounter", "Lockstep", "Status",
+          "RejectedWrites", "Step"}
+
+
+async def check_address_space(rig: Rig) -> None:
+    assert set(rig.nodes) == set(EXPECTED_UNITS) | OTHERS
+    for name, (symbol, code) in EXPECTED_UNITS.items():
+        eu = await (await rig.nodes[name].get_child("0:EngineeringUnits")).read_value()
+        assert eu.NamespaceUri == "http://www.opcfoundation.org/UA/units/un/cefact"
+        assert (eu.DisplayName.Text, eu.UnitId) == (symbol, int.from_bytes(code.encode()))
+    speed = await (await rig.nodes["SpeedSetpoint"].get_child("0:EURange")).read_value()
+    assert (speed.Low, speed.High) == (0.0, 300.0 / (30.0 / math.pi))   # limits.max_surface_rpm
+    torque = await (await rig.nodes["TorqueCommand"].get_child("0:EURange")).read_value()
+    assert torque.Low == -torque.High < 0
+    assert await rig.value("Lockstep") is True
+    assert await rig.value("DriveMode") == "speed"
+    stamp = (await rig.nodes["SimTime"].read_data_value()).SourceTimestamp
+    assert stamp.year == 1970 and await rig.value("SimTime") == 0.0
+
+
+BAD_WRITES = [  # (variable, variant, status code)
+    ("SpeedSetpoint", ua.Variant(math.nan, DOUBLE), ua.uaerrors.BadOutOfRange),
+    ("SpeedSetpoint", ua.Variant(math.inf, DOUBLE), ua.uaerrors.BadOutOfRange),
+    ("WobSetpoint", ua.Variant(-1.0, DOUBLE), ua.uaerrors.BadOutOfRange),
+    ("TorqueCommand", ua.Variant(-1e30, DOUBLE), ua.uaerrors.BadOutOfRange),
+    ("SpeedSetpoint", ua.Variant(1000.0, DOUBLE), ua.uaerrors.BadOutOfRange),
+    ("SpeedSetpoint", ua.Variant(3.0, ua.VariantType.Float), ua.uaerrors.BadTypeMismatch),
+    ("DriveMode", ua.Variant("kinematic", ua.VariantType.String), ua.uaerrors.BadOutOfRange),
+    ("CommandCounter", ua.Variant(1, ua.VariantType.Int64), ua.uaerrors.BadTypeMismatch),
+    ("CommandCounter", ua.Variant(2, UINT32), ua.uaerrors.BadInvalidState),   # out of turn
+    ("SampleCounter", ua.Variant(1, UINT32), ua.uaerrors.BadNotWritable),
+    ("QuillTorque", ua.Variant(0.0, DOUBLE), ua.uaerrors.BadNotWritable),
+]
+
+
+async def check_bad_writes(rig: Rig) -> None:
+    for name, value, error in BAD_WRITES:
+        with pytest.raises(error):
+            await rig.nodes[name].write_value(value)
+    # a request with one bad value is refused whole: its counter increment sends nothing
+    with pytest.raises(ua.uaerrors.BadOutOfRange):
+        await rig.write(SpeedSetpoint=ua.Variant(5.0, DOUBLE),
+                        WobSetpoint=ua.Variant(math.nan, DOUBLE),
+                        CommandCounter=ua.Variant(1, UINT32))
+    assert await rig.value("RejectedWrites") == len(BAD_WRITES) + 1
+    assert await rig.value("CommandCounter") == 0
+    assert await rig.value("SpeedSetpoint") != 5.0
+    # ... and the sim did not advance; a good command then does
+    await rig.write(CommandCounter=ua.Variant(1, UINT32))
+    await wait_sample(rig, 1)
+    assert await rig.value("SimTime") == pytest.approx(0.01, abs=1e-12)
+
+
+async def browse_and_refuse(url: str) -> None:
+    client, rig = await connect(url)
+    try:
+        await check_address_space(rig)
+        await check_bad_writes(rig)
+    finally:
+        await client.disconnect()
+
+
+def test_address_space_units_ranges_and_bad_writes(tmp_path: Path) -> None:
+    with sim_and_gateway(tmp_path) as (sim, gateway, url):
+        run(browse_and_refuse(url))
+        assert stop(gateway, signal.SIGINT) == 0, (tmp_path / "gateway.log").read_text()
+        assert stop(sim, signal.SIGINT) == 0
+    assert "Traceback" not in (tmp_path / "gateway.log").read_text()
+
+
+# ---- the closed loop ------------------------------------------------------------------------
+
+async def law_through_counters(rig: Rig, first: int, last: int, integral: float) -> float:
+    """Commands ``first`` .. ``last`` by CommandCounter; the law's integral after them."""
+    for counter in range(first, last + 1):
+        speed, integral = pi_step(integral, await rig.value("QuillTorque"))
+        await rig.write(SpeedSetpoint=ua.Variant(speed, DOUBLE),
+                        CommandCounter=ua.Variant(counter, UINT32))
+        await wait_sample(rig, counter)
+    return integral
+
+
+async def law_through_step(rig: Rig, first: int, last: int, integral: float) -> float:
+    """Commands ``first`` .. ``last`` by the method Step."""
+    for counter in range(first, last + 1):
+        speed, integral = pi_step(integral, await rig.value("QuillTorque"))
+        await rig.write(SpeedSetpoint=ua.Variant(speed, DOUBLE))
+        assert await rig.step() == counter
+    return integral
+
+
+async def close_the_loop(url: str) -> None:
+    half = PERIODS // 2
+    client, rig = await connect(url)
+    integral = await law_through_counters(rig, 1, half, 0.0)
+    await client.disconnect()                    # the client goes away ...
+    await asyncio.sleep(0.5)
+    client, rig = await connect(url)             # ... and comes back: the sim waited
+    try:
+        assert await rig.value("SampleCounter") == await rig.value("CommandCounter") == half
+        assert await rig.value("SimTime") == pytest.approx(half * 0.01, abs=1e-9)
+        await law_through_step(rig, half + 1, PERIODS, integral)
+    finally:
+        await client.disconnect()
+
+
+def test_a_pi_law_through_opcua_gives_the_bench_telemetry_bit_for_bit(tmp_path: Path) -> None:
+    record = tmp_path / "run.mcap"
+    with sim_and_gateway(tmp_path, record) as (sim, gateway, url):
+        run(close_the_loop(url))
+        assert stop(gateway, signal.SIGINT) == 0, (tmp_path / "gateway.log").read_text()
+        assert stop(sim, signal.SIGINT) == 0, (tmp_path / "sim.log").read_text()
+    remote = read_telemetry(record)
+    local = run_in_process(SCENARIO).rows
+    assert remote.shape == local.shape == (PERIODS + 1, local.shape[1])
+    assert remote.tobytes() == local.tobytes()
+
+
+# ---- safe by default ------------------------------------------------------------------------
+
+@pytest.mark.parametrize("endpoint", ["opc.tcp://0.0.0.0:4840/drill_sim/",
+                                      "opc.tcp://192.0.2.7:4840/", "http://127.0.0.1:4840/"])
+def test_an_insecure_or_malformed_endpoint_is_refused_in_one_line(endpoint: str) -> None:
+    done = subprocess.run([str(BIN / "opcua_gateway"), "--ros-args", "-p",
+                           f"endpoint:={endpoint}"], capture_output=True, text=True,
+                          timeout=60)
+    assert done.returncode == 2
+    lines = (done.stdout + done.stderr).strip().splitlines()
+    assert len(lines) == 1 and "Traceback" not in lines[0]
+    assert endpoint in lines[0]
