@@ -77,7 +77,7 @@ docs: venv
 	$(PY) docs/generate.py
 
 # Benchmarks print figures (no pass/fail): kernel ns/step, node CPU and real-time factor,
-# MCAP throughput, rerun bridge CPU, recording loss, maps, closed loop, lockstep.
+# MCAP throughput, rerun bridge CPU, recording loss, maps, closed loop, lockstep, OPC UA.
 bench: venv
 	$(PY) benchmarks/bench_kernel.py
 	$(PY) benchmarks/bench_node.py
@@ -87,6 +87,7 @@ bench: venv
 	$(PY) benchmarks/bench_map.py
 	$(PY) benchmarks/bench_closed_loop.py
 	$(PY) benchmarks/bench_lockstep.py
+	$(PY) benchmarks/bench_opcua.py
 
 # The paper's figures and the field map (docs/gallery/*.png), computed on a local Dask
 # cluster; FIGURES_CACHE keeps the maps as NetCDF so a re-run resumes them.
