@@ -98,6 +98,12 @@ def unece_unit_id(code: str) -> int:
     return unit_id
 
 
+def node_id(rig: str, name: str) -> str:
+    """The string NodeId of a rig's variable or method in :data:`NAMESPACE_URI`
+    (``Rig.DriveSpeed``): stable across restarts, so a PLC may bind to it."""
+    return f"{rig}.{name}"
+
+
 def rig_name(namespace: str) -> str:
     """The rig object's BrowseName: the ROS namespace's last part, ``Rig`` in the root."""
     return namespace.rstrip("/").rpartition("/")[2] or DEFAULT_RIG

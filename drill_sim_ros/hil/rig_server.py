@@ -35,6 +35,7 @@ from drill_sim_ros.hil.address_space import (
     VARIABLE_BY_NAME,
     VARIABLES,
     Variable,
+    node_id,
     unece_unit_id,
 )
 
@@ -88,6 +89,15 @@ def sim_timestamp(time_ns: int) -> datetime:
     return SIM_EPOCH + timedelta(microseconds=time_ns / 1000)
 
 
+async def _add_property(node: Any, name: str, value: Any, data_type: int) -> None:
+    """A standard property (BrowseName in namespace 0) of ``node``, NodeId ``<node>.<name>``."""
+    index = node.nodeid.NamespaceIndex
+    await node.add_property(ua.NodeId(f"{node.nodeid.Identifier}.{name}", index),
+                            ua.QualifiedName(name, 0),
+                            ua.Variant(value, ua.VariantType.ExtensionObject),
+                            datatype=ua.NodeId(data_type))
+
+
 class RigServer:
     """The asyncua server of one rig object ``rig`` at ``endpoint``; ``send(command)``
     hands a command to the simulator (called in the event loop)."""
@@ -114,10 +124,13 @@ class RigServer:
         self.server.set_server_name(f"drill_sim_ros OPC UA gateway ({self.rig})")
         self.server.set_security_policy([ua.SecurityPolicyType.NoSecurity])
         index = await self.server.register_namespace(NAMESPACE_URI)
-        rig = await self.server.nodes.objects.add_object(index, self.rig)
+        rig = await self.server.nodes.objects.add_object(ua.NodeId(self.rig, index),
+                                                         ua.QualifiedName(self.rig, index))
         for variable in VARIABLES:
             await self._add_variable(rig, index, variable)
-        await rig.add_method(index, STEP_METHOD, self._step, [], [ua.VariantType.UInt32])
+        await rig.add_method(ua.NodeId(node_id(self.rig, STEP_METHOD), index),
+                             ua.QualifiedName(STEP_METHOD, index),
+                             self._step, [], [ua.VariantType.UInt32])
         self.server.subscribe_server_callback(CallbackType.PreWrite, self._pre_write)
         await self.server.start()
 
@@ -125,19 +138,17 @@ class RigServer:
         await self.server.stop()
 
     async def _add_variable(self, rig: Any, index: int, variable: Variable) -> None:
-        node = await rig.add_variable(index, variable.name,
+        node = await rig.add_variable(ua.NodeId(node_id(self.rig, variable.name), index),
+                                      ua.QualifiedName(variable.name, index),
                                       variant(variable, self.values[variable.name]))
         if variable.writable:
             await node.set_writable()
         if variable.unit is not None:
-            await node.add_property(0, "EngineeringUnits", ua.Variant(
-                eu_information(variable), ua.VariantType.ExtensionObject),
-                datatype=ua.NodeId(ua.ObjectIds.EUInformation))
+            await _add_property(node, "EngineeringUnits", eu_information(variable),
+                                ua.ObjectIds.EUInformation)
         eu_range = self.settings.eu_range(variable.name)
         if eu_range is not None:
-            await node.add_property(0, "EURange", ua.Variant(
-                ua.Range(*eu_range), ua.VariantType.ExtensionObject),
-                datatype=ua.NodeId(ua.ObjectIds.Range))
+            await _add_property(node, "EURange", ua.Range(*eu_range), ua.ObjectIds.Range)
         self.nodes[variable.name] = node
         self._names[node.nodeid] = variable.name
 

@@ -257,3 +257,13 @@ def test_an_insecure_or_malformed_endpoint_is_refused_in_one_line(endpoint: str)
     lines = (done.stdout + done.stderr).strip().splitlines()
     assert len(lines) == 1 and "Traceback" not in lines[0]
     assert endpoint in lines[0]
+
+
+def test_without_a_sim_node_the_gateway_says_so_in_one_line() -> None:
+    endpoint = f"opc.tcp://127.0.0.1:{free_port()}/drill_sim/"
+    done = subprocess.run([str(BIN / "opcua_gateway"), "--ros-args", "-p", f"endpoint:={endpoint}",
+                           "-p", "sim_wait_s:=1.0", "-r", "__ns:=/nobody_here"],
+                          capture_output=True, text=True, timeout=60)
+    assert done.returncode == 2
+    lines = (done.stdout + done.stderr).strip().splitlines()
+    assert len(lines) == 1 and "no sim_node /nobody_here/drill_sim answered" in lines[0], lines
