@@ -99,11 +99,12 @@ async def _add_property(node: Any, name: str, value: Any, data_type: int) -> Non
 
 
 class RigServer:
-    """The asyncua server of one rig object ``rig`` at ``endpoint``; ``send(command)``
-    hands a command to the simulator (called in the event loop)."""
+    """The asyncua server of one rig object ``rig`` at ``endpoint``; ``send(command,
+    stamp_ns)`` hands the simulator a command answering the sample stamped ``stamp_ns``
+    (called in the event loop)."""
 
     def __init__(self, endpoint: str, rig: str, settings: RigSettings,
-                 send: Callable[[Command], None], step_timeout_s: float = 10.0) -> None:
+                 send: Callable[[Command, int], None], step_timeout_s: float = 10.0) -> None:
         self.server = Server()
         self.endpoint, self.rig, self.settings = endpoint, rig, settings
         self._send = send
@@ -123,6 +124,7 @@ class RigServer:
         self.server.set_endpoint(self.endpoint)
         self.server.set_server_name(f"drill_sim_ros OPC UA gateway ({self.rig})")
         self.server.set_security_policy([ua.SecurityPolicyType.NoSecurity])
+        self.server.set_identity_tokens([ua.AnonymousIdentityToken])   # loopback only
         index = await self.server.register_namespace(NAMESPACE_URI)
         rig = await self.server.nodes.objects.add_object(ua.NodeId(self.rig, index),
                                                          ua.QualifiedName(self.rig, index))
@@ -224,7 +226,7 @@ class RigServer:
         self.outstanding = True
         self._send(Command(speed_rad_s=changed.get("SpeedSetpoint"),
                            motor_torque_nm=changed.get("TorqueCommand"),
-                           wob_n=changed.get("WobSetpoint")))
+                           wob_n=changed.get("WobSetpoint")), self.latest_ns)
         _log.debug("command %d sent", counter)
 
     async def _step(self, _parent: ua.NodeId) -> Any:

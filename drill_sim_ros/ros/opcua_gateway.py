@@ -101,7 +101,6 @@ class GatewayNode(Node):
             10.0)).value
         self.on_sample = None
         self.latest_sample: tuple[dict[str, float], int] | None = None   # (before on_sample)
-        self._latest_ns = -1
         self._pub = self.create_publisher(JointState, topics.node_relative(
             topics.CMD_TOP_DRIVE), LOCKSTEP_QOS)
         self.create_subscription(JointState, topics.node_relative(topics.SURFACE_MEASURED),
@@ -109,14 +108,13 @@ class GatewayNode(Node):
 
     def _on_sample(self, msg: JointState) -> None:
         values, time_ns = sample_values(msg)
-        self._latest_ns = max(self._latest_ns, time_ns)
         self.latest_sample = (values, time_ns)
         if self.on_sample is not None:
             self.on_sample(values, time_ns)
 
-    def send(self, command: Command) -> None:
-        """The command answering the latest sample (thread-safe: rclpy's publish)."""
-        self._pub.publish(top_drive_command(command, self._latest_ns))
+    def send(self, command: Command, stamp_ns: int) -> None:
+        """The command answering the sample stamped ``stamp_ns`` (from any thread)."""
+        self._pub.publish(top_drive_command(command, stamp_ns))
 
     def sim_parameters(self) -> dict[str, Any]:
         """sim_node's SIM_PARAMETERS (DrillSimError, one line, if it does not answer)."""

@@ -5,8 +5,9 @@ processes over loopback (issue 33).
   EURanges, source timestamps in simulated time.
 - Bad writes (NaN, inf, out of range, wrong type, read-only, a counter out of turn) are
   refused with their Bad status codes, counted, and never advance the sim.
-- A PI law closes the loop through the counters, the client goes away (the sim waits) and
-  another one comes back through ``Step``: the recorded telemetry equals the in-process
+- A PI law closes the loop through the counters (SampleCounter polled), the client goes away
+  (the sim waits), another one comes back and goes on through the counters (SampleCounter
+  subscribed) and through ``Step``: the recorded telemetry equals the in-process
   bench of the same law, bit for bit. The client uses asyncua and the law only.
 - An off-loopback endpoint is refused at start in one line.
 """
@@ -209,6 +210,35 @@ async def law_through_counters(rig: Rig, first: int, last: int, integral: float)
     return integral
 
 
+class SampleCounterChanges:
+    """asyncua's data-change handler for SampleCounter: its latest value, an event per change."""
+
+    def __init__(self) -> None:
+        self.value = -1
+        self.changed = asyncio.Event()
+
+    def datachange_notification(self, _node: Any, value: int, _data: Any) -> None:
+        self.value = value
+        self.changed.set()
+
+
+async def law_through_subscription(rig: Rig, first: int, last: int, integral: float) -> float:
+    """Commands ``first`` .. ``last`` by CommandCounter, SampleCounter by data changes."""
+    changes = SampleCounterChanges()
+    subscription = await rig.client.create_subscription(1, changes)
+    await subscription.subscribe_data_change(rig.nodes["SampleCounter"])
+    for counter in range(first, last + 1):
+        speed, integral = pi_step(integral, await rig.value("QuillTorque"))
+        changes.changed.clear()
+        await rig.write(SpeedSetpoint=ua.Variant(speed, DOUBLE),
+                        CommandCounter=ua.Variant(counter, UINT32))
+        while changes.value != counter:
+            await asyncio.wait_for(changes.changed.wait(), 10.0)
+            changes.changed.clear()
+    await subscription.delete()
+    return integral
+
+
 async def law_through_step(rig: Rig, first: int, last: int, integral: float) -> float:
     """Commands ``first`` .. ``last`` by the method Step."""
     for counter in range(first, last + 1):
@@ -228,7 +258,8 @@ async def close_the_loop(url: str) -> None:
     try:
         assert await rig.value("SampleCounter") == await rig.value("CommandCounter") == half
         assert await rig.value("SimTime") == pytest.approx(half * 0.01, abs=1e-9)
-        await law_through_step(rig, half + 1, PERIODS, integral)
+        integral = await law_through_subscription(rig, half + 1, half + 100, integral)
+        await law_through_step(rig, half + 101, PERIODS, integral)
     finally:
         await client.disconnect()
 
