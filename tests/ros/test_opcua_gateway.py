@@ -49,8 +49,8 @@ def free_port() -> int:
         return probe.getsockname()[1]
 
 
-def sim_command(record: Path | None) -> list[str]:
-    values = {"lockstep": True, "lockstep_trigger": "command", "status_line": False,
+def sim_command(record: Path | None, lockstep: bool = True) -> list[str]:
+    values = {"lockstep": lockstep, "lockstep_trigger": "command", "status_line": False,
               "publish_clock": False, **sim_node_parameters(SCENARIO, SCENARIO.load_preset())}
     if record is not None:
         values["record.path"] = str(record)
@@ -62,10 +62,10 @@ def sim_command(record: Path | None) -> list[str]:
 
 
 @contextmanager
-def sim_and_gateway(tmp_path: Path, record: Path | None = None
+def sim_and_gateway(tmp_path: Path, record: Path | None = None, lockstep: bool = True
                     ) -> Iterator[tuple[subprocess.Popen, subprocess.Popen, str]]:
     url = f"opc.tcp://127.0.0.1:{free_port()}/drill_sim/"
-    with running(sim_command(record), tmp_path / "sim.log") as sim, \
+    with running(sim_command(record, lockstep), tmp_path / "sim.log") as sim, \
             running(["opcua_gateway", "--ros-args", "-p", f"endpoint:={url}"],
                     tmp_path / "gateway.log") as gateway:
         yield sim, gateway, url
@@ -274,6 +274,40 @@ def test_a_pi_law_through_opcua_gives_the_bench_telemetry_bit_for_bit(tmp_path: 
     local = run_in_process(SCENARIO).rows
     assert remote.shape == local.shape == (PERIODS + 1, local.shape[1])
     assert remote.tobytes() == local.tobytes()
+
+
+# ---- free run: a PLC's own cycle at real time -----------------------------------------------
+
+async def wait_until(rig: Rig, name: str, holds: Any, timeout_s: float = 20.0) -> Any:
+    """Poll ``name`` until ``holds(value)`` (bounded); the value."""
+    end = asyncio.get_running_loop().time() + timeout_s
+    while not holds(value := await rig.value(name)):
+        assert asyncio.get_running_loop().time() < end, f"{name} stayed at {value}"
+        await asyncio.sleep(0.02)
+    return value
+
+
+async def drive_in_free_run(url: str) -> None:
+    client, rig = await connect(url)
+    try:
+        assert await rig.value("Lockstep") is False
+        start_s = await rig.value("SimTime")
+        await wait_until(rig, "SimTime", lambda t: t > start_s)       # the values follow
+        counter = await rig.value("SampleCounter") + 1
+        await rig.write(SpeedSetpoint=ua.Variant(8.0, DOUBLE),
+                        CommandCounter=ua.Variant(counter, UINT32))
+        await wait_sample(rig, counter)
+        await wait_until(rig, "DriveSpeed", lambda w: abs(w - 8.0) < 0.4)   # and it acts
+    finally:
+        await client.disconnect()
+
+
+def test_in_free_run_the_values_follow_the_sim_and_a_counted_command_acts(
+        tmp_path: Path) -> None:
+    with sim_and_gateway(tmp_path, lockstep=False) as (sim, gateway, url):
+        run(drive_in_free_run(url))
+        assert stop(gateway, signal.SIGINT) == 0, (tmp_path / "gateway.log").read_text()
+        assert stop(sim, signal.SIGINT) == 0
 
 
 # ---- safe by default ------------------------------------------------------------------------
