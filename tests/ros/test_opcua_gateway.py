@@ -49,7 +49,7 @@ def free_port() -> int:
         return probe.getsockname()[1]
 
 
-def sim_command(record: Path | None, lockstep: bool = True) -> list[str]:
+def sim_command(record: Path | None, lockstep: bool = True, namespace: str = "") -> list[str]:
     values = {"lockstep": lockstep, "lockstep_trigger": "command", "status_line": False,
               "publish_clock": False, **sim_node_parameters(SCENARIO, SCENARIO.load_preset())}
     if record is not None:
@@ -58,15 +58,18 @@ def sim_command(record: Path | None, lockstep: bool = True) -> list[str]:
     for name, value in values.items():
         text = ("true" if value else "false") if isinstance(value, bool) else str(value)
         args += ["-p", f"{name}:={text}"]
-    return ["sim_node", "--ros-args", *args]
+    remap = ["-r", f"__ns:={namespace}"] if namespace else []
+    return ["sim_node", "--ros-args", *remap, *args]
 
 
 @contextmanager
-def sim_and_gateway(tmp_path: Path, record: Path | None = None, lockstep: bool = True
+def sim_and_gateway(tmp_path: Path, record: Path | None = None, lockstep: bool = True,
+                    namespace: str = ""
                     ) -> Iterator[tuple[subprocess.Popen, subprocess.Popen, str]]:
     url = f"opc.tcp://127.0.0.1:{free_port()}/drill_sim/"
-    with running(sim_command(record, lockstep), tmp_path / "sim.log") as sim, \
-            running(["opcua_gateway", "--ros-args", "-p", f"endpoint:={url}"],
+    remap = ["-r", f"__ns:={namespace}"] if namespace else []
+    with running(sim_command(record, lockstep, namespace), tmp_path / "sim.log") as sim, \
+            running(["opcua_gateway", "--ros-args", *remap, "-p", f"endpoint:={url}"],
                     tmp_path / "gateway.log") as gateway:
         yield sim, gateway, url
 
@@ -88,8 +91,10 @@ class Rig:
         return await self.obj.call_method(f"{self.index}:Step")
 
 
-async def connect(url: str, deadline_s: float = START_TIMEOUT_S) -> tuple[Client, Rig]:
-    """A client connected to the gateway once its Status is running (bounded)."""
+async def connect(url: str, deadline_s: float = START_TIMEOUT_S, rig_name: str = "Rig"
+                  ) -> tuple[Client, Rig]:
+    """A client connected to the gateway's ``rig_name`` once its Status is running
+    (bounded)."""
     loop = asyncio.get_running_loop()
     end = loop.time() + deadline_s
     while True:
@@ -98,7 +103,7 @@ async def connect(url: str, deadline_s: float = START_TIMEOUT_S) -> tuple[Client
         try:
             await client.connect()
             index = await client.get_namespace_index(NAMESPACE_URI)
-            obj = await client.nodes.objects.get_child(f"{index}:Rig")
+            obj = await client.nodes.objects.get_child(f"{index}:{rig_name}")
             nodes = {(await n.read_browse_name()).Name: n for n in await obj.get_children()}
             rig = Rig(client, index, obj, nodes)
             if await rig.value("Status") == "running":
@@ -288,7 +293,8 @@ async def wait_until(rig: Rig, name: str, holds: Any, timeout_s: float = 20.0) -
 
 
 async def drive_in_free_run(url: str) -> None:
-    client, rig = await connect(url)
+    client, rig = await connect(url, rig_name="rig2")           # the namespace's last part
+    assert rig.obj.nodeid == ua.NodeId("rig2", rig.index)
     try:
         assert await rig.value("Lockstep") is False
         start_s = await rig.value("SimTime")
@@ -302,9 +308,10 @@ async def drive_in_free_run(url: str) -> None:
         await client.disconnect()
 
 
-def test_in_free_run_the_values_follow_the_sim_and_a_counted_command_acts(
+def test_in_free_run_in_a_namespace_the_values_follow_and_a_counted_command_acts(
         tmp_path: Path) -> None:
-    with sim_and_gateway(tmp_path, lockstep=False) as (sim, gateway, url):
+    with sim_and_gateway(tmp_path, lockstep=False, namespace="/site/rig2") as (sim, gateway,
+                                                                              url):
         run(drive_in_free_run(url))
         assert stop(gateway, signal.SIGINT) == 0, (tmp_path / "gateway.log").read_text()
         assert stop(sim, signal.SIGINT) == 0
