@@ -117,6 +117,8 @@ class RigServer:
         self.latest_ns: int | None = None
         self.outstanding = False
         self.rejected = 0
+        self.commands_sent = 0
+        self.samples_in = 0
         self._waiters: list[asyncio.Future[int]] = []
 
     async def start(self) -> None:
@@ -138,6 +140,13 @@ class RigServer:
 
     async def stop(self) -> None:
         await self.server.stop()
+
+    def figures(self) -> dict[str, str]:
+        """The diagnostics' key/values (read from any thread: plain ints and strings)."""
+        return {"endpoint": self.endpoint, "status": str(self.values["Status"]),
+                "rejected_writes": str(self.rejected), "commands_sent": str(self.commands_sent),
+                "samples_in": str(self.samples_in),
+                "sample_counter": str(self.values["SampleCounter"])}
 
     async def _add_variable(self, rig: Any, index: int, variable: Variable) -> None:
         node = await rig.add_variable(ua.NodeId(node_id(self.rig, variable.name), index),
@@ -224,6 +233,7 @@ class RigServer:
                    if values[name] != self._in_force[name]}
         self._in_force.update(changed)
         self.outstanding = True
+        self.commands_sent += 1
         self._send(Command(speed_rad_s=changed.get("SpeedSetpoint"),
                            motor_torque_nm=changed.get("TorqueCommand"),
                            wob_n=changed.get("WobSetpoint")), self.latest_ns)
@@ -251,6 +261,7 @@ class RigServer:
             return
         first = self.latest_ns is None
         self.latest_ns = time_ns
+        self.samples_in += 1
         for name, value in values.items():
             await self._set(name, value, time_ns)
         if first:

@@ -24,6 +24,7 @@ import threading
 from typing import Any
 
 import rclpy
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from rcl_interfaces.msg import FloatingPointRange, ParameterDescriptor
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.node import Node
@@ -39,7 +40,7 @@ from drill_sim_ros.hil.rig_server import RigServer, RigSettings
 from drill_sim_ros.model.errors import DrillSimError
 from drill_sim_ros.model.params import RPM_PER_RAD_S
 from drill_sim_ros.ros.lockstep_driver import LOCKSTEP_QOS, top_drive_command
-from drill_sim_ros.ros.messages import LATEST_SAMPLE_QOS, stamp_ns
+from drill_sim_ros.ros.messages import LATEST_SAMPLE_QOS, stamp_ns, status
 from drill_sim_ros.ros.parameters import init_ros
 
 NODE_NAME = "opcua_gateway"
@@ -52,6 +53,7 @@ SIM_PARAMETERS = ("limits.max_surface_rpm", "limits.max_wob_n", "top_drive.max_t
                   "lockstep_trigger")
 GIL_SWITCH_INTERVAL_S = 0.0005    # as sim_node's: a thread waiting for the GIL waits less
 POLL_S = 0.2
+DIAGNOSTICS_PERIOD_S = 1.0        # wall time, as sim_node's
 
 
 def _seconds(description: str, default: float) -> tuple[float, ParameterDescriptor]:
@@ -100,6 +102,10 @@ class GatewayNode(Node):
             "Step returns BadTimeout after this many wall seconds without the sample [s]",
             10.0)).value
         self.on_sample = None
+        self.figures: Any = None            # () -> the diagnostics' values, once serving
+        self._rejected_before = "0"
+        self._diagnostics = self.create_publisher(DiagnosticArray, topics.DIAGNOSTICS, 10)
+        self.create_timer(DIAGNOSTICS_PERIOD_S, self._publish_diagnostics)
         self.latest_sample: tuple[dict[str, float], int] | None = None   # (before on_sample)
         self._pub = self.create_publisher(JointState, topics.node_relative(
             topics.CMD_TOP_DRIVE), LOCKSTEP_QOS)
@@ -111,6 +117,20 @@ class GatewayNode(Node):
         self.latest_sample = (values, time_ns)
         if self.on_sample is not None:
             self.on_sample(values, time_ns)
+
+    def _publish_diagnostics(self) -> None:
+        """``opcua_gateway: <rig>``: WARN when writes were refused since the last one."""
+        if self.figures is None:
+            return
+        values = self.figures()
+        refused = values["rejected_writes"] != self._rejected_before
+        self._rejected_before = values["rejected_writes"]
+        level = DiagnosticStatus.WARN if refused else DiagnosticStatus.OK
+        message = "writes refused (see the log)" if refused else values["status"]
+        msg = DiagnosticArray(status=[status(f"{NODE_NAME}: {self.rig}", level, message,
+                                             values)])
+        msg.header.stamp = self.get_clock().now().to_msg()
+        self._diagnostics.publish(msg)
 
     def send(self, command: Command, stamp_ns: int) -> None:
         """The command answering the sample stamped ``stamp_ns`` (from any thread)."""
@@ -143,6 +163,7 @@ async def serve(node: GatewayNode, settings: RigSettings) -> None:
     samples: asyncio.Queue[tuple[dict[str, float], int]] = asyncio.Queue()
     rig = RigServer(node.endpoint, node.rig, settings, node.send, node.step_timeout_s)
     await rig.start()
+    node.figures = rig.figures
     node.on_sample = lambda values, time_ns: loop.call_soon_threadsafe(
         samples.put_nowait, (values, time_ns))
     if node.latest_sample is not None:      # received while sim_node's parameters came

@@ -4,7 +4,8 @@ processes over loopback (issue 33).
 - The address space: the rig object, its BrowseNames, units (EUInformation, UNECE) and
   EURanges, source timestamps in simulated time.
 - Bad writes (NaN, inf, out of range, wrong type, read-only, a counter out of turn) are
-  refused with their Bad status codes, counted, and never advance the sim.
+  refused with their Bad status codes, counted (``RejectedWrites``, /diagnostics), and never
+  advance the sim.
 - A PI law closes the loop through the counters (SampleCounter polled), the client goes away
   (the sim waits), another one comes back and goes on through the counters (SampleCounter
   subscribed) and through ``Step``: the recorded telemetry equals the in-process
@@ -27,10 +28,12 @@ from typing import Any
 import pytest
 from asyncua import Client, ua
 
+from drill_sim_ros import topics
 from drill_sim_ros.control.bench import run_in_process, sim_node_parameters
 from drill_sim_ros.control.scenario import Scenario
 from drill_sim_ros.ros.closed_loop import read_telemetry
 from tests.archive.helpers import BIN, running, stop
+from tests.ros.harness import Probe, Ros, ros_context
 from tests.ros.opcua_pi_law import pi_step
 
 pytestmark = pytest.mark.ros
@@ -195,9 +198,25 @@ async def browse_and_refuse(url: str) -> None:
         await client.disconnect()
 
 
+def gateway_diagnostics(ros: Ros, probe: Probe) -> dict[str, str]:
+    """The values of the gateway's latest status on /diagnostics (bounded wait)."""
+    def latest() -> dict[str, str] | None:
+        for msg in reversed(probe.messages(topics.DIAGNOSTICS)):
+            for item in msg.status:
+                if item.name == "opcua_gateway: Rig":
+                    return {kv.key: kv.value for kv in item.values} | {"level": item.level}
+        return None
+    assert ros.spin_until(lambda: latest() is not None, 10.0), "no gateway diagnostics"
+    return latest()
+
+
 def test_address_space_units_ranges_and_bad_writes(tmp_path: Path) -> None:
-    with sim_and_gateway(tmp_path) as (sim, gateway, url):
+    with sim_and_gateway(tmp_path) as (sim, gateway, url), ros_context() as ros:
         run(browse_and_refuse(url))
+        probe = ros.add(Probe(ros.context, [topics.DIAGNOSTICS]))
+        figures = gateway_diagnostics(ros, probe)
+        assert figures["rejected_writes"] == str(len(BAD_WRITES) + 1)
+        assert figures["commands_sent"] == figures["sample_counter"] == "1"
         assert stop(gateway, signal.SIGINT) == 0, (tmp_path / "gateway.log").read_text()
         assert stop(sim, signal.SIGINT) == 0
     assert "Traceback" not in (tmp_path / "gateway.log").read_text()
