@@ -1,10 +1,11 @@
-"""Where the gateway may listen: loopback for anonymous clients, nowhere else (issue 33).
+"""Where the gateway may listen: loopback for anonymous clients, elsewhere only secured
+(issue 33).
 
 An OPC UA server reachable off the machine lets anyone who reaches it command a simulated top
-drive and, in hardware in the loop, the rig's controller under test. This version serves
-anonymous access without security on loopback only; a non-loopback endpoint is refused at
-start with one line (a user/password or a Basic256Sha256 Sign & Encrypt policy is the way to
-open it, and not built yet).
+drive and, in hardware in the loop, the rig's controller under test. Anonymous access without
+security is served on loopback only; a non-loopback endpoint needs the secured mode
+(:mod:`.security`: Basic256Sha256, Sign & Encrypt, a user and password) and is refused at
+start with one line without it.
 """
 
 from __future__ import annotations
@@ -38,11 +39,13 @@ def is_loopback(host: str) -> bool:
         return False
 
 
-def check_endpoint(endpoint: str) -> None:
-    """ParameterError (one line) unless ``endpoint`` binds a loopback address."""
+def check_endpoint(endpoint: str, secured: bool = False) -> None:
+    """ParameterError (one line) unless ``endpoint`` binds a loopback address or the gateway
+    is ``secured``."""
     host = endpoint_host(endpoint)
-    if not is_loopback(host):
+    if not secured and not is_loopback(host):
         raise ParameterError(
             f"endpoint {endpoint!r} binds {host}, off loopback: anonymous access without a "
-            "security policy is allowed on loopback only, and this gateway has no user or "
-            "certificate security yet; bind 127.0.0.1 (and tunnel, e.g. ssh -L 4840:...)")
+            "security policy is allowed on loopback only; set security.certificate, "
+            "security.private_key, security.user and security.password_file (Basic256Sha256, "
+            "Sign & Encrypt), or bind 127.0.0.1")

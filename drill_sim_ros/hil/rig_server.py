@@ -38,6 +38,7 @@ from drill_sim_ros.hil.address_space import (
     node_id,
     unece_unit_id,
 )
+from drill_sim_ros.hil.security import APPLICATION_URI, PasswordUser, Security
 
 _log = logging.getLogger(__name__)
 SIM_EPOCH = datetime(1970, 1, 1, tzinfo=timezone.utc)
@@ -104,8 +105,11 @@ class RigServer:
     (called in the event loop)."""
 
     def __init__(self, endpoint: str, rig: str, settings: RigSettings,
-                 send: Callable[[Command, int], None], step_timeout_s: float = 10.0) -> None:
-        self.server = Server()
+                 send: Callable[[Command, int], None], step_timeout_s: float = 10.0,
+                 security: Security | None = None) -> None:
+        self.security = security
+        self.server = Server(user_manager=None if security is None else PasswordUser(
+            security.user, security.password))
         self.endpoint, self.rig, self.settings = endpoint, rig, settings
         self._send = send
         self.step_timeout_s = step_timeout_s
@@ -125,8 +129,7 @@ class RigServer:
         await self.server.init()
         self.server.set_endpoint(self.endpoint)
         self.server.set_server_name(f"drill_sim_ros OPC UA gateway ({self.rig})")
-        self.server.set_security_policy([ua.SecurityPolicyType.NoSecurity])
-        self.server.set_identity_tokens([ua.AnonymousIdentityToken])   # loopback only
+        await self._secure()
         index = await self.server.register_namespace(NAMESPACE_URI)
         rig = await self.server.nodes.objects.add_object(ua.NodeId(self.rig, index),
                                                          ua.QualifiedName(self.rig, index))
@@ -137,6 +140,19 @@ class RigServer:
                              self._step, [], [ua.VariantType.UInt32])
         self.server.subscribe_server_callback(CallbackType.PreWrite, self._pre_write)
         await self.server.start()
+
+    async def _secure(self) -> None:
+        """Anonymous and unencrypted (loopback only), or Basic256Sha256 Sign & Encrypt
+        with the one user of :attr:`security`."""
+        if self.security is None:
+            self.server.set_security_policy([ua.SecurityPolicyType.NoSecurity])
+            self.server.set_identity_tokens([ua.AnonymousIdentityToken])
+            return
+        await self.server.set_application_uri(APPLICATION_URI)
+        self.server.set_security_policy([ua.SecurityPolicyType.Basic256Sha256_SignAndEncrypt])
+        self.server.set_identity_tokens([ua.UserNameIdentityToken])
+        await self.server.load_certificate(str(self.security.certificate))
+        await self.server.load_private_key(str(self.security.private_key))
 
     async def stop(self) -> None:
         await self.server.stop()

@@ -37,6 +37,8 @@ from drill_sim_ros.control.command import Command
 from drill_sim_ros.hil.address_space import DEFAULT_ENDPOINT, SAMPLE_VARIABLES, rig_name
 from drill_sim_ros.hil.endpoint import check_endpoint
 from drill_sim_ros.hil.rig_server import RigServer, RigSettings
+from drill_sim_ros.hil.security import SETTINGS as SECURITY_SETTINGS
+from drill_sim_ros.hil.security import load_security
 from drill_sim_ros.model.errors import DrillSimError
 from drill_sim_ros.model.params import RPM_PER_RAD_S
 from drill_sim_ros.ros.lockstep_driver import LOCKSTEP_QOS, top_drive_command
@@ -54,6 +56,14 @@ SIM_PARAMETERS = ("limits.max_surface_rpm", "limits.max_wob_n", "top_drive.max_t
 GIL_SWITCH_INTERVAL_S = 0.0005    # as sim_node's: a thread waiting for the GIL waits less
 POLL_S = 0.2
 DIAGNOSTICS_PERIOD_S = 1.0        # wall time, as sim_node's
+
+
+SECURITY_HELP = {
+    "security.certificate": "the server's certificate, DER or PEM, with the URI "
+                            "urn:drill_sim_ros:opcua_gateway ('' = not secured: loopback only)",
+    "security.private_key": "the certificate's private key, PEM",
+    "security.user": "the one user name a client must give",
+    "security.password_file": "a file whose first line is that user's password"}
 
 
 def _seconds(description: str, default: float) -> tuple[float, ParameterDescriptor]:
@@ -101,6 +111,9 @@ class GatewayNode(Node):
         self.step_timeout_s = self.declare_parameter("step_timeout_s", *_seconds(
             "Step returns BadTimeout after this many wall seconds without the sample [s]",
             10.0)).value
+        self.security = load_security({name: self.declare_parameter(
+            name, "", ParameterDescriptor(description=SECURITY_HELP[name], read_only=True)
+        ).value for name in SECURITY_SETTINGS})
         self.on_sample = None
         self.figures: Any = None            # () -> the diagnostics' values, once serving
         self._rejected_before = "0"
@@ -161,7 +174,8 @@ async def serve(node: GatewayNode, settings: RigSettings) -> None:
     """Run the OPC UA server until ROS shuts down (SIGINT, SIGTERM)."""
     loop = asyncio.get_running_loop()
     samples: asyncio.Queue[tuple[dict[str, float], int]] = asyncio.Queue()
-    rig = RigServer(node.endpoint, node.rig, settings, node.send, node.step_timeout_s)
+    rig = RigServer(node.endpoint, node.rig, settings, node.send, node.step_timeout_s,
+                    node.security)
     await rig.start()
     node.figures = rig.figures
     node.on_sample = lambda values, time_ns: loop.call_soon_threadsafe(
@@ -198,7 +212,7 @@ def main(args: list[str] | None = None) -> int:
     node = None
     try:
         node = GatewayNode()
-        check_endpoint(node.endpoint)
+        check_endpoint(node.endpoint, secured=node.security is not None)
         asyncio.run(serve(node, rig_settings(node.sim_parameters())))
     except (KeyboardInterrupt, ExternalShutdownException):
         pass

@@ -1,4 +1,5 @@
-"""The rig's address space table and the endpoint rule, without a server (issue 33)."""
+"""The rig's address space table, the endpoint rule and the security settings, without a
+server (issue 33)."""
 
 from __future__ import annotations
 
@@ -12,6 +13,7 @@ from drill_sim_ros.hil.address_space import (
     unece_unit_id,
 )
 from drill_sim_ros.hil.endpoint import check_endpoint, is_loopback
+from drill_sim_ros.hil.security import PasswordUser, load_security
 from drill_sim_ros.model.errors import ParameterError
 
 ISSUE_33_NAMES = {"DriveSpeed", "MotorTorque", "QuillTorque", "HookLoad", "WobEstimate",
@@ -58,3 +60,30 @@ def test_other_endpoints_are_refused_in_one_line(endpoint: str, says: str) -> No
         check_endpoint(endpoint)
     assert "\n" not in str(refused.value)
     assert not is_loopback("0.0.0.0")
+
+
+def test_a_secured_gateway_may_bind_off_loopback() -> None:
+    check_endpoint("opc.tcp://0.0.0.0:4840/drill_sim/", secured=True)
+
+
+def test_security_settings_all_or_none(tmp_path) -> None:
+    names = ("security.certificate", "security.private_key", "security.user",
+             "security.password_file")
+    assert load_security(dict.fromkeys(names, "")) is None
+    with pytest.raises(ParameterError, match=r"missing: security\.private_key"):
+        load_security({"security.certificate": "c.der", "security.user": "plc",
+                       "security.password_file": "p"})
+    files = {name: tmp_path / name for name in names[:2] + names[3:]}
+    for path in files.values():
+        path.write_text("")
+    values = {name: str(path) for name, path in files.items()} | {"security.user": "plc"}
+    with pytest.raises(ParameterError, match="is empty"):
+        load_security(values)
+    files["security.password_file"].write_text("s3cret\nignored\n")
+    security = load_security(values)
+    assert (security.user, security.password) == ("plc", "s3cret")
+    users = PasswordUser("plc", "s3cret")
+    assert users.get_user(None, "plc", "s3cret") is not None
+    assert users.get_user(None, "plc", "guess") is None
+    assert users.get_user(None, "other", "s3cret") is None
+    assert users.get_user(None) is None

@@ -10,7 +10,8 @@ processes over loopback (issue 33).
   (the sim waits), another one comes back and goes on through the counters (SampleCounter
   subscribed) and through ``Step``: the recorded telemetry equals the in-process
   bench of the same law, bit for bit. The client uses asyncua and the law only.
-- An off-loopback endpoint is refused at start in one line.
+- A secured gateway (Basic256Sha256, Sign & Encrypt, user and password) admits its user
+  only; an off-loopback endpoint without it is refused at start in one line.
 """
 
 from __future__ import annotations
@@ -27,10 +28,14 @@ from typing import Any
 
 import pytest
 from asyncua import Client, ua
+from asyncua.crypto.cert_gen import setup_self_signed_certificate
+from asyncua.crypto.security_policies import SecurityPolicyBasic256Sha256
+from cryptography.x509.oid import ExtendedKeyUsageOID
 
 from drill_sim_ros import topics
 from drill_sim_ros.control.bench import run_in_process, sim_node_parameters
 from drill_sim_ros.control.scenario import Scenario
+from drill_sim_ros.hil.security import APPLICATION_URI
 from drill_sim_ros.ros.closed_loop import read_telemetry
 from tests.archive.helpers import BIN, running, stop
 from tests.ros.harness import Probe, Ros, ros_context
@@ -67,12 +72,13 @@ def sim_command(record: Path | None, lockstep: bool = True, namespace: str = "")
 
 @contextmanager
 def sim_and_gateway(tmp_path: Path, record: Path | None = None, lockstep: bool = True,
-                    namespace: str = ""
+                    namespace: str = "", options: tuple[str, ...] = ()
                     ) -> Iterator[tuple[subprocess.Popen, subprocess.Popen, str]]:
     url = f"opc.tcp://127.0.0.1:{free_port()}/drill_sim/"
     remap = ["-r", f"__ns:={namespace}"] if namespace else []
     with running(sim_command(record, lockstep, namespace), tmp_path / "sim.log") as sim, \
-            running(["opcua_gateway", "--ros-args", *remap, "-p", f"endpoint:={url}"],
+            running(["opcua_gateway", "--ros-args", *remap, "-p", f"endpoint:={url}",
+                     *options],
                     tmp_path / "gateway.log") as gateway:
         yield sim, gateway, url
 
@@ -94,16 +100,21 @@ class Rig:
         return await self.obj.call_method(f"{self.index}:Step")
 
 
-async def connect(url: str, deadline_s: float = START_TIMEOUT_S, rig_name: str = "Rig"
-                  ) -> tuple[Client, Rig]:
-    """A client connected to the gateway's ``rig_name`` once its Status is running
-    (bounded)."""
+async def plain_client(url: str) -> Client:
+    client = Client(url, timeout=5)
+    client.session_timeout = 600_000        # (the server's maximum)
+    return client
+
+
+async def connect(url: str, deadline_s: float = START_TIMEOUT_S, rig_name: str = "Rig",
+                  make_client: Any = plain_client) -> tuple[Client, Rig]:
+    """A client (``await make_client(url)``) connected to the gateway's ``rig_name`` once its
+    Status is running (bounded)."""
     loop = asyncio.get_running_loop()
     end = loop.time() + deadline_s
     while True:
-        client = Client(url, timeout=5)
-        client.session_timeout = 600_000        # (the server's maximum)
         try:
+            client = await make_client(url)       # (a secured one asks for the certificate)
             await client.connect()
             index = await client.get_namespace_index(NAMESPACE_URI)
             obj = await client.nodes.objects.get_child(f"{index}:{rig_name}")
@@ -337,6 +348,61 @@ def test_in_free_run_in_a_namespace_the_values_follow_and_a_counted_command_acts
 
 
 # ---- safe by default ------------------------------------------------------------------------
+
+async def make_certificates(folder: Path) -> None:
+    """Self-signed certificates for the gateway (its URI) and for a client."""
+    for name, uri, use in (("server", APPLICATION_URI, ExtendedKeyUsageOID.SERVER_AUTH),
+                           ("client", "urn:drill_sim_ros:test_client",
+                            ExtendedKeyUsageOID.CLIENT_AUTH)):
+        await setup_self_signed_certificate(folder / f"{name}_key.pem",
+                                            folder / f"{name}_cert.der", uri, "localhost",
+                                            [use], {})
+
+
+def secured_client(folder: Path, password: str) -> Any:
+    async def make(url: str) -> Client:
+        client = await plain_client(url)
+        client.application_uri = "urn:drill_sim_ros:test_client"
+        await client.set_security(SecurityPolicyBasic256Sha256, str(folder / "client_cert.der"),
+                                  str(folder / "client_key.pem"))
+        client.set_user("plc")
+        client.set_password(password)
+        return client
+    return make
+
+
+async def secured_session(url: str, folder: Path) -> None:
+    client, rig = await connect(url, make_client=secured_client(folder, "s3cret"))
+    try:
+        assert await rig.step() == 1
+    finally:
+        await client.disconnect()
+    with pytest.raises(ua.UaError, match="No matching endpoints"):   # anonymous, no security
+        await (await plain_client(url)).connect()
+    with pytest.raises(ua.uaerrors.BadUserAccessDenied):
+        await (await secured_client(folder, "guess")(url)).connect()
+
+
+def test_a_secured_gateway_admits_its_user_only(tmp_path: Path) -> None:
+    run(make_certificates(tmp_path))
+    (tmp_path / "password").write_text("s3cret\n")
+    options = ["-p", f"security.certificate:={tmp_path / 'server_cert.der'}",
+               "-p", f"security.private_key:={tmp_path / 'server_key.pem'}",
+               "-p", "security.user:=plc",
+               "-p", f"security.password_file:={tmp_path / 'password'}"]
+    with sim_and_gateway(tmp_path, options=tuple(options)) as (sim, gateway, url):
+        run(secured_session(url, tmp_path))
+        assert stop(gateway, signal.SIGINT) == 0, (tmp_path / "gateway.log").read_text()
+        assert stop(sim, signal.SIGINT) == 0
+
+
+def test_half_a_security_setting_is_refused_in_one_line() -> None:
+    done = subprocess.run([str(BIN / "opcua_gateway"), "--ros-args", "-p", "security.user:=plc"],
+                          capture_output=True, text=True, timeout=60)
+    assert done.returncode == 2
+    lines = (done.stdout + done.stderr).strip().splitlines()
+    assert len(lines) == 1 and "missing: security.certificate, security.private_key" in lines[0]
+
 
 @pytest.mark.parametrize("endpoint", ["opc.tcp://0.0.0.0:4840/drill_sim/",
                                       "opc.tcp://192.0.2.7:4840/", "http://127.0.0.1:4840/"])
