@@ -1,28 +1,20 @@
-"""A PI law on the quill torque, written twice over one pure function: as a bench controller
-(``module:Class`` for :func:`drill_sim_ros.control.bench.run_in_process`) and for a plain
-asyncua client (tests/ros/test_opcua_gateway.py), which uses only :func:`pi_step`.
-
-The speed setpoint drops as the string torque rises above its nominal: proportional plus
-integral action, one control period per call, the same float operations in both uses.
-"""
+"""The PI law of examples/opcua_controller.py as a bench controller (``module:Class`` for
+:func:`drill_sim_ros.control.bench.run_in_process`): the example file itself is loaded, so the
+bench and tests/ros/test_opcua_gateway.py's asyncua client run the very function
+(:func:`pi_step`) the example runs, with the same float operations."""
 
 from __future__ import annotations
 
+import importlib.util
+from pathlib import Path
+
 from drill_sim_ros.control.command import Command, SurfaceMeasurement
 
-SETPOINT_RAD_S = 6.0              # about 57 rev/min
-NOMINAL_TORQUE_NM = 3400.0
-KP_RAD_S_PER_NM = 4e-4
-KI_RAD_S2_PER_NM = 2e-4
-PERIOD_S = 0.01
-
-
-def pi_step(integral_nm_s: float, string_torque_nm: float) -> tuple[float, float]:
-    """(speed setpoint rad/s, new integral N m s) answering one torque sample."""
-    error_nm = string_torque_nm - NOMINAL_TORQUE_NM
-    integral_nm_s = integral_nm_s + error_nm * PERIOD_S
-    speed = SETPOINT_RAD_S - KP_RAD_S_PER_NM * error_nm - KI_RAD_S2_PER_NM * integral_nm_s
-    return min(max(speed, 0.0), 20.0), integral_nm_s
+EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "opcua_controller.py"
+_spec = importlib.util.spec_from_file_location("opcua_controller_example", EXAMPLE)
+_example = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(_example)
+pi_step = _example.pi_step
 
 
 class PiLaw:

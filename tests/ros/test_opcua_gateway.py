@@ -21,6 +21,7 @@ import math
 import signal
 import socket
 import subprocess
+import sys
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -39,7 +40,7 @@ from drill_sim_ros.hil.security import APPLICATION_URI
 from drill_sim_ros.ros.closed_loop import read_telemetry
 from tests.archive.helpers import BIN, running, stop
 from tests.ros.harness import Probe, Ros, ros_context
-from tests.ros.opcua_pi_law import pi_step
+from tests.ros.opcua_pi_law import EXAMPLE, pi_step
 
 pytestmark = pytest.mark.ros
 SCENARIO = Scenario(controller="tests.ros.opcua_pi_law:PiLaw", duration_s=6.0,
@@ -308,6 +309,24 @@ def test_a_pi_law_through_opcua_gives_the_bench_telemetry_bit_for_bit(tmp_path: 
     remote = read_telemetry(record)
     local = run_in_process(SCENARIO).rows
     assert remote.shape == local.shape == (PERIODS + 1, local.shape[1])
+    assert remote.tobytes() == local.tobytes()
+
+
+EXAMPLE_PERIODS = 300
+
+
+def test_the_example_controller_gives_the_bench_telemetry_bit_for_bit(tmp_path: Path) -> None:
+    """examples/opcua_controller.py, a process with asyncua and the law only."""
+    record = tmp_path / "run.mcap"
+    with sim_and_gateway(tmp_path, record) as (sim, gateway, url):
+        done = subprocess.run([sys.executable, str(EXAMPLE), "--endpoint", url, "--periods",
+                               str(EXAMPLE_PERIODS)], capture_output=True, text=True,
+                              timeout=RUN_TIMEOUT_S)
+        assert done.returncode == 0, done.stderr[-2000:]
+        assert stop(gateway, signal.SIGINT) == 0
+        assert stop(sim, signal.SIGINT) == 0
+    remote = read_telemetry(record)
+    local = run_in_process(SCENARIO).rows[:EXAMPLE_PERIODS + 1]
     assert remote.tobytes() == local.tobytes()
 
 
