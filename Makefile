@@ -77,8 +77,8 @@ docs: venv
 	$(PY) docs/generate.py
 
 # Benchmarks print figures (no pass/fail): kernel ns/step, node CPU and real-time factor,
-# MCAP throughput, rerun bridge CPU, recording loss, maps, closed loop, lockstep, the gym
-# per scenario; the kernel line includes its ns/step as a ratio to a naive reference step.
+# MCAP throughput, rerun bridge CPU, recording loss, maps, closed loop, lockstep, OPC UA, the
+# gym per scenario; the kernel line includes its ns/step as a ratio to a naive reference step.
 bench: venv
 	$(PY) benchmarks/bench_kernel.py
 	$(PY) benchmarks/bench_node.py
@@ -88,6 +88,7 @@ bench: venv
 	$(PY) benchmarks/bench_map.py
 	$(PY) benchmarks/bench_closed_loop.py
 	$(PY) benchmarks/bench_lockstep.py
+	$(PY) benchmarks/bench_opcua.py
 	$(PY) benchmarks/bench_gym.py
 
 # The paper's figures and the field map (docs/gallery/*.png), computed on a local Dask

@@ -30,6 +30,7 @@ setup(
             "drill_sim = drill_sim_ros.cli:main",
             "sim_node = drill_sim_ros.ros.sim_node:main",
             "top_drive_controller = drill_sim_ros.ros.controller_node:main",
+            "opcua_gateway = drill_sim_ros.ros.opcua_gateway:main",
             "mcap_recorder = drill_sim_ros.archive.recorder_node:main",
             "mcap_replay = drill_sim_ros.archive.replay_node:main",
             "mcap_reindex = drill_sim_ros.archive.reindex:main",

@@ -8,7 +8,8 @@ same).
 
 Sources: ``SPECS`` of ``drill_sim_ros/ros/parameters.py`` (the parameter table) and
 ``MSG_TYPES``, ``DESCRIPTIONS``, ``JOINTS`` and ``JOINT_FIELDS`` of ``drill_sim_ros/topics.py``
-with the QoS sim_node uses (the topic table).
+with the QoS sim_node uses (the topic table); ``VARIABLES`` of
+``drill_sim_ros/hil/address_space.py`` (the OPC UA address space of docs/hil.md).
 """
 
 from __future__ import annotations
@@ -141,10 +142,17 @@ def topic_table() -> str:
     return "\n".join(rows)
 
 
+def address_space_table() -> str:
+    """The OPC UA gateway's address space (``VARIABLES`` of hil/address_space.py)."""
+    from drill_sim_ros.hil.address_space import markdown_table
+    return markdown_table()
+
+
 # (page, region name) -> the function that writes the region
 REGIONS: dict[tuple[str, str], Callable[[], str]] = {
     ("docs/sim_node.md", "topics"): topic_table,
     ("docs/sim_node.md", "parameters"): parameter_table,
+    ("docs/hil.md", "address-space"): address_space_table,
 }
 
 

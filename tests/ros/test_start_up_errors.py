@@ -67,7 +67,7 @@ def test_plain_arguments_are_help_or_one_line(capsys) -> None:
     assert capsys.readouterr().out == "USAGE\n"
 
 
-@pytest.mark.parametrize("command", ["sim_node", "top_drive_controller"])
+@pytest.mark.parametrize("command", ["sim_node", "top_drive_controller", "opcua_gateway"])
 def test_a_node_given_help_or_a_stray_argument_does_not_start(command: str) -> None:
     shown = subprocess.run([str(BIN / command), "--help"], capture_output=True, text=True,
                            timeout=60)

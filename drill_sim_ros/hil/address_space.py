@@ -1,0 +1,134 @@
+"""The OPC UA address space of one rig (issue 33): its variables, their units, their sources.
+
+ROS-free and asyncua-free: one table, :data:`VARIABLES`, that the gateway builds its nodes
+from (:mod:`drill_sim_ros.hil.rig_server`), that maps a ``drill/surface/measured`` sample onto
+the read-only values, and that ``docs/hil.md`` shows (:func:`markdown_table`). PLC programs
+bind to these BrowseNames: keep them.
+
+Units are the UNECE Recommendation 20 common codes that OPC UA's EUInformation carries
+(namespace :data:`UNECE_URI`, UnitId from the code by :func:`unece_unit_id`, OPC UA Part 8
+5.6.3).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+NAMESPACE_URI = "urn:drill_sim_ros"
+DEFAULT_ENDPOINT = "opc.tcp://127.0.0.1:4840/drill_sim/"
+DEFAULT_RIG = "Rig"
+UNECE_URI = "http://www.opcfoundation.org/UA/units/un/cefact"
+DRIVE_MODES = ("speed", "torque")
+# The source timestamp of a value is its simulated time, counted from this instant (UTC).
+SIM_EPOCH_TEXT = "1970-01-01T00:00:00Z"
+
+
+@dataclass(frozen=True)
+class Unit:
+    """An engineering unit: its symbol, UNECE common code and description."""
+
+    symbol: str
+    code: str
+    description: str
+
+
+RAD_S = Unit("rad/s", "2A", "radian per second")
+NEWTON_METRE = Unit("N·m", "NU", "newton metre")
+NEWTON = Unit("N", "NEW", "newton")
+METRE = Unit("m", "MTR", "metre")
+METRE_S = Unit("m/s", "MTS", "metre per second")
+SECOND = Unit("s", "SEC", "second")
+
+
+@dataclass(frozen=True)
+class Variable:
+    """One variable of a rig object. ``source``: for a sample value, the JointState array
+    (position, velocity, effort) and joint index of ``drill/surface/measured``
+    (``topics.MEASURED_JOINTS``: top_drive, quill, hook_load, wob_estimate), or ``stamp``;
+    ``limit``: for a setpoint, the sim_node parameter its EURange comes from."""
+
+    name: str
+    type_name: str                  # OPC UA built-in type: Double, UInt32, Boolean, String
+    writable: bool
+    meaning: str
+    unit: Unit | None = None
+    source: tuple[str, int] | None = None
+    limit: str = ""
+
+
+VARIABLES = (
+    Variable("DriveSpeed", "Double", False, "drive speed, encoder", RAD_S, ("velocity", 0)),
+    Variable("MotorTorque", "Double", False, "motor torque, the drive's estimate",
+             NEWTON_METRE, ("effort", 0)),
+    Variable("QuillTorque", "Double", False, "string torque at the quill (torque sub)",
+             NEWTON_METRE, ("effort", 1)),
+    Variable("HookLoad", "Double", False, "hook load (load cell)", NEWTON, ("effort", 2)),
+    Variable("WobEstimate", "Double", False, "applied WOB estimate (string weight - hook "
+             "load)", NEWTON, ("effort", 3)),
+    Variable("BitDepth", "Double", False, "bit depth below the start", METRE,
+             ("position", 2)),
+    Variable("Rop", "Double", False, "rate of penetration", METRE_S, ("velocity", 2)),
+    Variable("SimTime", "Double", False, "simulated time of the sample", SECOND, ("stamp", 0)),
+    Variable("SpeedSetpoint", "Double", True, "drive speed setpoint (DriveMode speed)", RAD_S,
+             limit="limits.max_surface_rpm"),
+    Variable("TorqueCommand", "Double", True, "motor torque command (DriveMode torque)",
+             NEWTON_METRE, limit="top_drive.max_torque_nm"),
+    Variable("WobSetpoint", "Double", True, "applied WOB setpoint", NEWTON,
+             limit="limits.max_wob_n"),
+    Variable("DriveMode", "String", True, "what a command carries: speed (SpeedSetpoint) or "
+             "torque (TorqueCommand)"),
+    Variable("CommandCounter", "UInt32", True, "the client's handshake: SampleCounter + 1 "
+             "sends the setpoints as the next period's command"),
+    Variable("SampleCounter", "UInt32", False, "the gateway's handshake: set to "
+             "CommandCounter once that command's sample is in the values"),
+    Variable("Lockstep", "Boolean", False, "sim_node runs in command-triggered lockstep"),
+    Variable("Status", "String", False, "what the gateway does or waits for, one line"),
+    Variable("RejectedWrites", "UInt32", False, "writes refused with a Bad status code"),
+)
+VARIABLE_BY_NAME = {v.name: v for v in VARIABLES}
+SAMPLE_VARIABLES = tuple(v for v in VARIABLES if v.source is not None)
+STEP_METHOD = "Step"
+
+
+def unece_unit_id(code: str) -> int:
+    """The EUInformation UnitId of a UNECE common code (its ASCII bytes, big-endian)."""
+    unit_id = 0
+    for char in code:
+        unit_id = (unit_id << 8) | ord(char)
+    return unit_id
+
+
+def node_id(rig: str, name: str) -> str:
+    """The string NodeId of a rig's variable or method in :data:`NAMESPACE_URI`
+    (``Rig.DriveSpeed``): stable across restarts, so a PLC may bind to it."""
+    return f"{rig}.{name}"
+
+
+def rig_name(namespace: str) -> str:
+    """The rig object's BrowseName: the ROS namespace's last part, ``Rig`` in the root."""
+    return namespace.rstrip("/").rpartition("/")[2] or DEFAULT_RIG
+
+
+def _range_text(variable: Variable) -> str:
+    if variable.name == "TorqueCommand":
+        return f"±`{variable.limit}`"
+    if variable.limit:
+        return f"0 … `{variable.limit}`" + (" (in rad/s)" if variable.unit is RAD_S else "")
+    if variable.name == "DriveMode":
+        return " or ".join(DRIVE_MODES)
+    return ""
+
+
+def markdown_table() -> str:
+    """The address space as the Markdown table of docs/hil.md."""
+    lines = ["| BrowseName | type | access | unit (UNECE) | EURange | meaning |",
+             "| --- | --- | --- | --- | --- | --- |"]
+    for v in VARIABLES:
+        unit = f"{v.unit.symbol} (`{v.unit.code}`)" if v.unit else "–"
+        access = "read/write" if v.writable else "read"
+        lines.append(f"| `{v.name}` | {v.type_name} | {access} | {unit} | "
+                     f"{_range_text(v) or '–'} | {v.meaning} |")
+    lines.append(f"| `{STEP_METHOD}()` | method | call | – | – | sends the setpoints as the "
+                 "next period's command (as CommandCounter + 1 does) and returns the new "
+                 "SampleCounter (UInt32) once that sample is in the values |")
+    return "\n".join(lines)
