@@ -17,9 +17,9 @@ import asyncio
 from asyncua import Client, ua
 
 SETPOINT_RAD_S = 6.0              # about 57 rev/min
-NOMINAL_TORQUE_NM = 3400.0
+NOMINAL_TORQUE_NM = 5000.0      # about the string torque of steady drilling at 57 rpm
 KP_RAD_S_PER_NM = 4e-4
-KI_RAD_S2_PER_NM = 2e-4
+KI_RAD_S2_PER_NM = 5e-5
 PERIOD_S = 0.01                   # sim_node's publish period (publish_rate_hz 100)
 MAX_SPEED_RAD_S = 20.0
 
