@@ -23,7 +23,7 @@ DEFINITIONS = (
     f"above {startup.SLIP_RPM:g} rpm. Over the second half of the run: a stick is the bit "
     f"below {startup.TURNING_RPM:g} rpm (|speed|); stick-slip means at least one stick of at "
     f"least {startup.MIN_STICK_S:g} s followed by a slip (the bit above "
-    f"{startup.SLIP_RPM:g} rpm) before the next stick; period_s is the mean time between "
+    f"{startup.SLIP_RPM:g} rpm) before the next such stick; period_s is the mean time between "
     "such slips (null with fewer than two).")
 
 

@@ -15,7 +15,8 @@ between stick-slip and ringing, twice the string's third torsional mode, zero-ph
 * a *stick* is a run of consecutive stuck samples; it lasts from its first stuck sample to
   the first sample after it;
 * the *slip after a stick* is the first sample above ``SLIP_RPM`` after the stick ends and
-  before the bit is stuck again;
+  before the next stick of at least ``MIN_STICK_S``: a shorter dip below ``TURNING_RPM``, as
+  a bit that creeps before it breaks free makes, does not end the search;
 * *stick-slip* (in the second half of the run): at least one stick of at least
   ``MIN_STICK_S`` (0.5 s) followed by a slip there; ``period_s`` is the mean time between
   such slips (null with fewer than two).
@@ -209,12 +210,11 @@ def stuck_spans(bit_rpm: np.ndarray) -> list[tuple[int, int]]:
 
 def slip_onsets(t_s: np.ndarray, bit_rpm: np.ndarray) -> list[float]:
     """The times of the slips that follow a stick of at least ``MIN_STICK_S`` (module doc):
-    after each such stick, the first sample above ``SLIP_RPM`` before the next stick."""
-    spans = stuck_spans(bit_rpm)
-    onsets = []
-    for i, (start, end) in enumerate(spans):
-        if end >= len(t_s) or t_s[end] - t_s[start] < MIN_STICK_S - TIME_TOLERANCE_S:
-            continue                      # still stuck at the end, or too short
+    after each such stick, the first sample above ``SLIP_RPM`` before the next one."""
+    spans = [(start, end) for start, end in stuck_spans(bit_rpm)
+             if end < len(t_s) and t_s[end] - t_s[start] >= MIN_STICK_S - TIME_TOLERANCE_S]
+    onsets = []                           # (a stick still going at the end has no slip)
+    for i, (_, end) in enumerate(spans):
         stop = spans[i + 1][0] if i + 1 < len(spans) else len(t_s)
         slipping = np.flatnonzero(bit_rpm[end:stop] > SLIP_RPM)
         if slipping.size:

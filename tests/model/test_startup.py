@@ -176,6 +176,15 @@ def test_a_short_start_up_in_a_deviated_well(tmp_path: Path) -> None:
     assert run.setpoint_rpm[-1] == pytest.approx(60.0)
 
 
+def test_a_creep_before_the_slip_does_not_end_the_stick() -> None:
+    """A bit that creeps out of a stick, dips below 1 rpm for less than 0.5 s and then
+    slips: the slip follows the stick (a fine string's wall makes such creeps)."""
+    bit = _piecewise([(0, 50, 0.0), (50, 52, 5.0), (52, 53, 0.0), (53, 100, 50.0),
+                      (100, 150, 0.0), (150, 151, 3.0), (151, 152, 0.5), (152, N, 40.0)])
+    t = np.arange(N) * DT_S
+    assert slip_onsets(t, bit) == pytest.approx([5.3, 15.2])
+
+
 def test_the_deviated_presets_friction_points_are_converged() -> None:
     """The field case's wall is lumped at ``damping_points`` junctions per section. The
     preset's start-up at 30 rpm against the same string at four times as many points (the
