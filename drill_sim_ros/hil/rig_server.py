@@ -126,10 +126,11 @@ class Rig:
     in the event loop). Its nodes exist once :meth:`build` has run."""
 
     def __init__(self, name: str, settings: RigSettings, send: Callable[[Command, int], None],
-                 switch_mode: SwitchMode | None = None, step_timeout_s: float = 10.0) -> None:
+                 switch_mode: SwitchMode | None = None, step_timeout_s: float = 10.0,
+                 mode_switch_timeout_s: float = MODE_SWITCH_TIMEOUT_S) -> None:
         self.name, self.settings = name, settings
         self._send, self._switch_mode = send, switch_mode
-        self.step_timeout_s = step_timeout_s
+        self.step_timeout_s, self.mode_switch_timeout_s = step_timeout_s, mode_switch_timeout_s
         self.nodes: dict[str, Any] = {}
         self._ranges: dict[str, Any] = {}               # EURange property nodes by variable
         self._server: Server | None = None
@@ -248,7 +249,8 @@ class Rig:
         if mode == self.values["DriveMode"] or self._switch_mode is None:
             return
         try:
-            reason = await asyncio.wait_for(self._switch_mode(mode), MODE_SWITCH_TIMEOUT_S)
+            reason = await asyncio.wait_for(self._switch_mode(mode),
+                                            self.mode_switch_timeout_s)
         except (TimeoutError, OSError) as exc:
             await self.refuse("DriveMode", Bad.BadTimeout, mode, f"sim_node: {exc!r}")
         if reason is not None:
