@@ -29,6 +29,7 @@ import logging
 import sys
 import threading
 from collections.abc import Awaitable, Callable
+from dataclasses import dataclass
 from typing import Any
 
 import rclpy
@@ -64,22 +65,65 @@ DIAGNOSTICS_PERIOD_S = 1.0        # wall time, as sim_node's
 SETTINGS_RETRY_S = 0.5            # how often stale sim_node settings are asked for again
 
 
-SECURITY_HELP = {
-    "security.certificate": "the server's certificate, DER or PEM, with the URI "
-                            "urn:drill_sim_ros:opcua_gateway ('' = not secured: loopback only)",
-    "security.private_key": "the certificate's private key, PEM",
-    "security.user": "the one user name a client must give",
-    "security.password_file": "a file whose first line is that user's password"}
+@dataclass(frozen=True)
+class Setting:
+    """One of the gateway's (read-only) ROS parameters; ``default`` None: an unset string
+    array; ``seconds``: a duration of 0.1 ... 3600 s."""
+
+    name: str
+    default: Any
+    description: str
+    seconds: bool = False
+
+    def descriptor(self) -> ParameterDescriptor:
+        desc = ParameterDescriptor(description=self.description, read_only=True)
+        if self.seconds:
+            desc.floating_point_range = [FloatingPointRange(from_value=MIN_SECONDS,
+                                                            to_value=MAX_SECONDS, step=0.0)]
+        return desc
+
+    def declared(self, node: Node) -> Any:
+        """Declare it on ``node``; its value (None: an unset array)."""
+        default = Parameter.Type.STRING_ARRAY if self.default is None else self.default
+        return node.declare_parameter(self.name, default, self.descriptor()).value
 
 
-def _seconds(description: str, default: float) -> tuple[float, ParameterDescriptor]:
-    return default, ParameterDescriptor(description=description, read_only=True,
-                                        floating_point_range=[FloatingPointRange(
-                                            from_value=0.1, to_value=3600.0, step=0.0)])
+MIN_SECONDS, MAX_SECONDS = 0.1, 3600.0
+SETTINGS = (
+    Setting("endpoint", DEFAULT_ENDPOINT, "opc.tcp://HOST:PORT/PATH the OPC UA server listens "
+            "on (loopback unless secured)"),
+    Setting("rigs", None, "the sim_node namespaces served, one rig object each, named after "
+            "the namespace's last part (a relative one is in this node's namespace); unset: "
+            "this node's namespace"),
+    Setting("rig", "", "BrowseName of a lone rig's object; '' = the namespace's last part, "
+            "or Rig in /"),
+    Setting("sim_node", topics.NODE_NAME, "sim_node's node name, in each rig's namespace"),
+    Setting("sim_wait_s", 30.0, "how long to wait at start for each sim_node's parameters "
+            "[s]", seconds=True),
+    Setting("step_timeout_s", 10.0, "Step returns BadTimeout after this many wall seconds "
+            "without the sample [s]", seconds=True),
+    Setting("security.certificate", "", "the server's certificate, DER or PEM, with the URI "
+            "urn:drill_sim_ros:opcua_gateway ('' = not secured: loopback only)"),
+    Setting("security.private_key", "", "the certificate's private key, PEM"),
+    Setting("security.user", "", "the one user name a client must give"),
+    Setting("security.password_file", "", "a file whose first line is that user's password"),
+)
 
 
-def _text(description: str) -> ParameterDescriptor:
-    return ParameterDescriptor(description=description, read_only=True)
+def _default_text(default: Any) -> str:
+    if default is None:
+        return "unset"
+    if isinstance(default, float):
+        return f"`{default:g}`"
+    return f"`{default}`" if default else "`''`"
+
+
+def settings_table() -> str:
+    """The gateway's parameters as the Markdown table of docs/hil.md."""
+    rows = ["| parameter | default | meaning |", "| --- | --- | --- |"]
+    for s in SETTINGS:
+        rows.append(f"| `{s.name}` | {_default_text(s.default)} | {s.description} |")
+    return "\n".join(rows)
 
 
 def rig_namespaces(listed: list[str] | None, own: str) -> list[str]:
@@ -116,23 +160,11 @@ class GatewayNode(Node):
 
     def __init__(self, **node_kwargs: Any) -> None:
         super().__init__(NODE_NAME, **node_kwargs)
-        self.endpoint = self.declare_parameter("endpoint", DEFAULT_ENDPOINT, _text(
-            "opc.tcp://HOST:PORT/PATH the OPC UA server listens on (loopback only)")).value
-        listed = self.declare_parameter("rigs", Parameter.Type.STRING_ARRAY, _text(
-            "the sim_node namespaces served, one rig object each, named after the "
-            "namespace's last part (relative: in this node's namespace); unset = this "
-            "node's namespace")).value
-        rig = self.declare_parameter("rig", "", _text(
-            "BrowseName of a lone rig's object; '' = the namespace's last part, or Rig")).value
-        sim_node = self.declare_parameter("sim_node", topics.NODE_NAME, _text(
-            "sim_node's node name, in each rig's namespace")).value
-        self.sim_wait_s = self.declare_parameter("sim_wait_s", *_seconds(
-            "how long to wait at start for sim_node's parameters [s]", 30.0)).value
-        self.step_timeout_s = self.declare_parameter("step_timeout_s", *_seconds(
-            "Step returns BadTimeout after this many wall seconds without the sample [s]",
-            10.0)).value
-        self.security = load_security({name: self.declare_parameter(
-            name, "", _text(SECURITY_HELP[name])).value for name in SECURITY_SETTINGS})
+        values = {s.name: s.declared(self) for s in SETTINGS}
+        self.endpoint = values["endpoint"]
+        self.sim_wait_s, self.step_timeout_s = values["sim_wait_s"], values["step_timeout_s"]
+        self.security = load_security({name: values[name] for name in SECURITY_SETTINGS})
+        listed, rig, sim_node = values["rigs"], values["rig"], values["sim_node"]
         namespaces = rig_namespaces(list(listed or []), self.get_namespace())
         self.links = [SimLink(self, ns, sim_node, name) for ns, name in
                       zip(namespaces, rig_names(namespaces, rig), strict=True)]
