@@ -9,7 +9,8 @@ same).
 Sources: ``SPECS`` of ``drill_sim_ros/ros/parameters.py`` (the parameter table) and
 ``MSG_TYPES``, ``DESCRIPTIONS``, ``JOINTS`` and ``JOINT_FIELDS`` of ``drill_sim_ros/topics.py``
 with the QoS sim_node uses (the topic table); ``VARIABLES`` of
-``drill_sim_ros/hil/address_space.py`` (the OPC UA address space of docs/hil.md).
+``drill_sim_ros/hil/address_space.py`` (the OPC UA address space of docs/hil.md) and
+``SETTINGS`` of ``drill_sim_ros/ros/opcua_gateway.py`` (the gateway's parameters there).
 """
 
 from __future__ import annotations
@@ -148,10 +149,17 @@ def address_space_table() -> str:
     return markdown_table()
 
 
+def gateway_parameter_table() -> str:
+    """The OPC UA gateway's own parameters (``SETTINGS`` of ros/opcua_gateway.py)."""
+    from drill_sim_ros.ros.opcua_gateway import settings_table
+    return settings_table()
+
+
 # (page, region name) -> the function that writes the region
 REGIONS: dict[tuple[str, str], Callable[[], str]] = {
     ("docs/sim_node.md", "topics"): topic_table,
     ("docs/sim_node.md", "parameters"): parameter_table,
+    ("docs/hil.md", "gateway-parameters"): gateway_parameter_table,
     ("docs/hil.md", "address-space"): address_space_table,
 }
 

@@ -1,4 +1,4 @@
-"""The OPC UA address space of one rig (issue 33): its variables, their units, their sources.
+"""The OPC UA address space of a rig object (issue 33): its variables, units and sources.
 
 ROS-free and asyncua-free: one table, :data:`VARIABLES`, that the gateway builds its nodes
 from (:mod:`drill_sim_ros.hil.rig_server`), that maps a ``drill/surface/measured`` sample onto
@@ -45,7 +45,7 @@ class Variable:
     """One variable of a rig object. ``source``: for a sample value, the JointState array
     (position, velocity, effort) and joint index of ``drill/surface/measured``
     (``topics.MEASURED_JOINTS``: top_drive, quill, hook_load, wob_estimate), or ``stamp``;
-    ``limit``: for a setpoint, the sim_node parameter its EURange comes from."""
+    ``limit``: for a setpoint, the sim_node parameter its EURange comes from (and follows)."""
 
     name: str
     type_name: str                  # OPC UA built-in type: Double, UInt32, Boolean, String
@@ -76,12 +76,14 @@ VARIABLES = (
     Variable("WobSetpoint", "Double", True, "applied WOB setpoint", NEWTON,
              limit="limits.max_wob_n"),
     Variable("DriveMode", "String", True, "what a command carries: speed (SpeedSetpoint) or "
-             "torque (TorqueCommand)"),
+             "torque (TorqueCommand); a new value switches sim_node's top_drive.mode first, "
+             "and shows sim_node's own switches (its kinematic mode shows as speed)"),
     Variable("CommandCounter", "UInt32", True, "the client's handshake: SampleCounter + 1 "
              "sends the setpoints as the next period's command"),
     Variable("SampleCounter", "UInt32", False, "the gateway's handshake: set to "
              "CommandCounter once that command's sample is in the values"),
-    Variable("Lockstep", "Boolean", False, "sim_node runs in command-triggered lockstep"),
+    Variable("Lockstep", "Boolean", False, "sim_node runs in command-triggered lockstep "
+             "(lockstep and lockstep_trigger, followed at runtime)"),
     Variable("Status", "String", False, "what the gateway does or waits for, one line"),
     Variable("RejectedWrites", "UInt32", False, "writes refused with a Bad status code"),
 )

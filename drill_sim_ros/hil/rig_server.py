@@ -1,15 +1,22 @@
-"""One rig's OPC UA server (asyncua): the address space of :mod:`.address_space`, the checks
-of every client write, and the lockstep handshake (ROS-free; the gateway node feeds it).
+"""The gateway's OPC UA server (asyncua): one object per rig, each with the address space of
+:mod:`.address_space`, the checks of every client write and its own lockstep handshake
+(ROS-free; the gateway node feeds it).
 
 - A client's write request is checked whole before any of it is applied (asyncua's PreWrite
   callback): a read-only variable, a wrong type, NaN, ±inf, a value outside its EURange or a
   CommandCounter out of turn fails the request with the matching Bad status code
-  (BadNotWritable, BadTypeMismatch, BadOutOfRange, BadInvalidState), counted in
-  ``RejectedWrites``; nothing of it reaches the simulator.
+  (BadNotWritable, BadTypeMismatch, BadOutOfRange, BadInvalidState), counted in that rig's
+  ``RejectedWrites``; nothing of it reaches the simulator. A request may span several rigs.
+- A new ``DriveMode`` switches the simulator's drive (``switch_mode``) before anything else of
+  the request is applied; a switch the simulator refuses fails the request with
+  BadInvalidState, one it does not answer with BadTimeout (both counted).
 - ``CommandCounter`` = ``SampleCounter`` + 1 (or a ``Step`` call) hands the setpoints to
   ``send`` as the next period's command, at once; when that period's sample is in the values
-  (:meth:`RigServer.sample_in`), ``SampleCounter`` takes the same value and ``Step`` returns
+  (:meth:`Rig.sample_in`), ``SampleCounter`` takes the same value and ``Step`` returns
   it. Without a new count, nothing is sent: a client that goes away leaves the sim waiting.
+- The EURanges, ``Lockstep`` and ``DriveMode`` follow the simulator's settings
+  (:meth:`Rig.follow`); a sample older than the latest one means the simulator started
+  again: the handshake starts over from it (``SampleCounter`` = ``CommandCounter``).
 """
 
 from __future__ import annotations
@@ -17,7 +24,7 @@ from __future__ import annotations
 import asyncio
 import logging
 import math
-from collections.abc import Callable
+from collections.abc import Awaitable, Callable, Sequence
 from dataclasses import dataclass
 from datetime import datetime, timedelta, timezone
 from typing import Any
@@ -44,12 +51,18 @@ _log = logging.getLogger(__name__)
 SIM_EPOCH = datetime(1970, 1, 1, tzinfo=timezone.utc)
 UINT32_MODULUS = 2**32
 Bad = ua.StatusCodes
+SETPOINTS = ("SpeedSetpoint", "TorqueCommand", "WobSetpoint")
+MODE_SWITCH_TIMEOUT_S = 5.0
+# switch_mode(mode): None once the simulator drives in ``mode``, else its reason for refusing
+# (TimeoutError, or any OSError, if it does not answer)
+SwitchMode = Callable[[str], Awaitable[str | None]]
 
 
 @dataclass(frozen=True)
 class RigSettings:
-    """What the rig object starts with: the setpoints' EURanges (SI, from sim_node's limits),
-    the setpoints in force, the drive mode and whether sim_node runs in command lockstep."""
+    """What a rig object takes from its simulator: the setpoints' EURanges (SI, from sim_node's
+    limits), the setpoints in force at start, the drive mode and whether sim_node runs in
+    command lockstep."""
 
     max_speed_rad_s: float
     max_torque_nm: float
@@ -90,31 +103,37 @@ def sim_timestamp(time_ns: int) -> datetime:
     return SIM_EPOCH + timedelta(microseconds=time_ns / 1000)
 
 
-async def _add_property(node: Any, name: str, value: Any, data_type: int) -> None:
+def _range_variant(low_high: tuple[float, float]) -> ua.Variant:
+    return ua.Variant(ua.Range(*low_high), ua.VariantType.ExtensionObject)
+
+
+async def _add_property(node: Any, name: str, value: ua.Variant, data_type: int) -> Any:
     """A standard property (BrowseName in namespace 0) of ``node``, NodeId ``<node>.<name>``."""
     index = node.nodeid.NamespaceIndex
-    await node.add_property(ua.NodeId(f"{node.nodeid.Identifier}.{name}", index),
-                            ua.QualifiedName(name, 0),
-                            ua.Variant(value, ua.VariantType.ExtensionObject),
-                            datatype=ua.NodeId(data_type))
+    return await node.add_property(ua.NodeId(f"{node.nodeid.Identifier}.{name}", index),
+                                   ua.QualifiedName(name, 0), value,
+                                   datatype=ua.NodeId(data_type))
 
 
-class RigServer:
-    """The asyncua server of one rig object ``rig`` at ``endpoint``; ``send(command,
-    stamp_ns)`` hands the simulator a command answering the sample stamped ``stamp_ns``
-    (called in the event loop)."""
+def _unset_setpoints() -> dict[str, float]:
+    """No setpoint known to be in force: the next command carries them all."""
+    return dict.fromkeys(SETPOINTS, math.nan)
 
-    def __init__(self, endpoint: str, rig: str, settings: RigSettings,
-                 send: Callable[[Command, int], None], step_timeout_s: float = 10.0,
-                 security: Security | None = None) -> None:
-        self.security = security
-        self.server = Server(user_manager=None if security is None else PasswordUser(
-            security.user, security.password))
-        self.endpoint, self.rig, self.settings = endpoint, rig, settings
-        self._send = send
-        self.step_timeout_s = step_timeout_s
+
+class Rig:
+    """One rig object ``name``; ``send(command, stamp_ns)`` hands its simulator a command
+    answering the sample stamped ``stamp_ns``, ``switch_mode`` switches its drive (both called
+    in the event loop). Its nodes exist once :meth:`build` has run."""
+
+    def __init__(self, name: str, settings: RigSettings, send: Callable[[Command, int], None],
+                 switch_mode: SwitchMode | None = None, step_timeout_s: float = 10.0,
+                 mode_switch_timeout_s: float = MODE_SWITCH_TIMEOUT_S) -> None:
+        self.name, self.settings = name, settings
+        self._send, self._switch_mode = send, switch_mode
+        self.step_timeout_s, self.mode_switch_timeout_s = step_timeout_s, mode_switch_timeout_s
         self.nodes: dict[str, Any] = {}
-        self._names: dict[ua.NodeId, str] = {}
+        self._ranges: dict[str, Any] = {}               # EURange property nodes by variable
+        self._server: Server | None = None
         self.values: dict[str, Any] = {v.name: settings.initial(v.name) for v in VARIABLES}
         self._in_force = {"SpeedSetpoint": settings.speed_rad_s, "WobSetpoint": settings.wob_n,
                           "TorqueCommand": math.nan}
@@ -123,92 +142,74 @@ class RigServer:
         self.rejected = 0
         self.commands_sent = 0
         self.samples_in = 0
-        self._waiters: list[asyncio.Future[int]] = []
+        self.restarts = 0
+        self._waiters: list[asyncio.Future[int | None]] = []
 
-    async def start(self) -> None:
-        await self.server.init()
-        self.server.set_endpoint(self.endpoint)
-        self.server.set_server_name(f"drill_sim_ros OPC UA gateway ({self.rig})")
-        await self._secure()
-        index = await self.server.register_namespace(NAMESPACE_URI)
-        rig = await self.server.nodes.objects.add_object(ua.NodeId(self.rig, index),
-                                                         ua.QualifiedName(self.rig, index))
+    # -- the address space ----------------------------------------------------------------
+    async def build(self, server: Server, index: int) -> dict[ua.NodeId, str]:
+        """Add the rig object under Objects; its writable variables' names by NodeId."""
+        self._server = server
+        rig = await server.nodes.objects.add_object(ua.NodeId(self.name, index),
+                                                    ua.QualifiedName(self.name, index))
         for variable in VARIABLES:
             await self._add_variable(rig, index, variable)
-        await rig.add_method(ua.NodeId(node_id(self.rig, STEP_METHOD), index),
+        await rig.add_method(ua.NodeId(node_id(self.name, STEP_METHOD), index),
                              ua.QualifiedName(STEP_METHOD, index),
                              self._step, [], [ua.VariantType.UInt32])
-        self.server.subscribe_server_callback(CallbackType.PreWrite, self._pre_write)
-        await self.server.start()
-
-    async def _secure(self) -> None:
-        """Anonymous and unencrypted (loopback only), or Basic256Sha256 Sign & Encrypt
-        with the one user of :attr:`security`."""
-        if self.security is None:
-            self.server.set_security_policy([ua.SecurityPolicyType.NoSecurity])
-            self.server.set_identity_tokens([ua.AnonymousIdentityToken])
-            return
-        await self.server.set_application_uri(APPLICATION_URI)
-        self.server.set_security_policy([ua.SecurityPolicyType.Basic256Sha256_SignAndEncrypt])
-        self.server.set_identity_tokens([ua.UserNameIdentityToken])
-        await self.server.load_certificate(str(self.security.certificate))
-        await self.server.load_private_key(str(self.security.private_key))
-
-    async def stop(self) -> None:
-        await self.server.stop()
-
-    def figures(self) -> dict[str, str]:
-        """The diagnostics' key/values (read from any thread: plain ints and strings)."""
-        return {"endpoint": self.endpoint, "status": str(self.values["Status"]),
-                "rejected_writes": str(self.rejected), "commands_sent": str(self.commands_sent),
-                "samples_in": str(self.samples_in),
-                "sample_counter": str(self.values["SampleCounter"])}
+        return {node.nodeid: name for name, node in self.nodes.items()}
 
     async def _add_variable(self, rig: Any, index: int, variable: Variable) -> None:
-        node = await rig.add_variable(ua.NodeId(node_id(self.rig, variable.name), index),
+        node = await rig.add_variable(ua.NodeId(node_id(self.name, variable.name), index),
                                       ua.QualifiedName(variable.name, index),
                                       variant(variable, self.values[variable.name]))
         if variable.writable:
             await node.set_writable()
         if variable.unit is not None:
-            await _add_property(node, "EngineeringUnits", eu_information(variable),
-                                ua.ObjectIds.EUInformation)
+            await _add_property(node, "EngineeringUnits", ua.Variant(
+                eu_information(variable), ua.VariantType.ExtensionObject),
+                ua.ObjectIds.EUInformation)
         eu_range = self.settings.eu_range(variable.name)
         if eu_range is not None:
-            await _add_property(node, "EURange", ua.Range(*eu_range), ua.ObjectIds.Range)
+            self._ranges[variable.name] = await _add_property(
+                node, "EURange", _range_variant(eu_range), ua.ObjectIds.Range)
         self.nodes[variable.name] = node
-        self._names[node.nodeid] = variable.name
 
     async def _set(self, name: str, value: Any, time_ns: int | None = None) -> None:
         """A value of the gateway's own (not a client write; no checks)."""
         self.values[name] = value
         stamp = sim_timestamp(time_ns) if time_ns is not None else None
-        await self.server.write_attribute_value(self.nodes[name].nodeid, ua.DataValue(
+        await self._server.write_attribute_value(self.nodes[name].nodeid, ua.DataValue(
             variant(VARIABLE_BY_NAME[name], value), SourceTimestamp=stamp))
 
     async def set_status(self, text: str) -> None:
         if text != self.values["Status"]:
             await self._set("Status", text)
 
-    # -- client writes --------------------------------------------------------------------
-    async def _pre_write(self, event: Any, _dispatcher: Any) -> None:
-        """Check a whole write request; raise its Bad status code to refuse all of it."""
-        writes = {}
-        for item in event.request_params.NodesToWrite:
-            name = self._names.get(item.NodeId)
-            if name is None:
-                continue
-            code, value = self._check(name, item)
-            if code is not None:
-                await self._refuse(name, code, value)
-            writes[name] = value
-        counter = writes.get("CommandCounter")
-        send = counter is not None and counter != self.values["CommandCounter"]
-        self.values.update(writes)              # (asyncua applies them after this check)
-        if send:
-            self._command(self.values, counter)
+    def figures(self) -> dict[str, str]:
+        """The diagnostics' key/values (read from any thread: plain ints and strings)."""
+        return {"status": str(self.values["Status"]), "rejected_writes": str(self.rejected),
+                "commands_sent": str(self.commands_sent), "samples_in": str(self.samples_in),
+                "sample_counter": str(self.values["SampleCounter"]),
+                "sim_restarts": str(self.restarts)}
 
-    def _check(self, name: str, item: ua.WriteValue) -> tuple[int | None, Any]:
+    # -- following the simulator's settings -----------------------------------------------
+    async def follow(self, settings: RigSettings) -> None:
+        """The simulator's settings now: new EURanges, ``Lockstep`` and ``DriveMode``."""
+        old, self.settings = self.settings, settings
+        for name, node in self._ranges.items():
+            if settings.eu_range(name) != old.eu_range(name):
+                await self._server.write_attribute_value(node.nodeid, ua.DataValue(
+                    _range_variant(settings.eu_range(name))))
+        if settings.lockstep != self.values["Lockstep"]:
+            await self._set("Lockstep", settings.lockstep)
+        if settings.drive_mode != self.values["DriveMode"]:
+            await self._set("DriveMode", settings.drive_mode)
+            self._in_force = _unset_setpoints()        # the new mode's setpoint goes next
+        if settings != old:
+            _log.info("%s follows its sim_node: %s", self.name, settings)
+
+    # -- client writes --------------------------------------------------------------------
+    def check(self, name: str, item: ua.WriteValue) -> tuple[int | None, Any]:
         """(None, value) if writing ``item`` to ``name`` is allowed, else (Bad code, value)."""
         variable = VARIABLE_BY_NAME[name]
         data = item.Value.Value
@@ -233,12 +234,37 @@ class RigServer:
             return Bad.BadInvalidState
         return None
 
-    async def _refuse(self, name: str, code: int, value: Any) -> None:
+    async def refuse(self, name: str, code: int, value: Any, why: str = "") -> None:
+        """Count a refused write and fail its request with ``code`` (always raises)."""
         self.rejected += 1
         await self._set("RejectedWrites", self.rejected % UINT32_MODULUS)
-        _log.warning("refused a write of %r to %s: %s (%d refused so far)", value, name,
-                     ua.StatusCode(code).name, self.rejected)
+        _log.warning("refused a write of %r to %s.%s: %s%s (%d refused so far)", value,
+                     self.name, name, ua.StatusCode(code).name, f" ({why})" if why else "",
+                     self.rejected)
         raise ua.UaStatusCodeError(code)
+
+    async def switch_drive(self, writes: dict[str, Any]) -> None:
+        """Switch the simulator's drive if ``writes`` changes DriveMode (refused: raises)."""
+        mode = writes.get("DriveMode", self.values["DriveMode"])
+        if mode == self.values["DriveMode"] or self._switch_mode is None:
+            return
+        try:
+            reason = await asyncio.wait_for(self._switch_mode(mode),
+                                            self.mode_switch_timeout_s)
+        except (TimeoutError, OSError) as exc:
+            await self.refuse("DriveMode", Bad.BadTimeout, mode, f"sim_node: {exc!r}")
+        if reason is not None:
+            await self.refuse("DriveMode", Bad.BadInvalidState, mode, f"sim_node: {reason}")
+        self._in_force = _unset_setpoints()            # the new mode's setpoint goes next
+
+    def accept(self, writes: dict[str, Any]) -> None:
+        """Take a checked request's values (asyncua applies them to the nodes after this);
+        a new CommandCounter sends the command."""
+        counter = writes.get("CommandCounter")
+        send = counter is not None and counter != self.values["CommandCounter"]
+        self.values.update(writes)
+        if send:
+            self._command(self.values, counter)
 
     # -- the handshake --------------------------------------------------------------------
     def _command(self, values: dict[str, Any], counter: int) -> None:
@@ -253,7 +279,7 @@ class RigServer:
         self._send(Command(speed_rad_s=changed.get("SpeedSetpoint"),
                            motor_torque_nm=changed.get("TorqueCommand"),
                            wob_n=changed.get("WobSetpoint")), self.latest_ns)
-        _log.debug("command %d sent", counter)
+        _log.debug("%s: command %d sent", self.name, counter)
 
     async def _step(self, _parent: ua.NodeId) -> Any:
         """The method Step: CommandCounter + 1 by a call; the new SampleCounter."""
@@ -268,13 +294,35 @@ class RigServer:
             counter = await asyncio.wait_for(waiter, self.step_timeout_s)
         except TimeoutError:
             return ua.StatusCode(Bad.BadTimeout)
+        if counter is None:                          # the simulator started again
+            return ua.StatusCode(Bad.BadInvalidState)
         return [ua.Variant(counter, ua.VariantType.UInt32)]
+
+    def _answer_waiters(self, counter: int | None) -> None:
+        for waiter in self._waiters:
+            if not waiter.done():
+                waiter.set_result(counter)
+        self._waiters.clear()
+
+    async def _start_over(self) -> None:
+        """The simulator started again: no command is outstanding, none of its setpoints is
+        known, and the client goes on from CommandCounter."""
+        self.restarts += 1
+        self.latest_ns, self.outstanding = None, False
+        self._in_force = _unset_setpoints()
+        self._answer_waiters(None)
+        await self._set("SampleCounter", self.values["CommandCounter"])
+        _log.warning("%s: sim_node started again (its time went back); the handshake goes "
+                     "on from CommandCounter %d", self.name, self.values["CommandCounter"])
 
     async def sample_in(self, values: dict[str, float], time_ns: int) -> None:
         """A sample of sim_node (SAMPLE_VARIABLES' values, stamped ``time_ns``) into the
-        variables; it answers the outstanding command, if any. An older one is ignored."""
-        if self.latest_ns is not None and time_ns <= self.latest_ns:
+        variables; it answers the outstanding command, if any. The same stamp again is
+        ignored; an older one means sim_node started again."""
+        if self.latest_ns is not None and time_ns == self.latest_ns:
             return
+        if self.latest_ns is not None and time_ns < self.latest_ns:
+            await self._start_over()
         first = self.latest_ns is None
         self.latest_ns = time_ns
         self.samples_in += 1
@@ -285,8 +333,63 @@ class RigServer:
         if self.outstanding:
             self.outstanding = False
             await self._set("SampleCounter", self.values["CommandCounter"], time_ns)
-            for waiter in self._waiters:
-                if not waiter.done():
-                    waiter.set_result(self.values["SampleCounter"])
-            self._waiters.clear()
+            self._answer_waiters(self.values["SampleCounter"])
 
+
+class RigServer:
+    """The asyncua server of the rig objects ``rigs`` at ``endpoint`` (their names differ)."""
+
+    def __init__(self, endpoint: str, rigs: Sequence[Rig],
+                 security: Security | None = None) -> None:
+        self.security = security
+        self.server = Server(user_manager=None if security is None else PasswordUser(
+            security.user, security.password))
+        self.endpoint, self.rigs = endpoint, tuple(rigs)
+        self._writable: dict[ua.NodeId, tuple[Rig, str]] = {}
+
+    async def start(self) -> None:
+        await self.server.init()
+        self.server.set_endpoint(self.endpoint)
+        names = ", ".join(rig.name for rig in self.rigs)
+        self.server.set_server_name(f"drill_sim_ros OPC UA gateway ({names})")
+        await self._secure()
+        index = await self.server.register_namespace(NAMESPACE_URI)
+        for rig in self.rigs:
+            for nodeid, name in (await rig.build(self.server, index)).items():
+                self._writable[nodeid] = (rig, name)
+        self.server.subscribe_server_callback(CallbackType.PreWrite, self._pre_write)
+        await self.server.start()
+
+    async def _secure(self) -> None:
+        """Anonymous and unencrypted (loopback only), or Basic256Sha256 Sign & Encrypt
+        with the one user of :attr:`security`."""
+        if self.security is None:
+            self.server.set_security_policy([ua.SecurityPolicyType.NoSecurity])
+            self.server.set_identity_tokens([ua.AnonymousIdentityToken])
+            return
+        await self.server.set_application_uri(APPLICATION_URI)
+        self.server.set_security_policy([ua.SecurityPolicyType.Basic256Sha256_SignAndEncrypt])
+        self.server.set_identity_tokens([ua.UserNameIdentityToken])
+        await self.server.load_certificate(str(self.security.certificate))
+        await self.server.load_private_key(str(self.security.private_key))
+
+    async def stop(self) -> None:
+        await self.server.stop()
+
+    async def _pre_write(self, event: Any, _dispatcher: Any) -> None:
+        """Check a whole write request (raise its Bad status code to refuse all of it), switch
+        drive modes, then hand each rig its part."""
+        writes: dict[Rig, dict[str, Any]] = {}
+        for item in event.request_params.NodesToWrite:
+            owner = self._writable.get(item.NodeId)
+            if owner is None:
+                continue
+            rig, name = owner
+            code, value = rig.check(name, item)
+            if code is not None:
+                await rig.refuse(name, code, value)
+            writes.setdefault(rig, {})[name] = value
+        for rig, values in writes.items():
+            await rig.switch_drive(values)
+        for rig, values in writes.items():
+            rig.accept(values)

@@ -1,168 +1,216 @@
 """opcua_gateway: sim_node's surface and commands as an OPC UA server (node ``opcua_gateway``).
 
-A PLC's controller closes the loop through it (hardware in the loop, docs/hil.md). The ROS
-side is a lockstep driver of sim_node (the handshake of docs/control-loop.md): it reads
-``drill/surface/measured`` (latched), and sends each command on ``drill/cmd/top_drive``
-stamped with the latest sample; the OPC UA side is :class:`~drill_sim_ros.hil.rig_server.
-RigServer`, which decides when a command goes (a client's ``CommandCounter`` or ``Step``).
+A PLC's controller closes the loop through it (hardware in the loop, docs/hil.md). One
+gateway serves one rig per sim_node namespace of its ``rigs`` parameter (default: its own
+namespace). The ROS side of each is a :class:`~drill_sim_ros.ros.sim_link.SimLink`, a
+lockstep driver of that sim_node (the handshake of docs/control-loop.md): it reads
+``<ns>/drill/surface/measured`` (latched), and sends each command on ``<ns>/drill/cmd/top_drive``
+stamped with the latest sample; the OPC UA side is a
+:class:`~drill_sim_ros.hil.rig_server.Rig` of the one
+:class:`~drill_sim_ros.hil.rig_server.RigServer`, which decides when a command goes (a
+client's ``CommandCounter`` or ``Step``).
 
-rclpy spins in a thread of its own; a sample crosses into asyncua's event loop through a
-queue, in order. The setpoints' EURanges, the setpoints in force and the drive mode are read
-from the running sim_node's parameters at start (one source: its ``limits.*``).
+rclpy spins in a thread of its own; samples and settings cross into asyncua's event loop
+through a queue, in order. The setpoints' EURanges, the setpoints in force, the drive mode and
+``Lockstep`` come from each sim_node's parameters (one source: its ``limits.*``), read at
+start and again whenever they change or sim_node starts again.
 
     sim_node --ros-args -p lockstep:=true -p lockstep_trigger:=command
     opcua_gateway --ros-args -p endpoint:=opc.tcp://127.0.0.1:4840/drill_sim/
+    opcua_gateway --ros-args -p "rigs:=[/site/rig1, /site/rig2]"    # two sim_nodes, one server
 """
 
 from __future__ import annotations
 
 import asyncio
 import contextlib
+import functools
 import logging
 import sys
 import threading
+from collections.abc import Awaitable, Callable
+from dataclasses import dataclass
 from typing import Any
 
 import rclpy
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
-from rcl_interfaces.msg import FloatingPointRange, ParameterDescriptor
+from rcl_interfaces.msg import FloatingPointRange, ParameterDescriptor, ParameterEvent
+from rclpy.exceptions import InvalidNamespaceException
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.node import Node
-from rclpy.parameter import parameter_value_to_python
-from rclpy.parameter_client import AsyncParameterClient
-from sensor_msgs.msg import JointState
+from rclpy.parameter import Parameter
+from rclpy.qos import qos_profile_parameter_events
+from rclpy.validate_namespace import validate_namespace
 
 from drill_sim_ros import topics
-from drill_sim_ros.control.command import Command
-from drill_sim_ros.hil.address_space import DEFAULT_ENDPOINT, SAMPLE_VARIABLES, rig_name
+from drill_sim_ros.hil.address_space import DEFAULT_ENDPOINT, rig_name
 from drill_sim_ros.hil.endpoint import check_endpoint
-from drill_sim_ros.hil.rig_server import RigServer, RigSettings
+from drill_sim_ros.hil.rig_server import Rig, RigServer, RigSettings
 from drill_sim_ros.hil.security import SETTINGS as SECURITY_SETTINGS
 from drill_sim_ros.hil.security import load_security
-from drill_sim_ros.model.errors import DrillSimError
-from drill_sim_ros.model.params import RPM_PER_RAD_S
-from drill_sim_ros.ros.lockstep_driver import LOCKSTEP_QOS, top_drive_command
-from drill_sim_ros.ros.messages import LATEST_SAMPLE_QOS, stamp_ns, status
+from drill_sim_ros.model.errors import DrillSimError, ParameterError
+from drill_sim_ros.ros.messages import status
 from drill_sim_ros.ros.parameters import init_ros
+from drill_sim_ros.ros.sim_link import SIM_PARAMETERS, SimLink, rig_settings, sim_values
 
 NODE_NAME = "opcua_gateway"
 USAGE = """usage: opcua_gateway [--ros-args -p endpoint:=opc.tcp://127.0.0.1:4840/drill_sim/ ...]
 
 sim_node's surface and commands as an OPC UA server, for a PLC's controller in the loop
-(docs/hil.md). Its settings are ROS parameters; start sim_node first."""
-SIM_PARAMETERS = ("limits.max_surface_rpm", "limits.max_wob_n", "top_drive.max_torque_nm",
-                  "model.surface_rpm", "model.applied_wob_n", "top_drive.mode", "lockstep",
-                  "lockstep_trigger")
+(docs/hil.md). Its settings are ROS parameters (-p "rigs:=[/rig1, /rig2]" serves the
+sim_nodes of two namespaces); start sim_node first."""
 GIL_SWITCH_INTERVAL_S = 0.0005    # as sim_node's: a thread waiting for the GIL waits less
 POLL_S = 0.2
 DIAGNOSTICS_PERIOD_S = 1.0        # wall time, as sim_node's
+SETTINGS_RETRY_S = 0.5            # how often stale sim_node settings are asked for again
 
 
-SECURITY_HELP = {
-    "security.certificate": "the server's certificate, DER or PEM, with the URI "
-                            "urn:drill_sim_ros:opcua_gateway ('' = not secured: loopback only)",
-    "security.private_key": "the certificate's private key, PEM",
-    "security.user": "the one user name a client must give",
-    "security.password_file": "a file whose first line is that user's password"}
+@dataclass(frozen=True)
+class Setting:
+    """One of the gateway's (read-only) ROS parameters; ``default`` None: an unset string
+    array; ``seconds``: a duration of 0.1 ... 3600 s."""
+
+    name: str
+    default: Any
+    description: str
+    seconds: bool = False
+
+    def descriptor(self) -> ParameterDescriptor:
+        desc = ParameterDescriptor(description=self.description, read_only=True)
+        if self.seconds:
+            desc.floating_point_range = [FloatingPointRange(from_value=MIN_SECONDS,
+                                                            to_value=MAX_SECONDS, step=0.0)]
+        return desc
+
+    def declared(self, node: Node) -> Any:
+        """Declare it on ``node``; its value (None: an unset array)."""
+        default = Parameter.Type.STRING_ARRAY if self.default is None else self.default
+        return node.declare_parameter(self.name, default, self.descriptor()).value
 
 
-def _seconds(description: str, default: float) -> tuple[float, ParameterDescriptor]:
-    return default, ParameterDescriptor(description=description, read_only=True,
-                                        floating_point_range=[FloatingPointRange(
-                                            from_value=0.1, to_value=3600.0, step=0.0)])
+MIN_SECONDS, MAX_SECONDS = 0.1, 3600.0
+SETTINGS = (
+    Setting("endpoint", DEFAULT_ENDPOINT, "opc.tcp://HOST:PORT/PATH the OPC UA server listens "
+            "on (loopback unless secured)"),
+    Setting("rigs", None, "the sim_node namespaces served, one rig object each, named after "
+            "the namespace's last part (a relative one is in this node's namespace); unset: "
+            "this node's namespace"),
+    Setting("rig", "", "BrowseName of a lone rig's object; '' = the namespace's last part, "
+            "or Rig in /"),
+    Setting("sim_node", topics.NODE_NAME, "sim_node's node name, in each rig's namespace"),
+    Setting("sim_wait_s", 30.0, "how long to wait at start for each sim_node's parameters "
+            "[s]", seconds=True),
+    Setting("step_timeout_s", 10.0, "Step returns BadTimeout after this many wall seconds "
+            "without the sample [s]", seconds=True),
+    Setting("security.certificate", "", "the server's certificate, DER or PEM, with the URI "
+            "urn:drill_sim_ros:opcua_gateway ('' = not secured: loopback only)"),
+    Setting("security.private_key", "", "the certificate's private key, PEM"),
+    Setting("security.user", "", "the one user name a client must give"),
+    Setting("security.password_file", "", "a file whose first line is that user's password"),
+)
 
 
-def sample_values(msg: JointState) -> tuple[dict[str, float], int]:
-    """The read-only values of a drill/surface/measured sample, and its stamp (ns)."""
-    time_ns = stamp_ns(msg.header.stamp)
-    arrays = {"position": msg.position, "velocity": msg.velocity, "effort": msg.effort}
-    values = {v.name: time_ns / 1e9 if v.source[0] == "stamp"
-              else float(arrays[v.source[0]][v.source[1]]) for v in SAMPLE_VARIABLES}
-    return values, time_ns
+def _default_text(default: Any) -> str:
+    if default is None:
+        return "unset"
+    if isinstance(default, float):
+        return f"`{default:g}`"
+    return f"`{default}`" if default else "`''`"
 
 
-def rig_settings(sim: dict[str, Any]) -> RigSettings:
-    """The rig object's settings from sim_node's parameters (``SIM_PARAMETERS``)."""
-    torque_nm = sim["top_drive.max_torque_nm"] or sys.float_info.max     # 0: no limit
-    return RigSettings(
-        max_speed_rad_s=sim["limits.max_surface_rpm"] / RPM_PER_RAD_S, max_torque_nm=torque_nm,
-        max_wob_n=sim["limits.max_wob_n"], speed_rad_s=sim["model.surface_rpm"] / RPM_PER_RAD_S,
-        wob_n=sim["model.applied_wob_n"],
-        drive_mode="torque" if sim["top_drive.mode"] == "torque" else "speed",
-        lockstep=bool(sim["lockstep"]) and sim["lockstep_trigger"] == "command")
+def settings_table() -> str:
+    """The gateway's parameters as the Markdown table of docs/hil.md."""
+    rows = ["| parameter | default | meaning |", "| --- | --- | --- |"]
+    for s in SETTINGS:
+        rows.append(f"| `{s.name}` | {_default_text(s.default)} | {s.description} |")
+    return "\n".join(rows)
+
+
+def rig_namespaces(listed: list[str] | None, own: str) -> list[str]:
+    """The absolute sim_node namespaces of the ``rigs`` parameter (relative ones are in the
+    gateway's namespace ``own``; none listed: ``own``); ParameterError for a bad one."""
+    namespaces = []
+    for name in listed or [own]:
+        absolute = name if name.startswith("/") else f"{own.rstrip('/')}/{name}"
+        absolute = absolute.rstrip("/") or "/"
+        try:
+            validate_namespace(absolute)
+        except InvalidNamespaceException:
+            raise ParameterError(f"rigs: {name!r} is not a ROS namespace") from None
+        namespaces.append(absolute)
+    return namespaces
+
+
+def rig_names(namespaces: list[str], rig: str) -> list[str]:
+    """The rig objects' BrowseNames: each namespace's last part (``rig`` names a lone rig);
+    ParameterError when two are the same."""
+    if rig and len(namespaces) > 1:
+        raise ParameterError(f"rig {rig!r} names one rig; rigs lists {len(namespaces)} (their "
+                             "objects take their namespaces' last parts)")
+    names = [rig] if rig else [rig_name(ns) for ns in namespaces]
+    twice = sorted({n for n in names if names.count(n) > 1})
+    if twice:
+        raise ParameterError(f"rigs: two rigs would both be called {twice[0]!r} (the "
+                             "namespaces' last parts must differ)")
+    return names
 
 
 class GatewayNode(Node):
-    """The ROS side: the command publisher, the sample subscription, the parameters."""
+    """The ROS side: one :class:`SimLink` per rig, the parameters, the diagnostics."""
 
     def __init__(self, **node_kwargs: Any) -> None:
         super().__init__(NODE_NAME, **node_kwargs)
-        self.endpoint = self.declare_parameter("endpoint", DEFAULT_ENDPOINT, ParameterDescriptor(
-            description="opc.tcp://HOST:PORT/PATH the OPC UA server listens on (loopback "
-                        "only)", read_only=True)).value
-        self.rig = self.declare_parameter("rig", "", ParameterDescriptor(
-            description="BrowseName of the rig object; '' = the namespace's last part, or "
-                        "Rig", read_only=True)).value or rig_name(self.get_namespace())
-        self.sim_node = self.declare_parameter("sim_node", topics.NODE_NAME, ParameterDescriptor(
-            description="sim_node's node name, in this node's namespace",
-            read_only=True)).value
-        self.sim_wait_s = self.declare_parameter("sim_wait_s", *_seconds(
-            "how long to wait at start for sim_node's parameters [s]", 30.0)).value
-        self.step_timeout_s = self.declare_parameter("step_timeout_s", *_seconds(
-            "Step returns BadTimeout after this many wall seconds without the sample [s]",
-            10.0)).value
-        self.security = load_security({name: self.declare_parameter(
-            name, "", ParameterDescriptor(description=SECURITY_HELP[name], read_only=True)
-        ).value for name in SECURITY_SETTINGS})
-        self.on_sample = None
-        self.figures: Any = None            # () -> the diagnostics' values, once serving
-        self._rejected_before = "0"
+        values = {s.name: s.declared(self) for s in SETTINGS}
+        self.endpoint = values["endpoint"]
+        self.sim_wait_s, self.step_timeout_s = values["sim_wait_s"], values["step_timeout_s"]
+        self.security = load_security({name: values[name] for name in SECURITY_SETTINGS})
+        listed, rig, sim_node = values["rigs"], values["rig"], values["sim_node"]
+        namespaces = rig_namespaces(list(listed or []), self.get_namespace())
+        self.links = [SimLink(self, ns, sim_node, name) for ns, name in
+                      zip(namespaces, rig_names(namespaces, rig), strict=True)]
         self._diagnostics = self.create_publisher(DiagnosticArray, topics.DIAGNOSTICS, 10)
         self.create_timer(DIAGNOSTICS_PERIOD_S, self._publish_diagnostics)
-        self.latest_sample: tuple[dict[str, float], int] | None = None   # (before on_sample)
-        self._pub = self.create_publisher(JointState, topics.node_relative(
-            topics.CMD_TOP_DRIVE), LOCKSTEP_QOS)
-        self.create_subscription(JointState, topics.node_relative(topics.SURFACE_MEASURED),
-                                 self._on_sample, LATEST_SAMPLE_QOS)
+        self.create_subscription(ParameterEvent, "/parameter_events", self._on_parameter_event,
+                                 qos_profile_parameter_events)
+        self.create_timer(SETTINGS_RETRY_S, self._poll_settings)
 
-    def _on_sample(self, msg: JointState) -> None:
-        values, time_ns = sample_values(msg)
-        self.latest_sample = (values, time_ns)
-        if self.on_sample is not None:
-            self.on_sample(values, time_ns)
+    def _on_parameter_event(self, msg: ParameterEvent) -> None:
+        for link in self.links:
+            link.on_parameter_event(msg)
+
+    def _poll_settings(self) -> None:
+        for link in self.links:
+            link.poll()
 
     def _publish_diagnostics(self) -> None:
-        """``opcua_gateway: <rig>``: WARN when writes were refused since the last one."""
-        if self.figures is None:
+        """``opcua_gateway: <rig>`` per rig: WARN when writes were refused since the last."""
+        statuses = [self._rig_status(link) for link in self.links if link.figures is not None]
+        if not statuses:
             return
-        values = self.figures()
-        refused = values["rejected_writes"] != self._rejected_before
-        self._rejected_before = values["rejected_writes"]
-        level = DiagnosticStatus.WARN if refused else DiagnosticStatus.OK
-        message = "writes refused (see the log)" if refused else values["status"]
-        msg = DiagnosticArray(status=[status(f"{NODE_NAME}: {self.rig}", level, message,
-                                             values)])
+        msg = DiagnosticArray(status=statuses)
         msg.header.stamp = self.get_clock().now().to_msg()
         self._diagnostics.publish(msg)
 
-    def send(self, command: Command, stamp_ns: int) -> None:
-        """The command answering the sample stamped ``stamp_ns`` (from any thread)."""
-        self._pub.publish(top_drive_command(command, stamp_ns))
+    def _rig_status(self, link: SimLink) -> DiagnosticStatus:
+        values = {"endpoint": self.endpoint, "namespace": link.namespace, **link.figures()}
+        refused = values["rejected_writes"] != link.rejected_before
+        link.rejected_before = values["rejected_writes"]
+        level = DiagnosticStatus.WARN if refused else DiagnosticStatus.OK
+        message = "writes refused (see the log)" if refused else values["status"]
+        return status(f"{NODE_NAME}: {link.rig}", level, message, values)
 
-    def sim_parameters(self) -> dict[str, Any]:
-        """sim_node's SIM_PARAMETERS (DrillSimError, one line, if it does not answer)."""
-        client = AsyncParameterClient(self, self.sim_node)
-        where = f"{self.get_namespace().rstrip('/')}/{self.sim_node}"
-        if not client.wait_for_services(timeout_sec=self.sim_wait_s):
-            raise DrillSimError(f"no sim_node {where} answered in {self.sim_wait_s:g} s "
-                                "(start sim_node first, in the same namespace and domain)")
-        future = client.get_parameters(list(SIM_PARAMETERS))
+    def sim_parameters(self, link: SimLink) -> dict[str, Any]:
+        """The SIM_PARAMETERS of ``link``'s sim_node (DrillSimError, one line, if it does not
+        answer)."""
+        if not link.parameters.wait_for_services(timeout_sec=self.sim_wait_s):
+            raise DrillSimError(f"no sim_node {link.sim_node} answered in {self.sim_wait_s:g} "
+                                "s (start sim_node first, in the rig's namespace and domain)")
+        future = link.parameters.get_parameters(list(SIM_PARAMETERS))
         rclpy.spin_until_future_complete(self, future, timeout_sec=self.sim_wait_s)
-        if not future.done():
-            raise DrillSimError(f"{where} did not return its parameters")
-        values = future.result().values
-        return {name: parameter_value_to_python(value)
-                for name, value in zip(SIM_PARAMETERS, values, strict=True)}
+        sim = sim_values(future.result()) if future.done() else None
+        if sim is None:
+            raise DrillSimError(f"{link.sim_node} did not return its parameters")
+        return sim
 
 
 def _spin(executor: SingleThreadedExecutor) -> None:
@@ -170,33 +218,54 @@ def _spin(executor: SingleThreadedExecutor) -> None:
         executor.spin()
 
 
-async def serve(node: GatewayNode, settings: RigSettings) -> None:
+Event = Callable[[], Awaitable[None]]
+
+
+def _switcher(link: SimLink) -> Callable[[str], Awaitable[str | None]]:
+    return lambda mode: asyncio.wrap_future(link.switch_mode(mode))
+
+
+def _connect(link: SimLink, rig: Rig, loop: asyncio.AbstractEventLoop,
+             events: asyncio.Queue[Event]) -> None:
+    """Hand ``link``'s samples and settings to ``rig`` through ``events`` (in order)."""
+    def put(event: Event) -> None:
+        loop.call_soon_threadsafe(events.put_nowait, event)
+
+    link.on_sample = lambda values, time_ns: put(functools.partial(rig.sample_in, values,
+                                                                   time_ns))
+    link.on_settings = lambda sim: put(functools.partial(rig.follow, rig_settings(sim)))
+    link.figures = rig.figures
+    if link.latest_sample is not None:      # received while sim_node's parameters came
+        events.put_nowait(functools.partial(rig.sample_in, *link.latest_sample))
+
+
+async def serve(node: GatewayNode, settings: list[RigSettings]) -> None:
     """Run the OPC UA server until ROS shuts down (SIGINT, SIGTERM)."""
     loop = asyncio.get_running_loop()
-    samples: asyncio.Queue[tuple[dict[str, float], int]] = asyncio.Queue()
-    rig = RigServer(node.endpoint, node.rig, settings, node.send, node.step_timeout_s,
-                    node.security)
-    await rig.start()
-    node.figures = rig.figures
-    node.on_sample = lambda values, time_ns: loop.call_soon_threadsafe(
-        samples.put_nowait, (values, time_ns))
-    if node.latest_sample is not None:      # received while sim_node's parameters came
-        samples.put_nowait(node.latest_sample)
+    events: asyncio.Queue[Event] = asyncio.Queue()
+    rigs = [Rig(link.rig, start_settings, link.send, _switcher(link), node.step_timeout_s)
+            for link, start_settings in zip(node.links, settings, strict=True)]
+    server = RigServer(node.endpoint, rigs, node.security)
+    await server.start()
+    for link, rig in zip(node.links, rigs, strict=True):
+        _connect(link, rig, loop, events)
     executor = SingleThreadedExecutor()
     executor.add_node(node)
     threading.Thread(target=_spin, args=(executor,), daemon=True).start()
-    node.get_logger().info(f"serving {node.rig} at {node.endpoint} (lockstep "
-                           f"{settings.lockstep}, drive mode {settings.drive_mode})")
+    for link, rig in zip(node.links, rigs, strict=True):
+        node.get_logger().info(f"serving {rig.name} ({link.sim_node}) at {node.endpoint} "
+                               f"(lockstep {rig.settings.lockstep}, drive mode "
+                               f"{rig.settings.drive_mode})")
     try:
         while rclpy.ok():
             try:
-                values, time_ns = await asyncio.wait_for(samples.get(), POLL_S)
+                event = await asyncio.wait_for(events.get(), POLL_S)
             except TimeoutError:
                 continue
-            await rig.sample_in(values, time_ns)
+            await event()
     finally:
         executor.shutdown(timeout_sec=1.0)
-        await rig.stop()
+        await server.stop()
 
 
 def main(args: list[str] | None = None) -> int:
@@ -213,7 +282,8 @@ def main(args: list[str] | None = None) -> int:
     try:
         node = GatewayNode()
         check_endpoint(node.endpoint, secured=node.security is not None)
-        asyncio.run(serve(node, rig_settings(node.sim_parameters())))
+        asyncio.run(serve(node, [rig_settings(node.sim_parameters(link))
+                                 for link in node.links]))
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     except (DrillSimError, ValueError, OSError) as exc:     # refused at start: one line

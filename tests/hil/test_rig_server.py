@@ -1,0 +1,236 @@
+"""The gateway's OPC UA server without ROS: a real asyncua server on loopback with two rig
+objects whose simulators are stand-ins, and a real asyncua client (issue 33).
+
+- Two rigs share one server: each has its own object, NodeIds, counters and commands; a
+  request spanning both is refused whole when one value is bad, counted by that rig alone.
+- A new DriveMode switches the stand-in's drive before the request's command goes; a switch
+  it refuses is BadInvalidState, one it never answers BadTimeout, both counted.
+- The EURanges, Lockstep and DriveMode follow the stand-in's settings; a sample older than the
+  latest (a restarted simulator) starts the handshake over from CommandCounter.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import math
+import socket
+from collections.abc import AsyncIterator
+from contextlib import asynccontextmanager
+from dataclasses import dataclass, field, replace
+from typing import Any
+
+import pytest
+from asyncua import Client, ua
+
+from drill_sim_ros.control.command import Command
+from drill_sim_ros.hil.rig_server import Rig, RigServer, RigSettings
+
+DOUBLE, UINT32, STRING = ua.VariantType.Double, ua.VariantType.UInt32, ua.VariantType.String
+SETTINGS = RigSettings(max_speed_rad_s=30.0, max_torque_nm=50_000.0, max_wob_n=1e6,
+                       speed_rad_s=4.0, wob_n=60_000.0, drive_mode="speed", lockstep=True)
+SAMPLE = {"DriveSpeed": 4.0, "MotorTorque": 1.0, "QuillTorque": 2.0, "HookLoad": 3.0,
+          "WobEstimate": 5.0, "BitDepth": 0.0, "Rop": 0.0, "SimTime": 0.0}
+PERIOD_NS = 10_000_000
+TIMEOUT_S = 30.0
+
+
+@dataclass
+class StandIn:
+    """A simulator: the commands it was sent (with their stamps) and its drive switches."""
+
+    commands: list[tuple[Command, int]] = field(default_factory=list)
+    switches: list[str] = field(default_factory=list)
+    refuse_with: str | None = None       # the reason it gives for refusing a switch
+    silent: bool = False                 # it never answers a switch
+
+    def send(self, command: Command, stamp_ns: int) -> None:
+        self.commands.append((command, stamp_ns))
+
+    async def switch_mode(self, mode: str) -> str | None:
+        self.switches.append(mode)
+        if self.silent:
+            await asyncio.Event().wait()
+        return self.refuse_with
+
+
+def free_port() -> int:
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        return probe.getsockname()[1]
+
+
+class View:
+    """The client's view of one rig object: its variables by BrowseName."""
+
+    def __init__(self, client: Client, nodes: dict[str, Any]) -> None:
+        self.client, self.nodes = client, nodes
+
+    async def value(self, name: str) -> Any:
+        return await self.nodes[name].read_value()
+
+    async def eu_range(self, name: str) -> tuple[float, float]:
+        value = await (await self.nodes[name].get_child("0:EURange")).read_value()
+        return value.Low, value.High
+
+
+async def view(client: Client, rig: str) -> View:
+    index = await client.get_namespace_index("urn:drill_sim_ros")
+    obj = await client.nodes.objects.get_child(f"{index}:{rig}")
+    return View(client, {(await n.read_browse_name()).Name: n for n in await obj.get_children()})
+
+
+@asynccontextmanager
+async def serving(**rig_options: Any) -> AsyncIterator[tuple[dict[str, Rig],
+                                                             dict[str, StandIn], Client]]:
+    """Rigs ``north`` and ``south`` in one server, their stand-ins, a connected client."""
+    stand_ins = {name: StandIn() for name in ("north", "south")}
+    rigs = {name: Rig(name, SETTINGS, s.send, s.switch_mode, **rig_options)
+            for name, s in stand_ins.items()}
+    url = f"opc.tcp://127.0.0.1:{free_port()}/drill_sim/"
+    server = RigServer(url, list(rigs.values()))
+    await server.start()
+    client = Client(url, timeout=5)
+    try:
+        await client.connect()
+        try:
+            yield rigs, stand_ins, client
+        finally:
+            await client.disconnect()
+    finally:
+        await server.stop()
+
+
+def run(coroutine: Any) -> Any:
+    return asyncio.run(asyncio.wait_for(coroutine, TIMEOUT_S))
+
+
+async def first_samples(rigs: dict[str, Rig]) -> None:
+    for rig in rigs.values():
+        await rig.sample_in(SAMPLE, 0)
+
+
+# ---- two rigs, one server -------------------------------------------------------------------
+
+async def two_rigs_apart() -> None:
+    async with serving() as (rigs, stand_ins, client):
+        await first_samples(rigs)
+        north, south = await view(client, "north"), await view(client, "south")
+        assert north.nodes["CommandCounter"].nodeid.Identifier == "north.CommandCounter"
+        await client.write_values([north.nodes["SpeedSetpoint"], north.nodes["CommandCounter"]],
+                                  [ua.Variant(6.0, DOUBLE), ua.Variant(1, UINT32)])
+        assert [c.speed_rad_s for c, _ in stand_ins["north"].commands] == [6.0]
+        assert stand_ins["south"].commands == []
+        await rigs["north"].sample_in(SAMPLE | {"SimTime": 0.01}, PERIOD_NS)
+        assert (await north.value("SampleCounter"), await south.value("SampleCounter")) == (1, 0)
+        assert await south.value("SimTime") == 0.0
+        # one request over both rigs, the south one's value bad: refused whole
+        with pytest.raises(ua.uaerrors.BadOutOfRange):
+            await client.write_values(
+                [north.nodes["CommandCounter"], south.nodes["WobSetpoint"]],
+                [ua.Variant(2, UINT32), ua.Variant(math.inf, DOUBLE)])
+        assert len(stand_ins["north"].commands) == 1
+        assert await north.value("CommandCounter") == 1
+        assert (await north.value("RejectedWrites"), await south.value("RejectedWrites")) == (
+            0, 1)
+
+
+def test_two_rigs_share_a_server_with_a_handshake_each() -> None:
+    run(two_rigs_apart())
+
+
+# ---- DriveMode ------------------------------------------------------------------------------
+
+async def switch_the_drive() -> None:
+    async with serving() as (rigs, stand_ins, client):
+        await first_samples(rigs)
+        north, stand_in = await view(client, "north"), stand_ins["north"]
+        await client.write_values(
+            [north.nodes["DriveMode"], north.nodes["TorqueCommand"],
+             north.nodes["CommandCounter"]],
+            [ua.Variant("torque", STRING), ua.Variant(-1234.5, DOUBLE), ua.Variant(1, UINT32)])
+        assert stand_in.switches == ["torque"]
+        (command, _), = stand_in.commands
+        assert (command.motor_torque_nm, command.speed_rad_s) == (-1234.5, None)
+        assert command.wob_n == SETTINGS.wob_n      # nothing known in force after a switch
+        await north.nodes["DriveMode"].write_value(ua.Variant("torque", STRING))
+        assert stand_in.switches == ["torque"]      # the mode it has: no switch
+        for wrong in ("kinematic", "Speed", ""):
+            with pytest.raises(ua.uaerrors.BadOutOfRange):
+                await north.nodes["DriveMode"].write_value(ua.Variant(wrong, STRING))
+        with pytest.raises(ua.uaerrors.BadTypeMismatch):
+            await north.nodes["DriveMode"].write_value(ua.Variant(1, ua.VariantType.Int32))
+        assert stand_in.switches == ["torque"]
+        assert await north.value("RejectedWrites") == 4
+        stand_in.refuse_with = "the drive would be unstable"
+        with pytest.raises(ua.uaerrors.BadInvalidState):
+            await north.nodes["DriveMode"].write_value(ua.Variant("speed", STRING))
+        assert (await north.value("DriveMode"), await north.value("RejectedWrites")) == (
+            "torque", 5)
+
+
+def test_drive_mode_switches_the_simulators_drive_and_wrong_modes_are_refused() -> None:
+    run(switch_the_drive())
+
+
+async def an_unanswered_switch() -> None:
+    async with serving(mode_switch_timeout_s=0.2) as (_, stand_ins, client):
+        north = await view(client, "north")
+        stand_ins["north"].silent = True
+        with pytest.raises(ua.uaerrors.BadTimeout):
+            await north.nodes["DriveMode"].write_value(ua.Variant("torque", STRING))
+        assert (await north.value("DriveMode"), await north.value("RejectedWrites")) == (
+            "speed", 1)
+
+
+def test_a_switch_the_simulator_does_not_answer_is_bad_timeout() -> None:
+    run(an_unanswered_switch())
+
+
+# ---- following the simulator ----------------------------------------------------------------
+
+async def follow_the_settings() -> None:
+    async with serving() as (rigs, stand_ins, client):
+        await first_samples(rigs)
+        north = await view(client, "north")
+        await north.nodes["SpeedSetpoint"].write_value(ua.Variant(20.0, DOUBLE))   # allowed
+        await rigs["north"].follow(replace(SETTINGS, max_speed_rad_s=10.0, max_torque_nm=7.0,
+                                           lockstep=False, drive_mode="torque"))
+        assert await north.eu_range("SpeedSetpoint") == (0.0, 10.0)
+        assert await north.eu_range("TorqueCommand") == (-7.0, 7.0)
+        assert await north.eu_range("WobSetpoint") == (0.0, SETTINGS.max_wob_n)
+        assert (await north.value("Lockstep"), await north.value("DriveMode")) == (
+            False, "torque")
+        with pytest.raises(ua.uaerrors.BadOutOfRange):
+            await north.nodes["SpeedSetpoint"].write_value(ua.Variant(20.0, DOUBLE))
+        await north.nodes["SpeedSetpoint"].write_value(ua.Variant(10.0, DOUBLE))
+        south = await view(client, "south")
+        assert await south.eu_range("SpeedSetpoint") == (0.0, SETTINGS.max_speed_rad_s)
+        assert stand_ins["north"].switches == []      # sim_node's own change: nothing to do
+
+
+def test_the_ranges_lockstep_and_drive_mode_follow_the_simulator() -> None:
+    run(follow_the_settings())
+
+
+async def start_over() -> None:
+    async with serving() as (rigs, stand_ins, client):
+        rig, north, stand_in = rigs["north"], await view(client, "north"), stand_ins["north"]
+        await first_samples(rigs)
+        for counter in (1, 2, 3):
+            await client.write_values([north.nodes["CommandCounter"]],
+                                      [ua.Variant(counter, UINT32)])
+            await rig.sample_in(SAMPLE, counter * PERIOD_NS)
+        await client.write_values([north.nodes["CommandCounter"]], [ua.Variant(4, UINT32)])
+        await rig.sample_in(SAMPLE, 0)      # restarted before answering command 4
+        assert await north.value("SampleCounter") == await north.value("CommandCounter") == 4
+        assert rig.figures()["sim_restarts"] == "1"
+        await client.write_values([north.nodes["CommandCounter"]], [ua.Variant(5, UINT32)])
+        command, stamp_ns = stand_in.commands[-1]
+        assert stamp_ns == 0                # it answers the restarted simulator's sample
+        assert (command.speed_rad_s, command.wob_n) == (SETTINGS.speed_rad_s, SETTINGS.wob_n)
+        await rig.sample_in(SAMPLE, PERIOD_NS)
+        assert await north.value("SampleCounter") == 5
+
+
+def test_a_restarted_simulator_starts_the_handshake_over_from_command_counter() -> None:
+    run(start_over())
