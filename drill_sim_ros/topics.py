@@ -126,7 +126,9 @@ DESCRIPTIONS: dict[str, str] = {
     DIAGNOSTICS: "two statuses, 1 Hz of wall time",
     CLOCK: "simulated time (when `publish_clock`)",
     RUN_INFO: "JSON of what runs (preset, groups, scales, sampling, string), once",
-    STRING_TORSION: "the distributed string along depth at `string.rate_hz` (default 10 Hz) "
+    STRING_TORSION: "with `string.message` joint_state (the default, typed, sends "
+                    "drill_sim_msgs/StringProfile on `/drill/typed/string/torsion`): the "
+                    "distributed string along depth at `string.rate_hz` (default 10 Hz) "
                     "of sim time, `string.depths` (<= 64) joints top to bottom, joint "
                     "`string_DDDD.Dm` at DDDD.D m below the top (e.g. `string_0021.1m`); "
                     "not for a lumped string",
