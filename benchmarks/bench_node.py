@@ -12,10 +12,14 @@
 (d) (b0) and (b) again, first with the subscriber process idle (its subscriptions matched,
     so Fast DDS still delivers to it, but it takes nothing and leaves the second core to the
     publisher), then with no subscriber: what the subscriber costs on this 2-core machine.
+(e) the string profiles (issue 35): free run of the distributed preset with its profiles as
+    drill_sim_msgs/StringProfile (string.message typed, the default), as JointState
+    (joint_state) and with none (string.rate_hz 0), and of its lumped twin, alternated
+    ``--rounds`` times; each as x real time (median) and as a ratio to the lumped twin's.
 Targets (issue 10): (a) sim_node <= 1.5x the reference, p99 <= 2 ms; (b) >= 100x, and with
-recording >= a third of that.
+recording >= a third of that; (issue 35) (e) typed >= 0.85x the lumped twin and >= 50x.
 Usage: .venv/bin/python benchmarks/bench_node.py [--seconds 10] [--pairs 3]
-       [--preset field_8p5in_shale]
+       [--preset field_8p5in_shale] [--rounds 2] [--strings-only]
 """
 
 from __future__ import annotations
@@ -44,6 +48,7 @@ from rclpy.node import Node
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 
 from drill_sim_ros import topics
+from drill_sim_ros.ros import typed
 from drill_sim_ros.ros.messages import type_of
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))   # for tests.process_probes
@@ -51,6 +56,13 @@ from tests.process_probes import cpu_seconds
 
 BIN = Path(sys.prefix) / "bin"
 PUBLISHED = [t for t in topics.MSG_TYPES if t not in topics.COMMANDS]
+if typed.PROFILE_AVAILABLE:            # (e): the typed profiles are subscribed too
+    PUBLISHED.append(topics.TYPED_STRING_TORSION)
+# (e): (label, preset suffix, sim_node parameters)
+STRING_CASES = (("distributed, typed profiles", "", ("string.message:=typed",)),
+                ("distributed, JointState profiles", "", ("string.message:=joint_state",)),
+                ("distributed, no profiles (string.rate_hz 0)", "", ("string.rate_hz:=0.0",)),
+                ("lumped twin", "_lumped", ()))
 
 
 class Listener(Node):
@@ -94,11 +106,14 @@ def spin_for(node: Node, seconds: float) -> None:
         rclpy.spin_once(node, timeout_sec=0.05)
 
 
-def start_node(preset: str, factor: float, record_path: str = "") -> subprocess.Popen:
+def start_node(preset: str, factor: float, record_path: str = "",
+               params: tuple[str, ...] = ()) -> subprocess.Popen:
     command = [str(BIN / "sim_node"), "--ros-args", "-p", f"model.preset:={preset}",
                "-p", f"real_time_factor:={factor}", "-p", "status_line:=false"]
     if record_path:
         command += ["-p", f"record.path:={record_path}"]
+    for param in params:
+        command += ["-p", param]
     return subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
 
 
@@ -212,6 +227,25 @@ def measure(listener: Listener, proc: subprocess.Popen, seconds: float,
             "rtf_reported": float(diag.get("real_time_factor_achieved", "nan"))}
 
 
+def string_profiles(listener: Listener, preset: str, seconds: float, rounds: int) -> None:
+    """(e): the free run of each of STRING_CASES, alternated ``rounds`` times; medians, and
+    their ratios to the lumped twin's."""
+    rates: dict[str, list[float]] = {label: [] for label, _, _ in STRING_CASES}
+    for round_index in range(1, rounds + 1):
+        for label, suffix, params in STRING_CASES:
+            run = measure(listener, start_node(preset + suffix, 0.0, params=params), seconds)
+            rates[label].append(run["sim_rate"])
+            print(f"(e) round {round_index}: {label}: {run['sim_rate']:.1f}x real time; CPU "
+                  f"{run['cpu_percent']:.0f} %; {run['received_per_s']:.0f} msg/s received",
+                  flush=True)
+    lumped = float(np.median(rates[STRING_CASES[-1][0]]))
+    for label, _, _ in STRING_CASES:
+        median = float(np.median(rates[label]))
+        print(f"(e) {label}: {median:.1f}x real time (median of {rounds}; "
+              f"{min(rates[label]):.1f}-{max(rates[label]):.1f}) = {median / lumped:.2f} of "
+              f"the lumped twin's", flush=True)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seconds", type=float, default=10.0)
@@ -219,6 +253,9 @@ def main() -> None:
                         help="(a) reference/sim_node measurements, alternated")
     parser.add_argument("--real-time-only", action="store_true", help="(a) only")
     parser.add_argument("--preset", default="field_8p5in_shale")
+    parser.add_argument("--rounds", type=int, default=2,
+                        help="(e) rounds of the string profile cases, alternated")
+    parser.add_argument("--strings-only", action="store_true", help="(e) only")
     parser.add_argument("--reference-publisher", metavar="PRESET", help=argparse.SUPPRESS)
     parser.add_argument("--reference-period", type=float, default=0.01, help=argparse.SUPPRESS)
     args = parser.parse_args()
@@ -228,6 +265,9 @@ def main() -> None:
     rclpy.init()
     listener = Listener()
     try:
+        if args.strings_only:
+            string_profiles(listener, args.preset, args.seconds, args.rounds)
+            return
         ratios = []
         for pair in range(1, args.pairs + 1):      # alternated: drift hits both alike
             ref = measure(listener, start_reference(args.preset), args.seconds)
@@ -261,6 +301,7 @@ def main() -> None:
         print(f"(c) free run, recording in process: achieved real-time factor "
               f"{rec['sim_rate']:.1f}x = {rec['sim_rate'] / free['sim_rate']:.2f} of (b); "
               f"CPU {rec['cpu_percent']:.0f} %")
+        string_profiles(listener, args.preset, args.seconds, args.rounds)
         watcher = Listener(telemetry=False)
         for case, spun in (("the subscriber process idle (its subscriptions matched, "
                             "nothing taken)", watcher), ("no subscriber", None)):

@@ -38,18 +38,23 @@ CMD_TOP_DRIVE = "/drill/cmd/top_drive"        # sensor_msgs/JointState (COMMAND_
 # command reacts to. Each array is empty or as long as name; other messages are rejected.
 COMMAND_JOINTS = ("top_drive", "hook")
 COMMANDS = (CMD_SURFACE_RPM, CMD_WOB, CMD_TOP_DRIVE)
-# published at a lower rate than the samples (not one message per sample)
-PROFILE_TOPICS = (STRING_TORSION,)
 
 # ---- typed twins (drill_sim_msgs, when installed; drill_sim_ros.ros.typed) --------------
 TYPED_TELEMETRY = "/drill/typed/telemetry"    # drill_sim_msgs/Telemetry, one per sample
 TYPED_RUN_INFO = "/drill/typed/run_info"      # drill_sim_msgs/RunInfo; latched
 TYPED_CMD_TOP_DRIVE = "/drill/typed/cmd/top_drive"  # drill_sim_msgs/TopDriveCommand (subscribed)
+# string.message typed (the default): the string profiles as drill_sim_msgs/StringProfile
+# here instead of drill/string/torsion's JointState
+TYPED_STRING_TORSION = "/drill/typed/string/torsion"
 TYPED_MSG_TYPES: dict[str, str] = {
     TYPED_TELEMETRY: "drill_sim_msgs/msg/Telemetry",
     TYPED_RUN_INFO: "drill_sim_msgs/msg/RunInfo",
     TYPED_CMD_TOP_DRIVE: "drill_sim_msgs/msg/TopDriveCommand",
+    TYPED_STRING_TORSION: "drill_sim_msgs/msg/StringProfile",
 }
+# published at a lower rate than the samples (not one message per sample): the string
+# profiles, on one of the two topics (string.message)
+PROFILE_TOPICS = (STRING_TORSION, TYPED_STRING_TORSION)
 
 # sim_node names its topics relative to its namespace (`-r __ns:=/rig1` moves them all),
 # except these two, which ROS conventions keep absolute. The names above are those of the
@@ -121,7 +126,9 @@ DESCRIPTIONS: dict[str, str] = {
     DIAGNOSTICS: "two statuses, 1 Hz of wall time",
     CLOCK: "simulated time (when `publish_clock`)",
     RUN_INFO: "JSON of what runs (preset, groups, scales, sampling, string), once",
-    STRING_TORSION: "the distributed string along depth at `string.rate_hz` (default 10 Hz) "
+    STRING_TORSION: "with `string.message` joint_state (the default, typed, sends "
+                    "drill_sim_msgs/StringProfile on `/drill/typed/string/torsion`): the "
+                    "distributed string along depth at `string.rate_hz` (default 10 Hz) "
                     "of sim time, `string.depths` (<= 64) joints top to bottom, joint "
                     "`string_DDDD.Dm` at DDDD.D m below the top (e.g. `string_0021.1m`); "
                     "not for a lumped string",

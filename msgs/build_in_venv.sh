@@ -23,4 +23,4 @@ cmake -S "$src" -B "$build" -DCMAKE_INSTALL_PREFIX="$venv" -DPython3_EXECUTABLE=
   -DBUILD_TESTING=OFF
 cmake --build "$build" -j 2
 cmake --install "$build"
-"$py" -c 'from drill_sim_msgs.msg import BitMode, RunInfo, Telemetry, TopDriveCommand'
+"$py" -c 'from drill_sim_msgs.msg import BitMode, RunInfo, StringProfile, Telemetry, TopDriveCommand'

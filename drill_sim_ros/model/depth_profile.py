@@ -12,6 +12,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 
 from drill_sim_ros.model.errors import ParameterError
 
@@ -45,18 +46,61 @@ def check_depth_count(count: int) -> None:
                              f"[1, {MAX_DEPTHS}]")
 
 
+@dataclass(frozen=True)
+class Interpolation:
+    """Linear interpolation at fixed points ``x`` of values given at fixed nodes ``xp``
+    (ascending), as ``np.interp`` computes it, bit for bit: ``(y[hi] - y[lo]) / span *
+    offset + y[lo]`` with ``lo`` the last node at or below the point, ``hi`` the next one,
+    ``offset = x - xp[lo]`` and ``span = xp[hi] - xp[lo]``; at a node or beyond the ends,
+    ``lo = hi`` is that node or the end's, offset 0 and span 1. ``nodes`` are the nodes
+    it reads (ascending), ``lo`` and ``hi`` indices into them."""
+
+    nodes: np.ndarray
+    lo: np.ndarray
+    hi: np.ndarray
+    offset: np.ndarray
+    span: np.ndarray
+
+    @classmethod
+    def at(cls, x: np.ndarray, xp: np.ndarray) -> Interpolation:
+        j = np.clip(np.searchsorted(xp, x, side="right") - 1, 0, len(xp) - 1)
+        inside = (x > xp[0]) & (x < xp[-1]) & (xp[j] != x)
+        hi = np.where(inside, j + 1, j)
+        nodes = np.unique(np.concatenate((j, hi)))
+        return cls(nodes, np.searchsorted(nodes, j), np.searchsorted(nodes, hi),
+                   np.where(inside, x - xp[j], 0.0),
+                   np.where(inside, xp[hi] - xp[j], 1.0))
+
+    def __call__(self, y: np.ndarray) -> np.ndarray:
+        """The values at the points of ``y`` at :attr:`nodes`."""
+        out = np.empty(self.lo.size)
+        _interpolate(y, self.lo, self.hi, self.offset, self.span, out)
+        return out
+
+
+@njit(cache=True)
+def _interpolate(y: np.ndarray, lo: np.ndarray, hi: np.ndarray, offset: np.ndarray,
+                 span: np.ndarray, out: np.ndarray) -> None:
+    for i in range(out.size):
+        out[i] = (y[hi[i]] - y[lo[i]]) / span[i] * offset[i] + y[lo[i]]
+
+
 class DepthSampler:
     """Samples the torsional profile of a distributed string at fixed depths.
 
     ``cell_depths_m`` is the depth of every cell (``string_profile()[0]``); at most one
-    depth per cell is sampled, so there are ``min(count, cells)`` depths.
+    depth per cell is sampled, so there are ``min(count, cells)`` depths. Each depth reads
+    the two cells around it (:attr:`cells`, indices into the profile's arrays), so a sample
+    needs only those (:meth:`Simulator.string_cells`).
     """
 
     def __init__(self, cell_depths_m: np.ndarray, length_m: float, count: int) -> None:
         check_depth_count(count)
-        self._cells_m = np.asarray(cell_depths_m, dtype=float)
-        self.depths_m = sample_depths_m(length_m, min(count, self._cells_m.size))
+        cells_m = np.asarray(cell_depths_m, dtype=float)
+        self.depths_m = sample_depths_m(length_m, min(count, cells_m.size))
         self.names = [depth_name(d) for d in self.depths_m]
+        self._interpolation = Interpolation.at(self.depths_m, cells_m)
+        self.cells = self._interpolation.nodes
 
     def sample(self, profile: tuple[np.ndarray, np.ndarray, np.ndarray],
                stamp_ns: int) -> StringSample:
@@ -64,5 +108,10 @@ class DepthSampler:
         interpolated at :attr:`depths_m` (beyond the first or last cell's middle: its
         value)."""
         _, speed, torque = profile
-        return StringSample(stamp_ns, np.interp(self.depths_m, self._cells_m, speed),
-                            np.interp(self.depths_m, self._cells_m, torque))
+        return self.sample_cells(speed[self.cells], torque[self.cells], stamp_ns)
+
+    def sample_cells(self, speed_rad_s: np.ndarray, torque_nm: np.ndarray,
+                     stamp_ns: int) -> StringSample:
+        """The sample of the speeds and torques at :attr:`cells` only."""
+        return StringSample(stamp_ns, self._interpolation(speed_rad_s),
+                            self._interpolation(torque_nm))

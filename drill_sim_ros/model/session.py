@@ -216,8 +216,8 @@ class SimSession:
     def _take_string(self) -> None:
         """The string profile of the current state, when one is due at this stamp."""
         if self.string_every and self.next_index % self.string_every == 0:
-            self._taken.append(self._strings.sample(self.sim.string_profile(),
-                                                    self.sim_time_ns))
+            speed, torque = self.sim.string_cells(self._strings.cells)
+            self._taken.append(self._strings.sample_cells(speed, torque, self.sim_time_ns))
 
     def _split_period(self) -> np.ndarray:
         """One period with the inputs due in it applied at their step (the step nearest

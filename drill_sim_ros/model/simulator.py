@@ -570,6 +570,14 @@ class Simulator:
             return depth, speed * sc.length_m / sc.time_s, force * sc.force_n
         return depth, speed / sc.time_s, force * sc.torque_nm
 
+    def string_cells(self, cells: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The torsional (speed rad/s, torque N m) of the distributed string now at
+        ``cells`` only (ascending int64 indices into :meth:`string_profile`'s arrays): the
+        values it gives there, without reading the other cells."""
+        force, speed = sg.cells_state(self._wave, self._wave_i, self._wave_f, 0, cells)
+        sc = self.scales
+        return speed / sc.time_s, force * sc.torque_nm
+
     def top_waves(self) -> tuple[float, float]:
         """The torsional waves at the top of the string now, kernel units: (a, the one the
         drive sent down last step; b, the one arriving from below)."""

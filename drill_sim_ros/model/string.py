@@ -749,6 +749,35 @@ def _line_state_into(wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray, l
             ib = ib + 1 if ib + 1 < n else 0
 
 
+def cells_state(wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray, lo: int,
+                cells: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(force, speed) of the ``cells`` (ascending indices among the cells that
+    :func:`line_state` lists for the line whose parts start at column ``lo``) now, the same
+    values it gives there, reading no other cell."""
+    force, speed = np.empty(cells.size), np.empty(cells.size)
+    _cells_state_into(wave, wave_i, wave_f, lo, cells, force, speed)
+    return force, speed
+
+
+@njit(cache=True)
+def _cells_state_into(wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray, lo: int,
+                      cells: np.ndarray, force: np.ndarray, speed: np.ndarray) -> None:
+    """:func:`cells_state` into the caller's arrays: cell k of a part (k below its top)
+    holds the a in slot pos - 1 - k and the b in slot pos + k, wrapping (see
+    :func:`_line_state_into`)."""
+    j, top = lo, 0                 # the part of cells[i], and the index of its first cell
+    for i in range(cells.size):
+        cell = cells[i]
+        while cell >= top + wave_i[W_LEN, j]:
+            top += wave_i[W_LEN, j]
+            j += 1
+        n, off, pos, z = wave_i[W_LEN, j], wave_i[W_OFF, j], wave_i[W_POS, j], wave_f[W_Z, j]
+        k = cell - top
+        a, b = wave[off + (pos - 1 - k) % n], wave[off + n + (pos + k) % n]
+        force[i] = 0.5 * (a + b)
+        speed[i] = (a - b) / (2.0 * z)
+
+
 def cell_depths_m(line: WaveLine, wave_i: np.ndarray, lo: int) -> np.ndarray:
     """Depth below the top of the middle of every cell of a line (its parts start at
     column ``lo`` of ``wave_i``), m."""

@@ -96,16 +96,32 @@ def clock_layout() -> Layout:
     return cdr.layout(stamp=cdr.stamp())
 
 
-def joint_state_layout(names: tuple[str, ...]) -> Layout:
+def joint_state_layout(names: tuple[str, ...], with_position: bool = True) -> Layout:
     """sensor_msgs/JointState with fixed joint names and an empty frame_id; the doubles are
-    position, then velocity, then effort, one per joint."""
+    position (none without ``with_position``: an empty array), then velocity, then effort,
+    one per joint."""
     cdr = CdrBuffer()
     at = cdr.stamp()
     cdr.string("")                             # header.frame_id
     cdr.uint32(len(names))
     for name in names:
         cdr.string(name)
-    values = [offset for _ in range(3) for offset in cdr.doubles(len(names))]
+    values: list[int] = []
+    if with_position:
+        values += cdr.doubles(len(names))
+    else:
+        cdr.uint32(0)                          # position: an empty array
+    values += [offset for _ in range(2) for offset in cdr.doubles(len(names))]
+    return cdr.layout(doubles=tuple(values), stamp=at)
+
+
+def string_profile_layout(frame_id: str, depths: int) -> Layout:
+    """drill_sim_msgs/StringProfile of ``depths`` depths; the doubles are depth_m, then
+    speed_rad_s, then torque_nm, one per depth."""
+    cdr = CdrBuffer()
+    at = cdr.stamp()
+    cdr.string(frame_id)
+    values = [offset for _ in range(3) for offset in cdr.doubles(depths)]
     return cdr.layout(doubles=tuple(values), stamp=at)
 
 

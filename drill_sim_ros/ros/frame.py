@@ -82,7 +82,7 @@ def _starts(lengths: list[int]) -> tuple[list[int], int]:
     return starts, -(-end // 8) * 8
 
 
-def _aligned(offset: int, size: int) -> int:
+def aligned_index(offset: int, size: int) -> int:
     """``offset`` in units of ``size`` bytes (a layout change that breaks alignment raises)."""
     if offset % size:
         raise ValueError(f"payload value at byte {offset} is not {size}-byte aligned")
@@ -96,9 +96,9 @@ def _plan(placed: list[tuple[int, Layout, list[tuple[str, bool]]]]) -> np.ndarra
     mode_at = -1
     for start, layout, values in placed:
         for at, (field, rad_s) in zip(layout.doubles, values, strict=True):
-            doubles += [_aligned(start + at, 8), F[field], int(rad_s)]
+            doubles += [aligned_index(start + at, 8), F[field], int(rad_s)]
         if layout.stamp is not None:
-            stamps.append(_aligned(start + layout.stamp, 4))
+            stamps.append(aligned_index(start + layout.stamp, 4))
         if layout.byte is not None:
             mode_at = start + layout.byte
     return np.array([len(doubles) // 3, len(stamps), mode_at, *doubles, *stamps],

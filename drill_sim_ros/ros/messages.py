@@ -29,8 +29,9 @@ TELEMETRY_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=100,
 
 
 def type_of(topic: str) -> type:
-    """The message class of one of the topics in :mod:`drill_sim_ros.topics`."""
-    return message_class(topics.MSG_TYPES[topic])
+    """The message class of one of the topics in :mod:`drill_sim_ros.topics` (a typed one
+    needs drill_sim_msgs)."""
+    return message_class({**topics.MSG_TYPES, **topics.TYPED_MSG_TYPES}[topic])
 
 
 def stamp(time_ns: int) -> Time:

@@ -167,13 +167,19 @@ SPECS: tuple[ParamSpec, ...] = (
               "Samples published per second of SIMULATED time.", 1.0, 1000.0, read_only=True,
               unit="Hz"),
     ParamSpec("string.rate_hz", DOUBLE, 10.0,
-              "String profiles on drill/string/torsion per second of SIMULATED time, on "
+              "String profiles (topic: string.message) per second of SIMULATED time, on "
               "every round(publish_rate_hz / string.rate_hz)-th sample (at most one per "
               "sample); 0 = off. A lumped string has none.", 0.0, 1000.0, read_only=True,
               unit="Hz"),
     ParamSpec("string.depths", INTEGER, 64,
               "Depths of each string profile: the middles of this many equal intervals of "
               "the string, top to bottom.", 1, 64, read_only=True),
+    ParamSpec("string.message", STRING, "typed",
+              "The string profiles' message: typed = drill_sim_msgs/StringProfile on "
+              "drill/typed/string/torsion (depths, speeds, torques); joint_state = "
+              "sensor_msgs/JointState on drill/string/torsion (one joint per depth), for "
+              "tools that read only standard messages, and the fallback without "
+              "drill_sim_msgs.", read_only=True, choices=("typed", "joint_state")),
     ParamSpec("publish_clock", BOOL, True, "Publish /clock (rosgraph_msgs/Clock) in sim time."),
     ParamSpec("clock_rate_hz", DOUBLE, 100.0,
               "/clock messages per second of SIMULATED time, on the samples' stamps: at most "

@@ -67,7 +67,12 @@ from drill_sim_ros.ros.parameters import (
     validate,
 )
 from drill_sim_ros.ros.sinks import SampleSinks, TypedTelemetry
-from drill_sim_ros.ros.string_sink import StringTorsionSink, string_topics
+from drill_sim_ros.ros.string_sink import (
+    StringProfileSink,
+    profile_packer,
+    string_message,
+    string_topics,
+)
 from drill_sim_ros.terminal import StatusLine, format_status
 
 RCLError = rclpy_implementation.RCLError
@@ -172,9 +177,9 @@ class SimNode(Node):
         self._pubs = {t: self.create_publisher(messages.type_of(t), topics.node_relative(t),
                                                self._qos(t), event_callbacks=QUIET_PUBLISHER)
                       for t in (*SAMPLE_TOPICS, topics.CLOCK, topics.DIAGNOSTICS,
-                                topics.RUN_INFO, *string_topics(self._preset, self._values))}
+                                topics.RUN_INFO, *self._string_topics())}
         self._sinks = SampleSinks(self._pubs)
-        self._string_sink: StringTorsionSink | None = None     # made by start()
+        self._string_sink: StringProfileSink | None = None     # made by start()
         self._add_command_topics()
         self._typed_pubs = self._add_typed_topics()
         self._add_services()
@@ -272,7 +277,7 @@ class SimNode(Node):
         with self._lock.urgent():
             session = SimSession(session_config(self._values, self._preset))
             self._session = session
-            self._string_sink = StringTorsionSink(self._sinks, session.string_names)
+            self._string_sink = self._profile_sink(session)
             self._sinks.warm_up()
             self._sinks.clock_period_ns = round(NS_PER_S / self._values["clock_rate_hz"])
             self._pacer = Pacer(self._wall_period_ns(self._rtf))
@@ -284,6 +289,24 @@ class SimNode(Node):
         if self._values["run_seconds"] > 0:
             self._stop_timer.reset()
         self._log_start()
+
+    def _string_topics(self) -> tuple[str, ...]:
+        """The topic of the string profiles (none: a lumped string or string.rate_hz 0)."""
+        return string_topics(self._preset, self._values, typed.PROFILE_AVAILABLE)
+
+    def _profile_sink(self, session: SimSession) -> StringProfileSink | None:
+        """The sink of the string profiles in the message ``string.message`` chooses."""
+        chosen = self._string_topics()
+        if not chosen:
+            return None
+        message = string_message(self._values, typed.PROFILE_AVAILABLE)
+        if message != self._values["string.message"]:
+            self.get_logger().warning("string.message typed: drill_sim_msgs/StringProfile "
+                                      f"is not installed, the profiles go out on "
+                                      f"{topics.STRING_TORSION} as JointState")
+        packer = profile_packer(message, session.string_depths_m, session.string_names,
+                                self._diagnostics.source.hardware_id)
+        return StringProfileSink(self._sinks, chosen[0], self._pubs, packer)
 
     @staticmethod
     def _qos(topic: str) -> QoSProfile:

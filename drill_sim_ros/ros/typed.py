@@ -3,7 +3,9 @@
 ``drill/typed/telemetry`` (drill_sim_msgs/Telemetry: a header stamped with the sample's sim
 time, framed by the rig, and one named field per telemetry value), ``drill/typed/run_info``
 (RunInfo, latched) and ``drill/typed/cmd/top_drive`` (TopDriveCommand, what
-``drill/cmd/top_drive`` carries as a JointState). The standard-message topics stay: plotting
+``drill/cmd/top_drive`` carries as a JointState) and, with ``string.message`` typed,
+``drill/typed/string/torsion`` (StringProfile, packed by
+:mod:`drill_sim_ros.ros.string_sink`). The standard-message topics stay: plotting
 tools read them without the package. Without ``drill_sim_msgs`` installed (a ROS install
 that has not built msgs/ yet) :data:`AVAILABLE` is False and sim_node publishes only those.
 
@@ -31,9 +33,16 @@ try:
 except ImportError:       # msgs/ not built here: the standard topics only
     BitMode = RunInfo = Telemetry = TopDriveCommand = None
 
+try:
+    from drill_sim_msgs.msg import StringProfile
+except ImportError:       # not built, or built before StringProfile: profiles as JointState
+    StringProfile = None
+
 AVAILABLE = Telemetry is not None
-__all__ = ["AVAILABLE", "BitMode", "RunInfo", "Telemetry", "TelemetryPacker",
-           "TopDriveCommand", "command_of", "run_info_message"]
+PROFILE_AVAILABLE = StringProfile is not None
+__all__ = ["AVAILABLE", "PROFILE_AVAILABLE", "BitMode", "RunInfo", "StringProfile",
+           "Telemetry", "TelemetryPacker", "TopDriveCommand", "command_of",
+           "run_info_message"]
 
 
 def telemetry_fields() -> list[str]:

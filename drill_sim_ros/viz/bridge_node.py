@@ -39,6 +39,7 @@ from std_msgs.msg import Float64MultiArray, String
 from drill_sim_ros import topics
 from drill_sim_ros.archive.output import OutputError, check_output
 from drill_sim_ros.model.presets import DEFAULT_PRESET, load_preset
+from drill_sim_ros.ros import typed
 from drill_sim_ros.ros.messages import RUN_INFO_QOS
 from drill_sim_ros.viz.analytics_off import disable_analytics
 from drill_sim_ros.viz.blueprint import build_blueprint, has_string_views
@@ -85,7 +86,7 @@ class TelemetryQueue:
 
     def __init__(self, context: Context | None = None, best_effort: bool = False,
                  topic: str = topics.TELEMETRY, msg_type: Any = Float64MultiArray) -> None:
-        name = topic.rsplit("/", 1)[-1]
+        name = "_".join(topic.split("/")[2:])       # /drill/typed/x -> typed_x
         self.node = Node(f"{NODE_NAME}_{name}", context=context, **HELPER_NODE)
         self._sub = self.node.create_subscription(msg_type, topics.node_relative(topic),
                                                   lambda _msg: None, telemetry_qos(best_effort))
@@ -111,6 +112,15 @@ class TelemetryQueue:
         self.node.destroy_node()
 
 
+def string_profile_types() -> list[tuple[str, Any]]:
+    """The string profile topics and their message classes: drill/string/torsion
+    (JointState), and drill/typed/string/torsion (StringProfile) with drill_sim_msgs."""
+    out: list[tuple[str, Any]] = [(topics.STRING_TORSION, JointState)]
+    if typed.PROFILE_AVAILABLE:
+        out.append((topics.TYPED_STRING_TORSION, typed.StringProfile))
+    return out
+
+
 RUN_INFO_WAIT_S = 3.0        # how long to wait for the sim's /drill/run_info at start
 
 
@@ -125,8 +135,9 @@ class RerunBridge(Node):
         self._dashboard = dashboard
         self._viewer = viewer
         self._queue = TelemetryQueue(self.context, best_effort)
-        self._strings = TelemetryQueue(self.context, best_effort, topics.STRING_TORSION,
-                                       JointState)
+        # the string profiles, as the sim's string.message sends them
+        self._strings = [TelemetryQueue(self.context, best_effort, topic, msg_type)
+                         for topic, msg_type in string_profile_types()]
         self.telemetry_topic = self._queue.topic_name
         self._order: np.ndarray | None = None
         self.dropped = 0
@@ -149,9 +160,10 @@ class RerunBridge(Node):
         rows = self._rows(self._queue.take_all())
         if rows:
             self._dashboard.log_batch(TelemetryBatch.from_rows(np.stack(rows), self._order))
-        strings = string_batch(self._strings.take_all())
-        if strings is not None:
-            self._dashboard.log_strings(strings)
+        for queue in self._strings:
+            strings = string_batch(queue.take_all())
+            if strings is not None:
+                self._dashboard.log_strings(strings)
         if self._viewer is not None:
             self._viewer.poll(time.monotonic(), progress(self._dashboard))
         self._status(force=False)
@@ -172,7 +184,8 @@ class RerunBridge(Node):
             self.flush()
         self._status(force=True)
         self._queue.destroy()
-        self._strings.destroy()
+        for queue in self._strings:
+            queue.destroy()
 
 
 def parse_args(argv: list[str]) -> argparse.Namespace:

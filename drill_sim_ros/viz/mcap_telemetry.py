@@ -67,14 +67,18 @@ def read_telemetry(path: str | Path | ArchiveReader,
 
 def read_string_profiles(path: str | Path | ArchiveReader,
                          batch_profiles: int = 1000) -> Iterator[StringBatch]:
-    """Yield the drill/string/torsion profiles in file order, ``batch_profiles`` at a time
-    (none for a lumped string or a recording made before the topic existed)."""
+    """Yield the string profiles in file order, ``batch_profiles`` at a time: those of
+    drill/typed/string/torsion (StringProfile) or of drill/string/torsion (JointState),
+    whichever the recording has (none for a lumped string or a recording made before the
+    topics existed)."""
     reader = path if isinstance(path, ArchiveReader) else ArchiveReader(path)
     messages: list[Any] = []
-    decode = None
-    for message in reader.messages(lambda topic: topic == topics.STRING_TORSION):
-        decode = decode or _decoder(message.channel)
-        messages.append(decode(message.data))
+    decoders: dict[int, Callable[[bytes], Any]] = {}
+    for message in reader.messages(lambda topic: topic in topics.PROFILE_TOPICS):
+        channel = message.channel
+        if channel.channel_id not in decoders:
+            decoders[channel.channel_id] = _decoder(channel)
+        messages.append(decoders[channel.channel_id](message.data))
         if len(messages) >= batch_profiles:
             if (batch := string_batch(messages)) is not None:
                 yield batch

@@ -1,5 +1,6 @@
 """The distributed string on the dashboard: a depth x time picture of its angular speed and
-the current speed and torque along depth, from drill/string/torsion.
+the current speed and torque along depth, from drill/typed/string/torsion
+(drill_sim_msgs/StringProfile) or drill/string/torsion (JointState).
 
 The picture (:data:`~drill_sim_ros.viz.entities.STRING_PICTURE`) is an RGB image, one row
 per depth (top drive at the top, bit at the bottom), one column per profile (newest at the
@@ -109,17 +110,32 @@ def depth_of_joint(name: str) -> float:
     return float(name.removeprefix("string_").removesuffix("m"))
 
 
+def profile_fields(msg: Any) -> tuple[tuple[Any, ...], Any, Any]:
+    """(its depths, speeds rad/s, torques N m) of a profile message of either kind: a
+    drill_sim_msgs/StringProfile (depths in m) or a JointState of drill/string/torsion (its
+    joint names, one per depth)."""
+    if hasattr(msg, "depth_m"):
+        return tuple(msg.depth_m), msg.speed_rad_s, msg.torque_nm
+    return tuple(msg.name), msg.velocity, msg.effort
+
+
 def string_batch(messages: list[Any]) -> StringBatch | None:
-    """A batch of JointState messages of drill/string/torsion (None: none, or malformed:
-    arrays not as long as the names, or the depths changed within the list)."""
-    good = [m for m in messages if m.name and len(m.velocity) == len(m.effort) == len(m.name)
-            and list(m.name) == list(messages[0].name)]
+    """A batch of string profiles, StringProfile or JointState messages, of one kind (None:
+    none, or malformed: arrays not as long as the depths, or the depths changed within the
+    list)."""
+    fields = [profile_fields(m) for m in messages]
+    first = fields[0][0] if fields else ()
+    good = [(m, speed, torque) for m, (depths, speed, torque) in zip(messages, fields,
+                                                                     strict=True)
+            if depths and depths == first and len(speed) == len(torque) == len(depths)]
     if not good:
         return None
-    times = np.array([m.header.stamp.sec + m.header.stamp.nanosec / NS_PER_S for m in good])
-    return StringBatch(times, np.array([depth_of_joint(n) for n in good[0].name]),
-                       np.array([m.velocity for m in good], dtype=np.float64),
-                       np.array([m.effort for m in good], dtype=np.float64))
+    times = np.array([m.header.stamp.sec + m.header.stamp.nanosec / NS_PER_S
+                      for m, _, _ in good])
+    depths_m = [depth_of_joint(d) if isinstance(d, str) else float(d) for d in first]
+    return StringBatch(times, np.array(depths_m, dtype=np.float64),
+                       np.array([speed for _, speed, _ in good], dtype=np.float64),
+                       np.array([torque for _, _, torque in good], dtype=np.float64))
 
 
 def depth_axis_y(depths_m: np.ndarray) -> tuple[float, float]:

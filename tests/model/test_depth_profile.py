@@ -10,7 +10,12 @@ import numpy as np
 import pytest
 import yaml
 
-from drill_sim_ros.model.depth_profile import DepthSampler, depth_name, sample_depths_m
+from drill_sim_ros.model.depth_profile import (
+    DepthSampler,
+    Interpolation,
+    depth_name,
+    sample_depths_m,
+)
 from drill_sim_ros.model.errors import ParameterError
 from drill_sim_ros.model.params import RPM_PER_RAD_S
 from drill_sim_ros.model.presets import load_preset, preset_from_dict, preset_path
@@ -44,6 +49,41 @@ def test_sampler_interpolates_linearly_between_cell_middles() -> None:
     assert sample.stamp_ns == 7
     assert sampler.names == ["string_0010.0m", "string_0030.0m"]
     assert len(DepthSampler(cells, 40.0, 64).depths_m) == 4      # at most one per cell
+
+
+def test_interpolation_is_np_interp_bit_for_bit_and_reads_only_its_nodes() -> None:
+    rng = np.random.default_rng(4)
+    xp = np.cumsum(rng.uniform(0.1, 3.0, 50))
+    # between nodes, on nodes, on the ends and beyond them
+    x = np.concatenate((rng.uniform(xp[0] - 2.0, xp[-1] + 2.0, 200), xp[[0, 7, 49]],
+                        [xp[0] - 1.0, xp[-1] + 1.0]))
+    interpolation = Interpolation.at(x, xp)
+    for _ in range(5):
+        y = rng.normal(0.0, 1e3, xp.size) * rng.uniform(1e-6, 1e6)
+        assert np.array_equal(interpolation(y[interpolation.nodes]), np.interp(x, xp, y))
+    inner = Interpolation.at(np.array([2.5]), np.array([1.0, 2.0, 3.0, 4.0]))
+    np.testing.assert_array_equal(inner.nodes, [1, 2])
+
+
+def test_reading_the_sampled_cells_gives_the_full_profiles_values() -> None:
+    """After waves have run up and down the string (a speed step at the top), the cells a
+    sampler reads (Simulator.string_cells) hold what string_profile gives there, and the
+    samples equal np.interp of the whole profile, bit for bit."""
+    sim = session(string_rate_hz=10.0, string_depths=64, perturb_v=1e-2)
+    first = sim.run(20)
+    sim.set_surface_rpm(first.rows[-1][F["surface_rpm"]] * 1.3)
+    block = sim.run(230)
+    depth, speed, torque = sim.sim.string_profile()
+    sampler = DepthSampler(depth, load_preset(FIELD).string.length_m, 64)
+    cell_speed, cell_torque = sim.sim.string_cells(sampler.cells)
+    assert np.array_equal(cell_speed, speed[sampler.cells])
+    assert np.array_equal(cell_torque, torque[sampler.cells])
+    assert sampler.cells.size <= 128 < depth.size
+    last = block.strings[-1]
+    assert last.stamp_ns == sim.sim_time_ns
+    assert np.array_equal(last.speed_rad_s, np.interp(sampler.depths_m, depth, speed))
+    assert np.array_equal(last.torque_nm, np.interp(sampler.depths_m, depth, torque))
+    assert np.ptp(last.speed_rad_s) > 1e-3          # not a steady string
 
 
 def test_depth_names_and_count_range() -> None:

@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 
 from drill_sim_ros import topics
+from drill_sim_ros.model.presets import DEFAULT_PRESET, load_preset
 from tests.viz import expected as ex
 from tests.viz.bridge_process import BridgeProcess, private_topic, remap_telemetry
 from tests.viz.rrd_read import read_recording, view_origins
@@ -80,7 +81,14 @@ def test_sim_node_telemetry_reaches_the_rrd(tmp_path: Path) -> None:
     np.testing.assert_array_equal(logged.scalars()[t_logged >= start],
                                   heard[keep, F["bit_rpm"]])
     assert set(ex.SCALARS) <= set(read_recording(rrd))
-    # the default preset's string is distributed: its profiles at 10 Hz of sim time
+    # the default preset's string is distributed: its profiles at 10 Hz of sim time, as
+    # StringProfile (string.message typed, the default): over their depths in m, not the
+    # 0.1 m of JointState names
     bars = read_recording(rrd)["/string/speed"]
     assert len(bars.time_ns) >= 3 and np.all(bars.time_ns % 100_000_000 == 0)
+    length_m = load_preset(DEFAULT_PRESET).string.length_m
+    depths_m = (np.arange(64) + 0.5) * length_m / 64
+    assert not np.allclose(depths_m, np.round(depths_m, 1))
+    np.testing.assert_allclose(bars.columns["BarChart:abscissa"][-1][0]["buffer"], depths_m,
+                               rtol=1e-12)
     assert {"/string/depth_time", "/string/speed"} <= set(view_origins(rrd).values())
