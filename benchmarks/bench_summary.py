@@ -23,8 +23,11 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 RUNS = (
     ("kernel ns/step / the naive step", ["bench_kernel.py", "--repeats", "3"]),
-    ("sim_node, free run and real time (distributed, lumped, the bare publisher)",
-     ["bench_node.py"]),
+    ("sim_node on the distributed default: real time and free run against the bare "
+     "publisher; (e) the string profiles and the lumped twin",
+     ["bench_node.py", "--pairs", "2"]),
+    ("sim_node on the lumped twin against the bare publisher",
+     ["bench_node.py", "--preset", "field_8p5in_shale_lumped", "--pairs", "2"]),
     ("closed-loop bench in process, both strings",
      ["bench_closed_loop.py", "--dds-seconds", "0"]),
     ("gym steps/s per scenario", ["bench_gym.py"]),
