@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import contextlib
 import itertools
+import logging
 import math
 import os
 import signal
@@ -124,10 +125,13 @@ def connect(scheduler: str | None = None, workers: int | None = None) -> Iterato
     n = workers or os.cpu_count() or 1
     if not 1 <= n <= 1024:
         raise DrillSimError(f"--workers = {n} must be in [1, 1024]")
+    # silence_logs: CRITICAL, since a worker whose heartbeat meets the scheduler closing (after
+    # Ctrl-C) logs a traceback at ERROR; a point's failure reaches the user in its result
     with _deferred_interrupt() as interrupted:      # a half-started cluster cannot close
         cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
                                host=LOOPBACK, dashboard_address=f"{LOOPBACK}:0",
-                               worker_dashboard_address=f"{LOOPBACK}:0", silence_logs=40)
+                               worker_dashboard_address=f"{LOOPBACK}:0",
+                               silence_logs=logging.CRITICAL)
     with cluster, Client(cluster) as client:
         if interrupted:
             raise KeyboardInterrupt

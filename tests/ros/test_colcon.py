@@ -118,7 +118,11 @@ def test_sigterm_or_a_closed_terminal_ends_a_recording_run_cleanly(tmp_path, sig
         summary = make_reader(stream).get_summary()
     assert summary is not None and summary.statistics.message_count >= 20 * 9
     recorded = {channel.topic for channel in summary.channels.values()}
-    assert set(topics.MSG_TYPES) - set(topics.COMMANDS) <= recorded
+    # the default string.message is typed: the profiles go on the typed topic, not on the
+    # JointState one; every other standard topic is recorded
+    assert set(topics.MSG_TYPES) - set(topics.COMMANDS) - {topics.STRING_TORSION} <= recorded
+    assert topics.TYPED_STRING_TORSION in recorded
+    assert topics.STRING_TORSION not in recorded
 
 
 def test_a_hung_up_terminal_under_the_status_line_still_ends_the_run_cleanly(tmp_path):
