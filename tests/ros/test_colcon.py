@@ -73,9 +73,12 @@ def run_until_published(command: list[str], env: dict[str, str], stop: signal.Si
         proc = subprocess.Popen(command, env=env, stdout=subprocess.PIPE,
                                 stderr=subprocess.STDOUT, text=True)
         try:
-            published = ros.spin_until(lambda: probe.count(topics.TELEMETRY) >= 20, 60.0)
+            # a fresh install compiles its kernels cold (no numba cache yet): on a loaded
+            # 2-core machine that alone can take most of a minute, and a signal that comes
+            # during the compile is handled only after it
+            published = ros.spin_until(lambda: probe.count(topics.TELEMETRY) >= 20, 150.0)
             proc.send_signal(stop)
-            out, _ = proc.communicate(timeout=20)
+            out, _ = proc.communicate(timeout=90)
         finally:
             if proc.poll() is None:
                 proc.kill()
