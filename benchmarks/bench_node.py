@@ -254,7 +254,8 @@ def main() -> None:
     parser.add_argument("--real-time-only", action="store_true", help="(a) only")
     parser.add_argument("--preset", default="field_8p5in_shale")
     parser.add_argument("--rounds", type=int, default=2,
-                        help="(e) rounds of the string profile cases, alternated")
+                        help="(e) rounds of the string profile cases, alternated (0: skip "
+                        "them, e.g. on a lumped preset)")
     parser.add_argument("--strings-only", action="store_true", help="(e) only")
     parser.add_argument("--reference-publisher", metavar="PRESET", help=argparse.SUPPRESS)
     parser.add_argument("--reference-period", type=float, default=0.01, help=argparse.SUPPRESS)
@@ -301,7 +302,8 @@ def main() -> None:
         print(f"(c) free run, recording in process: achieved real-time factor "
               f"{rec['sim_rate']:.1f}x = {rec['sim_rate'] / free['sim_rate']:.2f} of (b); "
               f"CPU {rec['cpu_percent']:.0f} %")
-        string_profiles(listener, args.preset, args.seconds, args.rounds)
+        if args.rounds > 0:
+            string_profiles(listener, args.preset, args.seconds, args.rounds)
         watcher = Listener(telemetry=False)
         for case, spun in (("the subscriber process idle (its subscriptions matched, "
                             "nothing taken)", watcher), ("no subscriber", None)):

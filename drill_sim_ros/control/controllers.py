@@ -32,8 +32,9 @@ The references (Z, C, I, J, omega_1 from :mod:`drill_sim_ros.control.rig`):
   Why this form (docs/closed-loop.md): a high-pass of T fed to the setpoint (the previous
   designs) made the drive return up to 1.07 of every wave above 5 Hz (the zero-order hold
   and the stiff loop's lag turn its phase), pumping the collars' ring until the motor hit
-  its limit; a low-pass made it worse. Emulating an impedance that keeps a real inertia at
-  high frequency stays within 1 % of passive there.
+  its limit; a low-pass made it worse. Emulating an impedance stays within 0.6 % of
+  passive there, and a damper in series with it (``hold_margin``,
+  :meth:`SoftDrive.droop_per_nm_s`) makes it passive up to a sixth of the control rate.
 """
 
 from __future__ import annotations
@@ -170,25 +171,54 @@ class SoftDrive(TopDriveController):
     to the string torque is 1 / (J_v s + kp_d + ki_d / s). With J_v = J the emulated drive
     keeps the real inertia at high frequency and is passive at every frequency; a lighter
     J_v widens the band it absorbs, and the loop's zero-order hold (half a control period)
-    then makes it return slightly more than it receives above a few Hz (|r| up to 1.009
-    for J_v = J / 10 and 1.020 for J / 20 on the field drive, docs/closed-loop.md); the
-    motor must also supply (J / J_v - 1) times the virtual rotor's net torque, so a light
-    J_v drives the motor to its limit on the collars' ring that reaches the top. The
-    virtual state starts at the switch-on from the measured drive speed and torque (no
-    bump)."""
+    then makes it return slightly more than it receives above a few Hz, which a damper in
+    series with the emulated impedance takes back (:meth:`droop_per_nm_s`); the motor
+    must also supply (J / J_v - 1) times the virtual rotor's net torque, so a light J_v
+    drives the motor to its limit on the collars' ring that reaches the top. The virtual
+    state starts at the switch-on from the measured drive speed and torque (no bump)."""
 
     PARAMS: ClassVar[dict[str, str]] = {**TopDriveController.PARAMS,
               "inertia_fraction": "J_v / J, the emulated drive's inertia over the real one's",
               "tuned_rad_s": "where the emulated drive's reactance vanishes, rad/s (default "
-                             "omega_1)"}
+                             "omega_1)",
+              "hold_margin": "the series damper's admittance over the hold's deficit "
+                             "(P / 2)(1 / J_v - 1 / J) (default 2: passive up to a sixth of "
+                             "the control rate, past the collars' ring)"}
 
     def defaults(self) -> dict[str, float]:
         return {**super().defaults(), "inertia_fraction": 1.0,
-                "tuned_rad_s": self.rig.first_mode_rad_s}
+                "tuned_rad_s": self.rig.first_mode_rad_s, "hold_margin": 2.0}
 
     def reset(self) -> None:
         super().reset()
-        self._virtual: list[float] | None = None    # w_v, I_d, e, u
+        self._virtual: list[float] | None = None    # w_v, I_d, e, u, droop, last T
+
+    def droop_per_nm_s(self) -> tuple[float, float]:
+        """(admittance 1/b rad/(N m s), high-pass factor) of the series damper that keeps
+        the emulated drive passive under the zero-order hold.
+
+        The torque sub is sampled at the start of each period and held over it (a delay of
+        P / 2), while the real drive meets the string's torque at once. Compensating its
+        inertia J down to J_v with that late torque adds the admittance
+        -(sin wP/2 / w)(1 / J_v - 1 / J) to the drive's, negative real, so above a few Hz,
+        where the virtual inertia hides the damper kp_d, the drive returns
+        1 + 2 Z (P / 2)(1 / J_v - 1 / J) of a wave (1.0041 for soft_torque and 1.0058 for
+        z_torque on the field drive: what was measured). A damper b in series with the
+        emulated impedance adds the real admittance 1 / b, but it acts through the same
+        hold and the period's speed ramp, a delay P: cos(wP) / b. With 1 / b = m times that
+        deficit (m = hold_margin) the drive is passive while m cos(wP) > 1, up to
+        arccos(1 / m) / (2 pi P): 16.7 Hz for m = 2 at 100 Hz, past the collars' ring
+        (c / L = 15.9 Hz on the field string). Above that no sampled correction helps:
+        anything computed from the samples lags by more than 90 degrees near the Nyquist
+        rate, and the drive's own instant damper kp adds only kp / (w J)^2 there
+        (docs/closed-loop.md). It is high-passed well below the first mode (corner
+        omega_1 / 10), so it yields to a torque change but not to the mean torque: no
+        steady speed droop."""
+        j_v, _, _ = self.virtual_gains()
+        deficit = 0.5 * self.period_s * max(1.0 / j_v - 1.0 / self.rig.drive_inertia_kg_m2,
+                                            0.0)
+        corner = 0.1 * self.params["tuned_rad_s"]
+        return self.params["hold_margin"] * deficit, 1.0 / (1.0 + corner * self.period_s)
 
     def virtual_gains(self) -> tuple[float, float, float]:
         """(J_v kg m^2, kp_d N m s, ki_d N m) of the emulated drive."""
@@ -207,21 +237,23 @@ class SoftDrive(TopDriveController):
             return nominal_rad_s
         j_v, kp_d, ki_d = self.virtual_gains()
         kp, ki = self.inner_gains()
+        p, t_nm = self.period_s, m.string_torque_nm
         if self._virtual is None:                  # start where the drive is, at rest
             w0 = m.drive_speed_rad_s
-            self._virtual = [w0, m.string_torque_nm - kp_d * (nominal_rad_s - w0), 0.0,
-                             m.string_torque_nm]
-        w_v, i_d, e, u_old = self._virtual
-        p, t_nm = self.period_s, m.string_torque_nm
+            self._virtual = [w0, t_nm - kp_d * (nominal_rad_s - w0), 0.0, t_nm, 0.0, t_nm]
+        w_v, i_d, e, u_old, droop_old, t_old = self._virtual
         err = nominal_rad_s - w_v
         i_d += ki_d * err * p
         tau_v = min(max(kp_d * err + i_d, -self.rig.max_torque_nm), self.rig.max_torque_nm)
         accel = (tau_v - t_nm) / j_v
         w_v += accel * p
-        u = t_nm + self.rig.drive_inertia_kg_m2 * accel   # what the real drive must apply
+        admittance, keep = self.droop_per_nm_s()
+        droop = keep * (droop_old + admittance * (t_nm - t_old))  # high-passed T / b
+        # what the real drive must apply to move as w_v - droop
+        u = t_nm + self.rig.drive_inertia_kg_m2 * (accel - (droop - droop_old) / p)
         e = (e + (u - u_old) / kp) / (1.0 + ki * p / kp)  # through the inverse of its loop
-        self._virtual = [w_v, i_d, e, u]
-        return w_v + e
+        self._virtual = [w_v, i_d, e, u, droop, t_nm]
+        return w_v - droop + e
 
 
 class SoftTorque(SoftDrive):

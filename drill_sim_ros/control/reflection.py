@@ -58,16 +58,17 @@ def _top_waves_through_bench(scenario: Scenario, preset: Preset, pulse: bool,
 def measure_reflection_with(preset_name: str, controller: str, mode: str = "speed",
                             seconds: float = 120.0, control_rate_hz: float = 100.0,
                             settle_s: float = 30.0,
-                            f_hz: np.ndarray | None = None) -> si.Reflection:
-    """|r| of the drive with ``controller`` in the loop (``mode``: speed or torque), after
-    ``settle_s`` off bottom for the controller to come to rest; no analytic curve (the
-    controller is a sampled, filtered law)."""
+                            f_hz: np.ndarray | None = None,
+                            params: dict[str, float] | None = None) -> si.Reflection:
+    """|r| of the drive with ``controller`` (its ``params`` overriding the defaults) in the
+    loop (``mode``: speed or torque), after ``settle_s`` off bottom for the controller to
+    come to rest; no analytic curve (the controller is a sampled, filtered law)."""
     f_hz = si.reflection_frequencies() if f_hz is None else f_hz
     preset = load_preset(preset_name)
     si.require_distributed(preset)
     scenario = Scenario(preset=preset_name, controller=controller, mode=mode,
                         duration_s=settle_s + seconds, enable_at_s=0.0,
-                        control_rate_hz=control_rate_hz)
+                        control_rate_hz=control_rate_hz, params=dict(params or {}))
     settle = round(settle_s * control_rate_hz)
     ratio = si.reflection_of(
         lambda pulse: _top_waves_through_bench(scenario, preset, pulse, settle),
