@@ -107,9 +107,12 @@ class TopDriveController:
         return {key: float(value) for key, value in params.items()}
 
     def reset(self) -> None:
-        """Forget all state (filters, loop integral, counters)."""
+        """Forget all state (filters, loop integral, counters). In torque mode, load the
+        compiled loop now, so that the first control period is not charged with it."""
         self._integral_nm: float | None = None
         self.clamped_commands = 0
+        if self.mode == "torque":
+            speed_loop(0.0, 0.0, 0.0, 1.0, 1.0, 1.0, self.period_s)
 
     def reference_rad_s(self, m: SurfaceMeasurement, nominal_rad_s: float) -> float:
         """The speed reference from the measurement (called every period, also before the
