@@ -31,6 +31,10 @@ def add_parser(sub: Any) -> None:
                    "(tcp://HOST:PORT); default: a local cluster on 127.0.0.1")
     p.add_argument("--workers", type=int, default=None,
                    help="local worker processes (default: one per core)")
+    p.add_argument("--ensemble", type=int, default=1, metavar="N",
+                   help="run every controller x scenario N times (1-64), member k with the "
+                        "bit's sigma l x (1 + k 1e-12): the spread of a chaotic case; "
+                        "member 0 is the plain run (default 1)")
     p.add_argument("--no-pictures", action="store_true",
                    help="skip the report's pictures (matplotlib)")
 
@@ -41,7 +45,8 @@ def cmd_suite(args: argparse.Namespace) -> int:
     controllers = args.controller or list(suite.DEFAULT_CONTROLLERS)
     for name in controllers:
         controller_class(name)                     # a bad name fails here, in one line
-    entries = suite.entries(suite.scenario_files(args.scenario or ()), controllers, args.mode)
+    entries = suite.ensemble(suite.entries(suite.scenario_files(args.scenario or ()),
+                                           controllers, args.mode), args.ensemble)
     line = StatusLine()
     def progress(done: int, total: int) -> None:
         line.show(f"drill_sim suite: {done}/{total} runs")
@@ -59,7 +64,11 @@ def cmd_suite(args: argparse.Namespace) -> int:
               "the same command to resume")
         return 130
     wall_s = time.perf_counter() - start
-    print(suite_report.format_table(entries, result.results))
+    print(suite_report.format_table(suite_report.plain(entries), result.results))
+    if args.ensemble > 1:
+        print(f"\nthe ensemble of {args.ensemble} members (member k: the bit's sigma l x "
+              f"(1 + k {suite.ENSEMBLE_STEP:g})):")
+        print(suite_report.format_ensemble_table(entries, result.results))
     written = suite_report.write_outputs(args.out, entries, result.results, wall_s,
                                          pictures=not args.no_pictures)
     print(f"drill_sim suite: {len(entries)} runs ({result.computed} computed now) in "

@@ -16,7 +16,7 @@ import xarray as xr
 
 from drill_sim_ros import __version__
 from drill_sim_ros.control.scorecard import status_text
-from drill_sim_ros.study.suite import Entry, EntryResult
+from drill_sim_ros.study.suite import ENSEMBLE_KEY, ENSEMBLE_STEP, Entry, EntryResult
 
 # (card key, column head, format) of the table
 COLUMNS = (("ssi_mean", "SSI after", ".3f"), ("stick_fraction", "stick frac", ".3f"),
@@ -62,12 +62,18 @@ HEADS = ("scenario", "controller", *(head for _, head, _ in COLUMNS), "status")
 
 def format_table(entries: Sequence[Entry], results: dict[str, EntryResult]) -> str:
     """The table as aligned text, a blank line between scenarios."""
-    rows = table_rows(entries, results)
-    widths = [max(len(h), *(len(r[i]) for r in rows)) for i, h in enumerate(HEADS)]
+    return _aligned(HEADS, table_rows(entries, results), last_left=True)
+
+
+def _aligned(heads: Sequence[str], rows: list[list[str]], last_left: bool) -> str:
+    """``rows`` under ``heads`` as aligned text: the first two columns (and the last, if
+    ``last_left``) to the left, the rest to the right; a blank line between scenarios."""
+    widths = [max(len(h), *(len(r[i]) for r in rows)) for i, h in enumerate(heads)]
     def line(cells: Sequence[str]) -> str:
-        return "  ".join(c.ljust(w) if i < 2 or i == len(cells) - 1 else c.rjust(w)
+        return "  ".join(c.ljust(w) if i < 2 or (last_left and i == len(cells) - 1)
+                         else c.rjust(w)
                          for i, (c, w) in enumerate(zip(cells, widths, strict=True))).rstrip()
-    out, last = [line(HEADS)], None
+    out, last = [line(heads)], None
     for row in rows:
         if last is not None and row[0] != last:
             out.append("")
@@ -77,18 +83,75 @@ def format_table(entries: Sequence[Entry], results: dict[str, EntryResult]) -> s
 
 
 def markdown_table(entries: Sequence[Entry], results: dict[str, EntryResult]) -> str:
-    rows = table_rows(entries, results)
-    lines = ["| " + " | ".join(HEADS[1:]) + " |", "|" + "---|" * (len(HEADS) - 1)]
+    return _markdown(HEADS, table_rows(entries, results))
+
+
+def _markdown(heads: Sequence[str], rows: list[list[str]]) -> str:
+    """``rows`` as a markdown table without the scenario column."""
+    lines = ["| " + " | ".join(heads[1:]) + " |", "|" + "---|" * (len(heads) - 1)]
     lines += ["| " + " | ".join(row[1:]) + " |" for row in rows]
     return "\n".join(lines)
+
+
+# ---- an ensemble (suite --ensemble N): each entry's members summarised -----------------------
+ENSEMBLE_HEADS = ("scenario", "controller", "runs", "stick-slip/ok/stalled/other",
+                  "SSI after: median (range)", "stick frac: median (range)",
+                  "at limit: median (max)")
+
+
+def members_of(entries: Sequence[Entry]) -> int:
+    """How many members the ensemble of ``entries`` has (1: a plain suite)."""
+    return 1 + max((e.member for e in entries), default=0)
+
+
+def plain(entries: Sequence[Entry]) -> list[Entry]:
+    """The entries of member 0: the scenarios as they are (the plain table's)."""
+    return [e for e in entries if e.member == 0]
+
+
+def ensemble_rows(entries: Sequence[Entry], results: dict[str, EntryResult]
+                  ) -> list[list[str]]:
+    """One row per scenario and controller over all of its members that ran."""
+    cards: dict[tuple[str, str], list[dict[str, Any]]] = {}
+    for e in entries:
+        group = cards.setdefault((e.scenario_name, _label(e)), [])
+        if e.key in results:
+            group.append(results[e.key].card)
+    rows = []
+    for (name, label), group in cards.items():
+        kinds = [status_text(card).split()[0] for card in group]
+        counts = [kinds.count(k) for k in ("stick-slip", "ok", "stalled")]
+        counts.append(len(kinds) - sum(counts))
+        limit = _finite(card.get("saturation_fraction") for card in group)
+        rows.append([name, label, str(len(group)), " / ".join(map(str, counts)),
+                     _spread(card.get("ssi_mean") for card in group),
+                     _spread(card.get("stick_fraction") for card in group),
+                     f"{np.median(limit):.1%} ({max(limit):.1%})" if limit else "-"])
+    return rows
+
+
+def _finite(values: Any) -> list[float]:
+    return [float(v) for v in values if isinstance(v, (int, float)) and math.isfinite(v)]
+
+
+def _spread(values: Any) -> str:
+    """median (min-max) of the finite ``values``; - if none."""
+    x = _finite(values)
+    return f"{np.median(x):.2f} ({min(x):.2f}-{max(x):.2f})" if x else "-"
+
+
+def format_ensemble_table(entries: Sequence[Entry], results: dict[str, EntryResult]) -> str:
+    return _aligned(ENSEMBLE_HEADS, ensemble_rows(entries, results), last_left=False)
 
 
 def suite_json(entries: Sequence[Entry], results: dict[str, EntryResult],
                wall_s: float) -> dict[str, Any]:
     return {"package_version": __version__, "wall_s": wall_s,
             "created_utc": datetime.now(UTC).isoformat(timespec="seconds"),
+            "ensemble": {"members": members_of(entries), "step": ENSEMBLE_STEP,
+                         "seeded": ENSEMBLE_KEY},
             "entries": [{"scenario": e.scenario_name, "controller": e.controller,
-                         "mode": e.scenario.mode,
+                         "mode": e.scenario.mode, "member": e.member,
                          "status": status_text(results[e.key].card) if e.key in results
                          else "not run",
                          "score": _clean(results[e.key].card) if e.key in results else None,
@@ -105,10 +168,13 @@ def _clean(value: Any) -> Any:
 
 
 def suite_dataset(entries: Sequence[Entry], results: dict[str, EntryResult]) -> xr.Dataset:
-    """The table over (scenario, controller): each figure, and the status as text."""
+    """The table over (scenario, controller), of member 0: each figure, and the status as
+    text; with an ensemble, the same over (scenario, controller, member) as ``ensemble_*``
+    variables."""
     scenarios = list(dict.fromkeys(e.scenario_name for e in entries))
     controllers = list(dict.fromkeys(_label(e) for e in entries))
-    shape = (len(scenarios), len(controllers))
+    members = members_of(entries)
+    shape = (len(scenarios), len(controllers), members)
     data = {name: np.full(shape, np.nan) for name in NUMERIC}
     status = np.full(shape, "not run", dtype=object)
     for e in entries:
@@ -116,18 +182,27 @@ def suite_dataset(entries: Sequence[Entry], results: dict[str, EntryResult]) -> 
         result = results.get(e.key)
         if result is None:
             continue
-        status[i, j] = status_text(result.card)
+        status[i, j, e.member] = status_text(result.card)
         for name in NUMERIC:
             value = result.wall_s if name == "wall_s" else result.card.get(name)
             if isinstance(value, (int, float)) and value is not None:
-                data[name][i, j] = float(value)
+                data[name][i, j, e.member] = float(value)
     dims = ("scenario", "controller")
-    variables = {name: (dims, values, {"units": UNITS.get(name, "1")})
+    variables = {name: (dims, values[..., 0], {"units": UNITS.get(name, "1")})
                  for name, values in data.items()}
-    variables["status"] = (dims, status.astype(str))
-    return xr.Dataset(variables, coords={"scenario": scenarios, "controller": controllers},
+    variables["status"] = (dims, status[..., 0].astype(str))
+    coords: dict[str, Any] = {"scenario": scenarios, "controller": controllers}
+    if members > 1:
+        edims = (*dims, "member")
+        variables.update({f"ensemble_{name}": (edims, values, {"units": UNITS.get(name, "1")})
+                          for name, values in data.items()})
+        variables["ensemble_status"] = (edims, status.astype(str))
+        coords["member"] = np.arange(members)
+    return xr.Dataset(variables, coords=coords,
                       attrs={"title": "drill_sim suite: controllers x scenarios",
-                             "package_version": __version__})
+                             "package_version": __version__,
+                             "ensemble_members": members, "ensemble_step": ENSEMBLE_STEP,
+                             "ensemble_seeded": ENSEMBLE_KEY})
 
 
 def write_outputs(out: Path, entries: Sequence[Entry], results: dict[str, EntryResult],
@@ -137,7 +212,7 @@ def write_outputs(out: Path, entries: Sequence[Entry], results: dict[str, EntryR
     (out / "suite.json").write_text(json.dumps(suite_json(entries, results, wall_s), indent=1))
     suite_dataset(entries, results).to_netcdf(out / "suite.nc", engine="h5netcdf")
     written = [out / "suite.json", out / "suite.nc"]
-    images = draw_pictures(out, entries, results) if pictures else {}
+    images = draw_pictures(out, plain(entries), results) if pictures else {}
     (out / "report.md").write_text(report_markdown(entries, results, images, wall_s))
     return [*written, *images.values(), out / "report.md"]
 
@@ -183,10 +258,17 @@ def report_markdown(entries: Sequence[Entry], results: dict[str, EntryResult],
              "ringing, HFTO), mean ROP, MSE at the bit, time from the switch-on to the last "
              "stick (- while it still sticks in the last 20 s), share of samples with the "
              "motor torque at its limit, status.", ""]
+    members = members_of(entries)
+    if members > 1:
+        lines += [f"Each table is member 0, the scenario as it is. Below it, the ensemble of "
+                  f"{members} members: member k with the bit's sigma l x (1 + k "
+                  f"{ENSEMBLE_STEP:g}), the same for every controller.", ""]
     for name, group in _by_scenario(entries).items():
         scenario = group[0].scenario
         lines += [f"## {name}", "", scenario.description or "", "",
-                  markdown_table(group, results), ""]
+                  markdown_table(plain(group), results), ""]
+        if members > 1:
+            lines += [_markdown(ENSEMBLE_HEADS, ensemble_rows(group, results)), ""]
         if name in images:
             lines += [f"![{name}]({images[name].name})", ""]
     return "\n".join(lines)
