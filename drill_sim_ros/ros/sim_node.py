@@ -16,6 +16,7 @@ node's :class:`HandoffLock` before touching the session, the schedule or the rec
 
 from __future__ import annotations
 
+import faulthandler
 import gc
 import json
 import math
@@ -801,6 +802,9 @@ def main(args: list[str] | None = None) -> int:
     # A closed terminal (SIGHUP) stops the node like Ctrl-C or SIGTERM, so the recording is
     # finished instead of cut off without its summary.
     signal.signal(signal.SIGHUP, lambda *_: rclpy.try_shutdown())
+    # `kill -USR1 <pid>` prints every thread's stack to stderr: where a node that does not
+    # stop is waiting (tests/ros/test_colcon.py asks for it before it gives up on a node)
+    faulthandler.register(signal.SIGUSR1, all_threads=True)
     node = None
     try:
         node = SimNode()

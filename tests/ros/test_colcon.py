@@ -78,7 +78,15 @@ def run_until_published(command: list[str], env: dict[str, str], stop: signal.Si
             # during the compile is handled only after it
             published = ros.spin_until(lambda: probe.count(topics.TELEMETRY) >= 20, 150.0)
             proc.send_signal(stop)
-            out, _ = proc.communicate(timeout=90)
+            try:
+                out, _ = proc.communicate(timeout=90)
+            except subprocess.TimeoutExpired:
+                proc.send_signal(signal.SIGUSR1)     # sim_node dumps its threads' stacks
+                with contextlib.suppress(subprocess.TimeoutExpired):
+                    proc.communicate(timeout=5)
+                proc.kill()
+                out, _ = proc.communicate()
+                pytest.fail(f"no exit within 90 s of {stop.name}; its threads:\n{out[-6000:]}")
         finally:
             if proc.poll() is None:
                 proc.kill()

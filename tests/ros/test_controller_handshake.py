@@ -226,8 +226,12 @@ def test_two_controllers_at_once_advance_the_sim_once_per_sample(tmp_path):
         watch = Watch(ros)
         record, log, sim_cm = sim_and_watch(tmp_path, PATIENT_WARN_S)
         with sim_cm as sim:
-            sent = sum(watch.report(r)["sent"] for r in reports)
-            assert sent > PERIODS
+            answered = [watch.report(r)["sent"] for r in reports]
+            sent = sum(answered)
+            # both answer every sample they take; on a loaded machine a late one finds the
+            # next sample already (depth 1) and the two may take turns, so duplicates are
+            # likely but not certain: every answer beyond one per sample is stale
+            assert sent >= PERIODS and min(answered) > 0, answered
             last = watch.count("stale_commands", sent - PERIODS)
             rows = finish(sim, log, record, [one, two])
     assert last["command_publishers"] == "2" and last["lost_commands"] == "0"
