@@ -18,9 +18,17 @@ from drill_sim_ros.archive.output import (
 from drill_sim_ros.control.bench import ClosedLoopRun, run_in_process
 from drill_sim_ros.control.controllers import CONTROL_MODES
 from drill_sim_ros.control.rig import RigPhysics, rig_physics
-from drill_sim_ros.control.scenario import Scenario, load_scenario, scenario_path
+from drill_sim_ros.control.scenario import (
+    ENSEMBLE_KEY,
+    ENSEMBLE_STEP,
+    Scenario,
+    check_ensemble,
+    load_scenario,
+    scenario_path,
+    seeded,
+)
 from drill_sim_ros.control.schedule import Schedule
-from drill_sim_ros.control.scorecard import SCORE_FIELDS, score, status_text
+from drill_sim_ros.control.scorecard import SCORE_FIELDS, score, status_text, summarize
 from drill_sim_ros.model.errors import DrillSimError
 from drill_sim_ros.model.presets import Preset
 from drill_sim_ros.terminal import StatusLine
@@ -64,6 +72,10 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--overwrite", action="store_true", help="replace an existing --plot file")
     p.add_argument("--no-baseline", action="store_true", help="skip the uncontrolled run "
                    "(by default it runs too, for the comparison)")
+    p.add_argument("--ensemble", type=int, default=1, metavar="N",
+                   help="also run N - 1 more members of the same case, member k with the "
+                        "bit's sigma l x (1 + k 1e-12), and print the spread of the scores "
+                        "(in process; 1-64, default 1: one run)")
     p.add_argument("--ros", action="store_true", help="run sim_node and the "
                    "top_drive_controller node as processes over loopback DDS, score the "
                    "recording")
@@ -81,7 +93,7 @@ def _scenario(args: argparse.Namespace) -> Scenario:
         if not sep or not name.strip() or not math.isfinite(params[name.strip()]):
             raise DrillSimError(f"--set {item!r} must be NAME=NUMBER (a finite number)")
     enable_at_s = args.enable_at
-    if enable_at_s is None and args.t_end is not None and args.t_end < base.enable_at_s:
+    if enable_at_s is None and args.t_end is not None and args.t_end <= base.enable_at_s:
         enable_at_s = args.t_end / 3.0          # a short run: switch on after a third
     return base.with_(preset=args.params, controller=args.controller, mode=args.mode,
                       duration_s=args.t_end, enable_at_s=enable_at_s, params=params)
@@ -135,7 +147,14 @@ def _plot_target(path: Path | None, overwrite: bool) -> Path | None:
 
 
 def cmd_closed_loop(args: argparse.Namespace) -> int:
+    check_ensemble(args.ensemble)
+    if args.ensemble > 1 and args.ros:
+        raise DrillSimError("--ensemble runs in process; drop --ros (or --ensemble)")
     scenario = _scenario(args)
+    if scenario.enable_at_s >= scenario.duration_s:
+        raise DrillSimError(f"--enable-at = {scenario.enable_at_s:g} s must come before the "
+                            f"end of the run (--t-end = {scenario.duration_s:g} s): nothing "
+                            "would be scored after the switch-on")
     preset = scenario.load_preset()
     plot_tmp = _plot_target(args.plot, args.overwrite)
     try:
@@ -161,20 +180,68 @@ def _baseline(args: argparse.Namespace, scenario: Scenario) -> ClosedLoopRun | N
                 "no control")
 
 
+def _members(args: argparse.Namespace, scenario: Scenario, label: str,
+             columns: dict[str, dict[str, Any]]) -> dict[str, list[dict[str, Any]]] | None:
+    """Every column's scorecards over the ensemble: member 0 (the run above) and members
+    1 .. N - 1 run here (``control.scenario.seeded``); None after Ctrl-C."""
+    preset = scenario.load_preset()
+    rig, schedule = rig_physics(preset), scenario.setpoints(preset)
+    cases = {label: scenario}
+    if "no control" in columns:
+        cases["no control"] = scenario.with_(controller="none", mode="speed", params={})
+    cards: dict[str, list[dict[str, Any]]] = {name: [columns[name]] for name in cases}
+    for member in range(1, args.ensemble):
+        for name, case in cases.items():
+            run = _run(seeded(case, member), False, f"{name}, member {member} of "
+                       f"{args.ensemble - 1}")
+            if run.interrupted:
+                _interrupted(run)
+                return None
+            cards[name].append(score(run.rows, case.enable_at_s, schedule, rig,
+                                     case.period_s))
+    return cards
+
+
+ENSEMBLE_ROWS = (("runs", "runs"), ("counts", "stick-slip / ok / stalled / other"),
+                 ("ssi_mean", "SSI after: median (range)"),
+                 ("ssi_last", "SSI last 20 s: median (range)"),
+                 ("stick_fraction", "stick fraction: median (range)"),
+                 ("saturation_fraction", "at the torque limit: median (max)"))
+
+
+def _ensemble_table(members: dict[str, list[dict[str, Any]]]) -> str:
+    cells = {name: summarize(cards) for name, cards in members.items()}
+    names = sorted(cells, key=lambda n: n != "no control")
+    lines = [f"{'':34s}" + "".join(f"{n:>24s}" for n in names)]
+    lines += [f"{head:34s}" + "".join(f"{cells[n][key]:>24s}" for n in names)
+              for key, head in ENSEMBLE_ROWS]
+    return "\n".join(lines)
+
+
 def _print_scores(args: argparse.Namespace, scenario: Scenario,
-                  columns: dict[str, dict[str, Any]], label: str, wall_s: float) -> None:
-    """The scorecards as one JSON object (``--json``) or as a table and the run's speed."""
+                  columns: dict[str, dict[str, Any]], label: str, wall_s: float,
+                  members: dict[str, list[dict[str, Any]]] | None = None) -> None:
+    """The scorecards as one JSON object (``--json``) or as a table and the run's speed;
+    with an ensemble, its members' scorecards (JSON) or their spread (table)."""
     rate = scenario.periods / wall_s if wall_s > 0 else math.nan
     if args.json:
-        print(json.dumps({"scenario": scenario.to_dict(), "path": "ros" if args.ros else
-                          "in-process", "periods": scenario.periods,
-                          "periods_per_s": rate, "score": columns[label],
-                          "baseline": columns.get("no control")}))
-    else:
-        print(_table(columns))
-        print(f"{scenario.periods:,} periods of {scenario.period_s * 1e3:g} ms "
-              f"{'over DDS' if args.ros else 'in process'}: {rate:,.0f} periods/s "
-              f"({rate * scenario.period_s:,.0f}x real time)")
+        out = {"scenario": scenario.to_dict(), "path": "ros" if args.ros else "in-process",
+               "periods": scenario.periods, "periods_per_s": rate, "score": columns[label],
+               "baseline": columns.get("no control")}
+        if members is not None:
+            out["ensemble"] = {"members": args.ensemble, "step": ENSEMBLE_STEP,
+                               "seeded": ENSEMBLE_KEY, "score": members[label],
+                               "baseline": members.get("no control")}
+        print(json.dumps(out))
+        return
+    print(_table(columns))
+    print(f"{scenario.periods:,} periods of {scenario.period_s * 1e3:g} ms "
+          f"{'over DDS' if args.ros else 'in process'}: {rate:,.0f} periods/s "
+          f"({rate * scenario.period_s:,.0f}x real time)")
+    if members is not None:
+        print(f"\nthe ensemble of {args.ensemble} members (member 0: the run above; member k: "
+              f"the bit's sigma l x (1 + k {ENSEMBLE_STEP:g})):")
+        print(_ensemble_table(members))
 
 
 def _write_plot(args: argparse.Namespace, plot_tmp: Path, title: str, scenario: Scenario,
@@ -207,7 +274,10 @@ def _closed_loop(args: argparse.Namespace, scenario: Scenario, preset: Preset,
     runs[label] = controlled
     columns = {name: score(run.rows, scenario.enable_at_s, schedule, rig, scenario.period_s)
                for name, run in runs.items()}
-    _print_scores(args, scenario, columns, label, controlled.wall_s)
+    members = _members(args, scenario, label, columns) if args.ensemble > 1 else None
+    if members is None and args.ensemble > 1:
+        return 130
+    _print_scores(args, scenario, columns, label, controlled.wall_s, members)
     if plot_tmp is not None:
         _write_plot(args, plot_tmp, f"{preset.name}: {label}, switched on at "
                     f"{scenario.enable_at_s:g} s", scenario, runs, columns, schedule, rig)

@@ -13,8 +13,9 @@ import pytest
 
 from drill_sim_ros.closed_loop_cli import LABELS
 from drill_sim_ros.control.bench import run_in_process
-from drill_sim_ros.control.scenario import Scenario
-from drill_sim_ros.control.scorecard import SCORE_FIELDS
+from drill_sim_ros.control.rig import rig_physics
+from drill_sim_ros.control.scenario import Scenario, seeded
+from drill_sim_ros.control.scorecard import SCORE_FIELDS, score
 from drill_sim_ros.model.telemetry import TELEMETRY_INDEX
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -96,6 +97,10 @@ def test_user_controller_by_module_and_class(tmp_path: Path) -> None:
         (("--t-end", "10", "--enable-at", "20"), "enable_at_s"),
         (("--set", "impedance_factor=x"), "impedance_factor"),
         (("--controller", "soft_torque", "--set", "gain=1"), "gain"),
+        (("--t-end", "30", "--enable-at", "30"), "--enable-at"),
+        (("--ensemble", "0"), "--ensemble"),
+        (("--ensemble", "65"), "--ensemble"),
+        (("--ensemble", "2", "--ros"), "--ensemble"),
     ],
 )
 def test_bad_input_is_one_line(args: tuple[str, ...], names: str) -> None:
@@ -103,3 +108,26 @@ def test_bad_input_is_one_line(args: tuple[str, ...], names: str) -> None:
     assert result.returncode == 2
     assert result.stderr.count("\n") == 1 and names in result.stderr, result.stderr
     assert "Traceback" not in result.stderr
+
+
+def test_an_ensemble_scores_its_members_as_the_bench_does() -> None:
+    """--ensemble 3: member 0 is the run printed as ``score``, and member 2, run by the
+    command, is the bench's own run of the scenario with the bit's sigma l x (1 + 2e-12);
+    the uncontrolled column has its members too."""
+    result = drill_sim("--controller", "soft_torque", "--t-end", "60", "--ensemble", "3",
+                       "--json")
+    assert result.returncode == 0, result.stderr
+    doc = json.loads(result.stdout.splitlines()[-1])
+    members, baseline = doc["ensemble"]["score"], doc["ensemble"]["baseline"]
+    assert len(members) == len(baseline) == 3 and doc["ensemble"]["step"] == 1e-12
+    assert members[0] == doc["score"] and baseline[0] == doc["baseline"]
+    scenario = seeded(Scenario(controller="soft_torque", duration_s=60.0, enable_at_s=20.0), 2)
+    preset = scenario.load_preset()
+    card = score(run_in_process(scenario).rows, scenario.enable_at_s,
+                 scenario.setpoints(preset), rig_physics(preset), scenario.period_s)
+    for key in ("ssi_mean", "stick_fraction", "rop_m_h", "saturation_fraction", "hfto_rms_rpm"):
+        assert members[2][key] == pytest.approx(card[key], rel=1e-12), key
+    table = drill_sim("--controller", "soft_torque", "--t-end", "30", "--ensemble", "2")
+    assert table.returncode == 0, table.stderr
+    assert "the ensemble of 2 members" in table.stdout
+    assert "stick-slip / ok / stalled / other" in table.stdout

@@ -266,3 +266,37 @@ def scenario_path(name_or_path: str | Path) -> Path:
 
 def save_scenario(scenario: Scenario, path: str | Path) -> None:
     Path(path).write_text(yaml.safe_dump(scenario.to_dict(), sort_keys=False))
+
+
+# ---- ensembles: one case, independent realisations of its chaos ----------------------------
+# member k of an ensemble runs with the bit's sigma l x (1 + k ENSEMBLE_STEP): no bit's wear is
+# known to a part in 1e12, so every member is the same case, and a chaotic stick-slip grows
+# the difference into an independent realisation (docs/league.md)
+ENSEMBLE_STEP = 1e-12
+ENSEMBLE_KEY = "contact_stress_times_wearflat_n_per_m"
+MAX_ENSEMBLE = 64
+
+
+def check_ensemble(members: Any) -> int:
+    """``--ensemble N``: an integer in [1, MAX_ENSEMBLE]."""
+    if isinstance(members, bool) or not isinstance(members, int) or \
+            not 1 <= members <= MAX_ENSEMBLE:
+        raise ParameterError(f"--ensemble {members!r} must be an integer in [1, "
+                             f"{MAX_ENSEMBLE}]")
+    return members
+
+
+def seeded(scenario: Scenario, member: int) -> Scenario:
+    """Member ``member`` of an ensemble of ``scenario``: its preset's sigma l (after the
+    scenario's own overrides) x (1 + member ENSEMBLE_STEP), as an override; member 0 is
+    ``scenario`` itself."""
+    if member == 0:
+        return scenario
+    physical = scenario.load_preset().physical
+    if physical is None:
+        raise ParameterError(f"--ensemble: preset {scenario.preset!r} is dimensionless; an "
+                             "ensemble seeds the bit's sigma l of a physical preset")
+    sigma_l = physical.contact_stress_times_wearflat_n_per_m * (1.0 + member * ENSEMBLE_STEP)
+    own = dict(scenario.overrides.get("physical", {}))
+    return scenario.with_(overrides={**scenario.overrides,
+                                     "physical": {**own, ENSEMBLE_KEY: sigma_l}})

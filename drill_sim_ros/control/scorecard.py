@@ -209,3 +209,29 @@ def status_text(card: dict[str, Any]) -> str:
     if status == "fault":
         return f"fault at {card['fault_time_s']:.2f} s"
     return status
+
+
+def summarize(cards: list[dict[str, Any]]) -> dict[str, str]:
+    """Several scorecards of one case (an ensemble's members) in a few cells: the runs, how
+    many read stick-slip / ok / stalled / other, and median (min-max) of the SSI after the
+    switch-on, of the SSI of the last 20 s and of the stick fraction, and median (max) of
+    the share at the torque limit; ``-`` where no card has a finite value."""
+    kinds = [status_text(card).split(" ")[0] for card in cards]
+    counts = [kinds.count(kind) for kind in ("stick-slip", "ok", "stalled")]
+    counts.append(len(kinds) - sum(counts))
+    limit = _finite(card.get("saturation_fraction") for card in cards)
+    return {"runs": str(len(cards)), "counts": " / ".join(map(str, counts)),
+            "ssi_mean": _spread(card.get("ssi_mean") for card in cards),
+            "ssi_last": _spread(card.get("ssi_last") for card in cards),
+            "stick_fraction": _spread(card.get("stick_fraction") for card in cards),
+            "saturation_fraction": f"{np.median(limit):.1%} ({max(limit):.1%})" if limit
+                                   else "-"}
+
+
+def _finite(values: Any) -> list[float]:
+    return [float(v) for v in values if isinstance(v, (int, float)) and math.isfinite(v)]
+
+
+def _spread(values: Any) -> str:
+    x = _finite(values)
+    return f"{np.median(x):.2f} ({min(x):.2f}-{max(x):.2f})" if x else "-"

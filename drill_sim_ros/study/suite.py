@@ -12,7 +12,7 @@ A scenario that needs a feature the model core does not have yet is not run: its
 carry the status ``needs <feature>``.
 
 An ensemble (``drill_sim suite --ensemble N``) runs each entry N times, member k with the
-bit's contact stress x wearflat sigma l scaled by 1 + k ENSEMBLE_STEP (:func:`seeded`): a
+bit's contact stress x wearflat sigma l scaled by 1 + k 1e-12 (``control.scenario.seeded``): a
 change far below anything a bit's wear is known to, which a chaotic stick-slip amplifies
 into an independent realisation, the same for every controller of a member. Member 0 is
 the scenario itself, so its results are those of a plain suite (and shared with it).
@@ -33,10 +33,12 @@ import numpy as np
 from drill_sim_ros.control.bench import Bench, build_controller
 from drill_sim_ros.control.scenario import (
     Scenario,
+    check_ensemble,
     load_scenario,
     scenario_dir,
     scenario_from_dict,
     scenario_path,
+    seeded,
 )
 from drill_sim_ros.control.scorecard import score
 from drill_sim_ros.model.errors import DrillSimError, NumericalFault, ParameterError
@@ -47,10 +49,6 @@ DEFAULT_CONTROLLERS = ("none", "stiff", "soft_torque", "z_torque")
 # the telemetry columns a result keeps (the picture's and the status's)
 TRACE_FIELDS = ("sim_time_s", "bit_rpm", "surface_rpm", "speed_setpoint_rpm",
                 "surface_torque_nm", "motor_torque_nm", "wob_n", "applied_wob_n", "mode")
-# an ensemble's member k runs with the bit's sigma l x (1 + k ENSEMBLE_STEP) (module doc)
-ENSEMBLE_STEP = 1e-12
-ENSEMBLE_KEY = "contact_stress_times_wearflat_n_per_m"
-MAX_ENSEMBLE = 64
 
 
 @dataclass(frozen=True)
@@ -127,28 +125,9 @@ def entries(paths: Sequence[Path], controllers: Sequence[str], mode: str) -> lis
     return out
 
 
-def seeded(scenario: Scenario, member: int) -> Scenario:
-    """Member ``member`` of an ensemble of ``scenario``: its preset's sigma l (after the
-    scenario's own overrides) x (1 + member ENSEMBLE_STEP), as an override; member 0 is
-    ``scenario`` itself."""
-    if member == 0:
-        return scenario
-    physical = scenario.load_preset().physical
-    if physical is None:
-        raise ParameterError(f"--ensemble: preset {scenario.preset!r} is dimensionless; an "
-                             "ensemble seeds the bit's sigma l of a physical preset")
-    sigma_l = physical.contact_stress_times_wearflat_n_per_m * (1.0 + member * ENSEMBLE_STEP)
-    own = dict(scenario.overrides.get("physical", {}))
-    return scenario.with_(overrides={**scenario.overrides,
-                                     "physical": {**own, ENSEMBLE_KEY: sigma_l}})
-
-
 def ensemble(todo: Sequence[Entry], members: int) -> list[Entry]:
     """Every entry of ``todo`` as members 0 .. ``members`` - 1, member by member."""
-    if not (isinstance(members, int) and 1 <= members <= MAX_ENSEMBLE):
-        raise ParameterError(f"--ensemble {members!r} must be an integer in [1, "
-                             f"{MAX_ENSEMBLE}]")
-    return [replace(entry, member=k) for k in range(members) for entry in todo]
+    return [replace(entry, member=k) for k in range(check_ensemble(members)) for entry in todo]
 
 
 def run_entry(scenario_data: dict[str, Any], key: str) -> EntryResult:

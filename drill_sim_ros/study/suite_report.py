@@ -15,8 +15,9 @@ import numpy as np
 import xarray as xr
 
 from drill_sim_ros import __version__
-from drill_sim_ros.control.scorecard import status_text
-from drill_sim_ros.study.suite import ENSEMBLE_KEY, ENSEMBLE_STEP, Entry, EntryResult
+from drill_sim_ros.control.scenario import ENSEMBLE_KEY, ENSEMBLE_STEP
+from drill_sim_ros.control.scorecard import status_text, summarize
+from drill_sim_ros.study.suite import Entry, EntryResult
 
 # (card key, column head, format) of the table
 COLUMNS = (("ssi_mean", "SSI after", ".3f"), ("stick_fraction", "stick frac", ".3f"),
@@ -111,7 +112,8 @@ def plain(entries: Sequence[Entry]) -> list[Entry]:
 
 def ensemble_rows(entries: Sequence[Entry], results: dict[str, EntryResult]
                   ) -> list[list[str]]:
-    """One row per scenario and controller over all of its members that ran."""
+    """One row per scenario and controller over all of its members that ran
+    (``scorecard.summarize``)."""
     cards: dict[tuple[str, str], list[dict[str, Any]]] = {}
     for e in entries:
         group = cards.setdefault((e.scenario_name, _label(e)), [])
@@ -119,25 +121,10 @@ def ensemble_rows(entries: Sequence[Entry], results: dict[str, EntryResult]
             group.append(results[e.key].card)
     rows = []
     for (name, label), group in cards.items():
-        kinds = [status_text(card).split()[0] for card in group]
-        counts = [kinds.count(k) for k in ("stick-slip", "ok", "stalled")]
-        counts.append(len(kinds) - sum(counts))
-        limit = _finite(card.get("saturation_fraction") for card in group)
-        rows.append([name, label, str(len(group)), " / ".join(map(str, counts)),
-                     _spread(card.get("ssi_mean") for card in group),
-                     _spread(card.get("stick_fraction") for card in group),
-                     f"{np.median(limit):.1%} ({max(limit):.1%})" if limit else "-"])
+        cell = summarize(group)
+        rows.append([name, label, cell["runs"], cell["counts"], cell["ssi_mean"],
+                     cell["stick_fraction"], cell["saturation_fraction"]])
     return rows
-
-
-def _finite(values: Any) -> list[float]:
-    return [float(v) for v in values if isinstance(v, (int, float)) and math.isfinite(v)]
-
-
-def _spread(values: Any) -> str:
-    """median (min-max) of the finite ``values``; - if none."""
-    x = _finite(values)
-    return f"{np.median(x):.2f} ({min(x):.2f}-{max(x):.2f})" if x else "-"
 
 
 def format_ensemble_table(entries: Sequence[Entry], results: dict[str, EntryResult]) -> str:

@@ -14,10 +14,9 @@ import yaml
 
 from drill_sim_ros.control.bench import run_in_process
 from drill_sim_ros.control.rig import rig_physics
-from drill_sim_ros.control.scenario import load_scenario, scenario_path
+from drill_sim_ros.control.scenario import load_scenario, scenario_path, seeded
 from drill_sim_ros.control.scorecard import score
 from drill_sim_ros.model.telemetry import TELEMETRY_INDEX
-from drill_sim_ros.study.suite import seeded
 from tests.study.helpers import drill_sim
 
 # 60 s of the field case on the lumped string: stick-slip from about 15 s, control on at
