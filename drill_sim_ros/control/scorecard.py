@@ -41,6 +41,7 @@ import numpy as np
 from drill_sim_ros.control.rig import RigPhysics
 from drill_sim_ros.control.schedule import Schedule
 from drill_sim_ros.model import analysis, defaults
+from drill_sim_ros.model.errors import ParameterError
 from drill_sim_ros.model.params import RPM_PER_RAD_S
 from drill_sim_ros.model.telemetry import TELEMETRY_INDEX
 
@@ -89,6 +90,10 @@ def score(rows: np.ndarray, enable_at_s: float, schedule: Schedule, rig: RigPhys
     end_s = float(t[-1])
     slow_all = lowpassed_bit_rpm(rows, rig.cutoff_hz)
     is_after = t > enable_at_s
+    if not is_after.any():
+        raise ParameterError(f"scorecard: the switch-on at {enable_at_s:g} s leaves nothing to "
+                             f"score; the run ends at {end_s:g} s (enable_at_s must come "
+                             "before the end)")
     after, slow = rows[is_after], slow_all[is_after]
     ta = after[:, F["sim_time_s"]]
     bit = after[:, F["bit_rpm"]]

@@ -196,3 +196,15 @@ def test_status_stalled_with_its_time_never_null() -> None:
     assert (
         score(synthetic(100.0), 20.0, Schedule(60.0, 60e3), RIG, PERIOD_S)["status"] == "ok"
     )  # last stick at 45 s
+
+
+def test_a_switch_on_at_the_end_is_one_error_not_a_crash() -> None:
+    """A scenario may switch on at its very end; then nothing is left to score, and the
+    scorecard says so in one ParameterError (it used to fail inside numpy)."""
+    from drill_sim_ros.model.errors import ParameterError
+    scenario = Scenario(preset="field_8p5in_shale_lumped", duration_s=2.0, enable_at_s=2.0)
+    preset = scenario.load_preset()
+    rows = run_in_process(scenario).rows
+    with pytest.raises(ParameterError, match="leaves nothing to score"):
+        score(rows, scenario.enable_at_s, scenario.setpoints(preset), rig_physics(preset),
+              scenario.period_s)
