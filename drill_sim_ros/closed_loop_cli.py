@@ -23,6 +23,7 @@ from drill_sim_ros.control.scenario import (
     ENSEMBLE_STEP,
     Scenario,
     check_ensemble,
+    ensemble_caption,
     load_scenario,
     scenario_path,
     seeded,
@@ -181,11 +182,11 @@ def _baseline(args: argparse.Namespace, scenario: Scenario) -> ClosedLoopRun | N
 
 
 def _members(args: argparse.Namespace, scenario: Scenario, label: str,
-             columns: dict[str, dict[str, Any]]) -> dict[str, list[dict[str, Any]]] | None:
+             columns: dict[str, dict[str, Any]], schedule: Schedule,
+             rig: RigPhysics) -> dict[str, list[dict[str, Any]]] | None:
     """Every column's scorecards over the ensemble: member 0 (the run above) and members
-    1 .. N - 1 run here (``control.scenario.seeded``); None after Ctrl-C."""
-    preset = scenario.load_preset()
-    rig, schedule = rig_physics(preset), scenario.setpoints(preset)
+    1 .. N - 1 run here (``control.scenario.seeded``; the seed changes neither the
+    setpoints nor the rig's modes); None after Ctrl-C."""
     cases = {label: scenario}
     if "no control" in columns:
         cases["no control"] = scenario.with_(controller="none", mode="speed", params={})
@@ -239,8 +240,7 @@ def _print_scores(args: argparse.Namespace, scenario: Scenario,
           f"{'over DDS' if args.ros else 'in process'}: {rate:,.0f} periods/s "
           f"({rate * scenario.period_s:,.0f}x real time)")
     if members is not None:
-        print(f"\nthe ensemble of {args.ensemble} members (member 0: the run above; member k: "
-              f"the bit's sigma l x (1 + k {ENSEMBLE_STEP:g})):")
+        print("\n" + ensemble_caption(args.ensemble))
         print(_ensemble_table(members))
 
 
@@ -274,7 +274,8 @@ def _closed_loop(args: argparse.Namespace, scenario: Scenario, preset: Preset,
     runs[label] = controlled
     columns = {name: score(run.rows, scenario.enable_at_s, schedule, rig, scenario.period_s)
                for name, run in runs.items()}
-    members = _members(args, scenario, label, columns) if args.ensemble > 1 else None
+    members = _members(args, scenario, label, columns, schedule, rig) \
+        if args.ensemble > 1 else None
     if members is None and args.ensemble > 1:
         return 130
     _print_scores(args, scenario, columns, label, controlled.wall_s, members)

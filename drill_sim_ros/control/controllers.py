@@ -195,6 +195,7 @@ class SoftDrive(TopDriveController):
     def reset(self) -> None:
         super().reset()
         self._virtual: list[float] | None = None    # w_v, I_d, e, u, droop, last T
+        self._droop = self.droop_per_nm_s()         # fixed by the parameters
 
     def droop_per_nm_s(self) -> tuple[float, float]:
         """(admittance 1/b rad/(N m s), high-pass factor) of the series damper that keeps
@@ -250,7 +251,7 @@ class SoftDrive(TopDriveController):
         tau_v = min(max(kp_d * err + i_d, -self.rig.max_torque_nm), self.rig.max_torque_nm)
         accel = (tau_v - t_nm) / j_v
         w_v += accel * p
-        admittance, keep = self.droop_per_nm_s()
+        admittance, keep = self._droop
         droop = keep * (droop_old + admittance * (t_nm - t_old))  # high-passed T / b
         # what the real drive must apply to move as w_v - droop
         u = t_nm + self.rig.drive_inertia_kg_m2 * (accel - (droop - droop_old) / p)

@@ -286,6 +286,12 @@ def check_ensemble(members: Any) -> int:
     return members
 
 
+def ensemble_caption(members: int) -> str:
+    """The line above an ensemble's table (suite, closed-loop, report.md)."""
+    return (f"the ensemble of {members} members (member 0: the case as it is; member k: the "
+            f"bit's sigma l x (1 + k {ENSEMBLE_STEP:g}), the same for every controller):")
+
+
 def seeded(scenario: Scenario, member: int) -> Scenario:
     """Member ``member`` of an ensemble of ``scenario``: its preset's sigma l (after the
     scenario's own overrides) x (1 + member ENSEMBLE_STEP), as an override; member 0 is

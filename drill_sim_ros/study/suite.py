@@ -25,6 +25,7 @@ import os
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
+from functools import cached_property
 from pathlib import Path
 from typing import Any
 
@@ -66,9 +67,9 @@ class Entry:
         base = f"{self.scenario_name}__{self.controller.replace(':', '.')}"
         return f"{base}__m{self.member}" if self.member else base
 
-    @property
+    @cached_property
     def run_scenario(self) -> Scenario:
-        """The scenario as this entry runs it."""
+        """The scenario as this entry runs it (a seeded member reads its preset: once)."""
         return seeded(self.scenario.with_(controller=self.controller, params={}),
                       self.member)
 

@@ -10,7 +10,7 @@ from pathlib import Path
 from typing import Any
 
 from drill_sim_ros.control.controllers import CONTROL_MODES
-from drill_sim_ros.control.scenario import ENSEMBLE_STEP
+from drill_sim_ros.control.scenario import ensemble_caption
 from drill_sim_ros.terminal import StatusLine
 
 
@@ -67,8 +67,7 @@ def cmd_suite(args: argparse.Namespace) -> int:
     wall_s = time.perf_counter() - start
     print(suite_report.format_table(suite_report.plain(entries), result.results))
     if args.ensemble > 1:
-        print(f"\nthe ensemble of {args.ensemble} members (member k: the bit's sigma l x "
-              f"(1 + k {ENSEMBLE_STEP:g})):")
+        print("\n" + ensemble_caption(args.ensemble))
         print(suite_report.format_ensemble_table(entries, result.results))
     written = suite_report.write_outputs(args.out, entries, result.results, wall_s,
                                          pictures=not args.no_pictures)

@@ -15,7 +15,7 @@ import numpy as np
 import xarray as xr
 
 from drill_sim_ros import __version__
-from drill_sim_ros.control.scenario import ENSEMBLE_KEY, ENSEMBLE_STEP
+from drill_sim_ros.control.scenario import ENSEMBLE_KEY, ENSEMBLE_STEP, ensemble_caption
 from drill_sim_ros.control.scorecard import status_text, summarize
 from drill_sim_ros.study.suite import Entry, EntryResult
 
@@ -247,9 +247,8 @@ def report_markdown(entries: Sequence[Entry], results: dict[str, EntryResult],
              "motor torque at its limit, status.", ""]
     members = members_of(entries)
     if members > 1:
-        lines += [f"Each table is member 0, the scenario as it is. Below it, the ensemble of "
-                  f"{members} members: member k with the bit's sigma l x (1 + k "
-                  f"{ENSEMBLE_STEP:g}), the same for every controller.", ""]
+        lines += ["Each scenario's first table is member 0; below it, "
+                  + ensemble_caption(members).rstrip(":") + ".", ""]
     for name, group in _by_scenario(entries).items():
         scenario = group[0].scenario
         lines += [f"## {name}", "", scenario.description or "", "",
