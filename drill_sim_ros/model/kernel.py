@@ -89,7 +89,8 @@ P_BHA_PART = 22     # distributed: the part at whose top the BHA speed is read
 P_PICKUP = 23       # distributed: the hook's pick-up speed off bottom (L* per t*)
 P_CLEARANCE = 24    # distributed: the bit's clearance above the rock it picks up to (L*)
 P_TAG_SPEED = 25    # distributed: the hook's lowering speed cap, L* per t* (inf until a tag)
-N_PARAMS = 26
+P_SUBSTEPS = 26     # distributed: steps of the bit law and the drive per wave-guide step
+N_PARAMS = 27
 OFF_BOTTOM_LIFTED = 3.0
 
 # ---- surface targets (float64) ----------------------------------------------------------
@@ -117,7 +118,12 @@ S_TD_INTEGRAL = 14  # speed loop integral, torque units
 S_MOTOR_TORQUE = 15  # motor torque of the last step
 S_V_HOOK = 16       # distributed: hook speed (down positive)
 S_HOOK_INTEGRAL = 17  # distributed: the WOB loop's integral term (a speed)
-N_STATE = 18
+S_SUB_COUNT = 18    # distributed, P_SUBSTEPS > 1: steps taken since the wave guide's last
+S_SUB_OMEGA_TOP = 19  # and the sums of the end speeds over them: the drive's,
+S_SUB_V_TOP = 20    # the hook's,
+S_SUB_OMEGA_BIT = 21  # the bit's angular
+S_SUB_V_BIT = 22    # and axial
+N_STATE = 23
 
 # ---- sample columns ---------------------------------------------------------------------
 C_TAU = 0
@@ -166,12 +172,13 @@ Loop.__doc__ = """The loop-carried state of a run (the ``S_*`` slots and the his
 Law = namedtuple("Law", (
     "dt", "tau_avg", "beta", "lam", "n_blades", "psi", "off_bottom", "layer_u", "cut_factor",
     "sector", "tgt_w", "w_rate", "inv_spacing", "hook_kp", "hook_ki", "pickup", "clearance",
-    "tag_speed"))
+    "tag_speed", "substeps"))
 Law.__doc__ = """A run's constants of the bit law, the rock and the hook: dtau, the statistics
 window start, beta, lambda, n, psi, off bottom, the next layer's top, the cutting factor, the
 blade sector 2 pi / n, the applied weight's target and ramp rate, the profile's nodes per
 radian, the hook's WOB loop gains, its pick-up speed (0 on bottom), the clearance it picks
-up to and its lowering speed's cap (the tag speed; inf until a tag)."""
+up to, its lowering speed's cap (the tag speed; inf until a tag) and the steps per step of
+the wave guide (:func:`_held_means`)."""
 Drive = namedtuple("Drive", (
     "mode", "omega", "torque", "omega_rate", "inertia", "kp", "ki", "max_torque", "lag_alpha"))
 Drive.__doc__ = """A run's top-drive parameters and commands (top_drive.drive_step)."""
@@ -323,7 +330,17 @@ def _steps(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarray
         probe += r.w_f + r.tob + d.motor
         _accumulate(acc, x.step * law.dt, law.tau_avg, r.mode, r.w_f, r.tob, r.doc, r.wob,
                     x.omega, r.t_top, x.v)
-        sg.advance(wave, wave_i, wave_f, lay, d.omega_s_next, r.v_hook, r.omega_new, r.v_new)
+        ends_now = (d.omega_s_next, r.v_hook, r.omega_new, r.v_new)
+        due = True
+        if law.substeps > 1:          # the wave guide once every substeps (_held_means)
+            sums = (st[S_SUB_OMEGA_TOP], st[S_SUB_V_TOP], st[S_SUB_OMEGA_BIT], st[S_SUB_V_BIT])
+            due, count, sums, ends_now = _held_means(st[S_SUB_COUNT], sums, ends_now,
+                                                     law.substeps)
+            st[S_SUB_COUNT] = count
+            st[S_SUB_OMEGA_TOP], st[S_SUB_V_TOP], st[S_SUB_OMEGA_BIT], st[S_SUB_V_BIT] = sums
+        if due:
+            sg.advance(wave, wave_i, wave_f, lay, ends_now[0], ends_now[1], ends_now[2],
+                       ends_now[3])
         head, count, node, frac, h_old = x.head, x.count, x.node, x.frac, x.h_old
         if exact:                     # the rock: the history stored, or re-cut under a blade
             head, count, cursor, ok = br.history_store(hist, head, count, r.cursor, x.phi,
@@ -358,6 +375,27 @@ def _respond(x: Loop, law: Law, surface: float, cursor: int, ends: tuple,
                                  law.clearance + doc / law.n_blades)
     return Response(cursor, doc, t_top, f_top, v_new, omega_new, x.u + v_new * law.dt,
                     x.phi + omega_new * law.dt, w_f, wob, tob, mode, stuck, v_hook, hook_int)
+
+
+@njit(cache=True, inline="always")
+def _held_means(count: float, sums: tuple, ends_now: tuple, substeps: int
+                ) -> tuple[bool, float, tuple, tuple]:
+    """The wave guide steps once every ``substeps`` steps of the bit law and the drive
+    (string.StringSpec.bit_substeps), between the means of the end speeds over them (the
+    drive's, the hook's, the bit's angular and axial); in between, the waves arriving at
+    the ends are held, and the ends meet them through the line's impedance at every step
+    (string.ends). The count and the sums live in the state (S_SUB_*), so a wave step may
+    straddle two calls. Passive: with the mean end speed w the line takes in b w + Z w^2,
+    the end gave b w + Z mean(w^2), Z var(w) more, and that is lost.
+    Returns (whether the wave guide steps now, the count and the sums after this step, the
+    speeds to step it with)."""
+    sums = (sums[0] + ends_now[0], sums[1] + ends_now[1], sums[2] + ends_now[2],
+            sums[3] + ends_now[3])
+    count += 1.0
+    if count < substeps:
+        return False, count, sums, ends_now
+    return True, 0.0, (0.0, 0.0, 0.0, 0.0), (sums[0] / substeps, sums[1] / substeps,
+                                             sums[2] / substeps, sums[3] / substeps)
 
 
 @njit(cache=True, inline="always")
@@ -416,7 +454,7 @@ def _law_params(prm: np.ndarray, tgt: np.ndarray, profile: np.ndarray) -> Law:
                prm[P_OFF_BOTTOM] != 0.0 and not lifted, prm[P_LAYER_U], prm[P_CUT], sector,
                tgt[I_W_APP], prm[P_W_RATE], profile.shape[0] / sector, prm[P_HOOK_KP],
                prm[P_HOOK_KI], prm[P_PICKUP] if lifted else 0.0, prm[P_CLEARANCE],
-               prm[P_TAG_SPEED])
+               prm[P_TAG_SPEED], max(1, int(prm[P_SUBSTEPS])))
 
 
 @njit(cache=True, inline="always")

@@ -252,11 +252,11 @@ def _spec_scalars(values: dict[str, Any]) -> dict[str, float | int]:
     out: dict[str, float | int] = {key: _field_value("string", key, values[key], f)
                                    for key, f in STRING_FIELDS.items()
                                    if "range" in f.metadata and key in values}
-    if "damping_points" in out:
-        if out["damping_points"] != int(out["damping_points"]):
-            raise ParameterError(f"'string.damping_points' = {values['damping_points']!r} "
-                                 "must be an integer")
-        out["damping_points"] = int(out["damping_points"])
+    for key in ("damping_points", "bit_substeps"):
+        if key in out:
+            if out[key] != int(out[key]):
+                raise ParameterError(f"'string.{key}' = {values[key]!r} must be an integer")
+            out[key] = int(out[key])
     return out
 
 

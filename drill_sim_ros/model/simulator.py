@@ -166,6 +166,7 @@ class Simulator:
         self._prm[k.P_PICKUP] = s.pickup
         self._prm[k.P_CLEARANCE] = s.clearance
         self._prm[k.P_TAG_SPEED] = math.inf       # the WOB loop unbounded until a tag
+        self._prm[k.P_SUBSTEPS] = s.substeps
 
     def _fill_drive(self, drive: td.TopDrive) -> None:
         """The drive's inertia ratio, gains, torque limit and lag into the parameters (its
@@ -185,12 +186,19 @@ class Simulator:
             self._wave = k.NO_WAVE
             return
         self._wave_i, self._wave_f, self._wave, self._parts = sg.build_lines(
-            self.string.lines, self.config.dtau)
+            self.string.lines, self.wave_dtau)
         if self._wave_i[sg.W_LEN].min() < 1:
             raise ParameterError(
-                f"a string section (or damping part) is shorter than one time step "
-                f"(dtau = {self.config.dtau:g}); lengthen it, merge it with its neighbour or "
-                "lower string.damping_points")
+                f"a string section (or damping part) is shorter than one step of the wave "
+                f"guide (dtau = {self.config.dtau:g} x string.bit_substeps = "
+                f"{self.string.substeps}); lengthen it, merge it with its neighbour, lower "
+                "string.damping_points or string.bit_substeps")
+
+    @property
+    def wave_dtau(self) -> float:
+        """The wave guide's step, the time a cell of its delay lines spans: dtau times the
+        bit law's steps per wave step (string.StringSpec.bit_substeps)."""
+        return self.config.dtau * self.string.substeps
 
     @property
     def distributed(self) -> bool:
@@ -219,6 +227,7 @@ class Simulator:
                        axial_speed, speed, -parts_t)
         self._wave_f[sg.W_WORK] = 0.0
         st = self._state
+        st[k.S_SUB_COUNT:k.S_SUB_V_BIT + 1] = 0.0     # a new wave step starts now
         st[k.S_TD_INTEGRAL] = st[k.S_MOTOR_TORQUE] = top_torque
         self._targets[k.I_MOTOR_TORQUE] = top_torque
 
@@ -591,7 +600,7 @@ class Simulator:
         unit C x rad for the torsional line, force unit x L* for the axial one)."""
         if not self.distributed:
             return 0.0
-        parts_t, dtau = self._parts[0], self.config.dtau
+        parts_t, dtau = self._parts[0], self.wave_dtau
         return (sg.line_energy(self._wave, self._wave_i, self._wave_f, 0, parts_t, dtau)
                 + sg.line_energy(self._wave, self._wave_i, self._wave_f, parts_t,
                                  self._wave_i.shape[1], dtau))
@@ -656,7 +665,7 @@ class Simulator:
         :meth:`hang_off_bottom`), kernel units (both lines; 0 without a well)."""
         if not self.distributed:
             return 0.0
-        return float(self._wave_f[sg.W_WORK].sum()) * self.config.dtau
+        return float(self._wave_f[sg.W_WORK].sum()) * self.wave_dtau
 
     def string_arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, tuple[int, ...]]:
         """The delay lines as they are (wave, layout int, layout float, parts per line), for

@@ -138,7 +138,10 @@ class StringSpec:
     applied-WOB command). ``damping_points``: point dampers (and wall-friction points) per
     section. Off bottom the hook picks the string up at ``hook_pickup_m_s`` until the bit
     is ``off_bottom_clearance_m`` above the rock, and holds it there; tagging bottom again
-    it lowers at most at ``hook_tag_m_s`` (the driller's slack-off). ``well``: the hole
+    it lowers at most at ``hook_tag_m_s`` (the driller's slack-off). ``bit_substeps``:
+    steps of the bit law and the drive per step of the wave guide (1: one step for all; n:
+    the delay lines are sampled at n dtau, the waves arriving at the ends held over it, and
+    the ends' mean speeds sent into the lines, kernel._held_means). ``well``: the hole
     around the string (:mod:`drill_sim_ros.model.well`; None: vertical, no wall contact)."""
 
     model: str = "lumped"
@@ -150,6 +153,7 @@ class StringSpec:
                                                                         low_open=True))
     hook_pickup_m_s: float = field(default=0.05, metadata=_bounds(0.0, 10.0, low_open=True))
     hook_tag_m_s: float = field(default=0.02, metadata=_bounds(0.0, 10.0, low_open=True))
+    bit_substeps: int = field(default=1, metadata=_bounds(1, 64))
     well: Well | None = None
 
     @property
@@ -485,7 +489,8 @@ class KernelString:
     per unit force error, and per unit force error and tau); ``bha_part``: the torsional
     part at whose top the BHA speed is read; ``spec``: the SI description; ``pickup``,
     ``clearance``: the hook's pick-up speed off bottom and the bit's clearance then;
-    ``tag_speed``: its lowering speed's cap when it tags bottom again."""
+    ``tag_speed``: its lowering speed's cap when it tags bottom again; ``substeps``: the
+    bit law's steps per wave-guide step (StringSpec.bit_substeps)."""
 
     model: int
     lines: tuple[WaveLine, ...] = ()
@@ -497,6 +502,7 @@ class KernelString:
     pickup: float = 0.0
     clearance: float = 0.0
     tag_speed: float = 0.0
+    substeps: int = 1
 
 
 LUMPED = KernelString(STRING_LUMPED)
@@ -521,7 +527,7 @@ def kernel_string(spec: StringSpec, time_s: float, torque_nm: float, length_m: f
                         2.0 / (t_w * stiffness), 1.0 / (t_w**2 * stiffness), bha_part, spec,
                         spec.hook_pickup_m_s * time_s / length_m,
                         spec.off_bottom_clearance_m / length_m,
-                        spec.hook_tag_m_s * time_s / length_m)
+                        spec.hook_tag_m_s * time_s / length_m, spec.bit_substeps)
 
 
 # ---- compiled: the string's step (the kernel's seam) ------------------------------------

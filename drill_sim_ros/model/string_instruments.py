@@ -214,7 +214,7 @@ def _undamped_peaks_hz(preset: Preset, count: int, seconds: float
     undamped string's ring-down after a pulse from the bit."""
     drive = TopDrive(mode="kinematic", inertia_ratio=preset.top_drive.inertia_ratio)
     sim = off_bottom_simulator(preset, drive, undamped=True)
-    width = PULSE_WIDTH_S / (preset.scales.time_s * sim.config.dtau)
+    width = PULSE_WIDTH_S / (preset.scales.time_s * sim.wave_dtau)     # in cells
     send_pulse_from_bit(sim, False, 0.05 * preset.params.omega0 * sim.string_arrays()[2][
         sg.W_Z, 0], width)
     send_pulse_from_bit(sim, True, 1.0, width)
@@ -263,7 +263,7 @@ def identified_damping_ratios(preset: Preset, modes_hz: dict[bool, list[float]],
     drive = TopDrive(mode="kinematic", inertia_ratio=preset.top_drive.inertia_ratio)
     sim = off_bottom_simulator(preset, drive)
     sample_hz = _sampling(sim)[1]
-    dt_s = preset.scales.time_s * sim.config.dtau
+    cell_s = preset.scales.time_s * sim.wave_dtau
     fits = {axial: damped_fit(preset.string, axial, modes_hz[axial], zetas[axial], sample_hz,
                               seconds) for axial in (False, True) if modes_hz[axial]}
     out: dict[bool, list[float | None]] = {False: [], True: []}
@@ -272,7 +272,7 @@ def identified_damping_ratios(preset: Preset, modes_hz: dict[bool, list[float]],
     for axial in fits:
         z_bit = float(sim.string_arrays()[2][sg.W_Z, line_columns(sim, axial)[1] - 1])
         release_twist(sim, axial, 0.05 * preset.params.omega0 * z_bit,
-                      TWIST_WIDTH_PERIODS / modes_hz[axial][-1] / dt_s)
+                      TWIST_WIDTH_PERIODS / modes_hz[axial][-1] / cell_s)
     data, sample_hz = _ring_down(sim, max(f.record_s for f in fits.values()),
                                  (k.C_OMEGA, k.C_V))
     for axial, fit in fits.items():
@@ -378,7 +378,7 @@ def measure_reflection(preset: Preset, seconds: float = 120.0,
         sim = off_bottom_simulator(line, drive, anechoic=True)
         if pulse:
             z_top = float(sim.string_arrays()[2][sg.W_Z, 0])
-            width = PULSE_WIDTH_S / (line.scales.time_s * sim.config.dtau)
+            width = PULSE_WIDTH_S / (line.scales.time_s * sim.wave_dtau)   # cells
             send_pulse_from_bit(sim, False, 0.05 * line.params.omega0 * z_top, width)
         a, b, _ = _top_records(sim, z_top_of(sim), seconds)
         return a, b

@@ -189,13 +189,20 @@ def test_the_deviated_presets_friction_points_are_converged() -> None:
     """The field case's wall is lumped at ``damping_points`` junctions per section. The
     preset's start-up at 30 rpm against the same string at four times as many points (the
     finer, independent path): the first slip within 5 %, the torque at break-away within 15 %
-    (the coarser points let the bit creep a little earlier), the share of the second half
-    stuck within 0.1. The old 4 points (625 m apart on the pipe, ringing at c / 2 dz =
-    2.5 Hz) fail it: 16.5 against 22.4 kN m, stuck 0.39 against 0.58 (docs/string.md)."""
+    (the coarser points let the bit creep a little earlier), and both go on sticking and
+    slipping. The old 4 points (625 m apart on the pipe, ringing at c / 2 dz = 2.5 Hz) fail
+    it: first slip at 17.2 s with 17.4 kN m, against 20.7-21.0 s and 21.0-22.2 kN m at 16
+    and 64 points.
+
+    The cycle that follows is not a convergence measure: off bottom the string has two
+    coexisting cycles, one of about 10 s with 65 % of the time stuck and one of 7.3 s with
+    52 %, and the resolution picks one (480 s runs, 2026-12-04: 16 and 32 points at
+    bit_substeps 1 or 8 and 64 at 4 land on the first; 64 at 1 or 8 and 128 at 4 on the
+    second; docs/string.md)."""
     preset = load_preset("field_8p5in_deviated")
     fine = replace(preset, string=replace(preset.string,
                                           damping_points=4 * preset.string.damping_points))
     run, ref = (startup_scores(run_startup(p, 30.0, 10.0, 60.0)) for p in (preset, fine))
     assert run["first_slip_s"] == pytest.approx(ref["first_slip_s"], rel=0.05)
     assert run["breakaway_torque_nm"] == pytest.approx(ref["breakaway_torque_nm"], rel=0.15)
-    assert run["stick_fraction"] == pytest.approx(ref["stick_fraction"], abs=0.1)
+    assert run["stick_slip"] and ref["stick_slip"]
