@@ -14,7 +14,9 @@ ROS-free; from telemetry rows (``TELEMETRY_FIELDS``, SI) of a run, after the swi
 * stick fraction (share of samples stuck), UTR = (omega_0 - min) / omega_0 of the raw bit
   speed (``model.analysis.severity_of``, omega_0 the mean setpoint of the schedule);
 * time to suppress: from the switch-on to the last stuck sample (0 if none; None when the
-  bit still sticks in the last 20 s);
+  bit still sticks in the last 20 s, or when the quiet end is no longer than the longest
+  spell the bit turned between two sticks after the switch-on: an intermittent stick-slip
+  is not ended by one quiet window);
 * period: the dominant period of the low-passed bit speed (its spectral peak above
   ``PERIOD_MIN_HZ``; None when it is flat: no spectral line of ``MIN_OSCILLATION_RMS_RPM``);
 * HFTO: the RMS of the bit speed above the cut-off (raw minus low-passed), its dominant
@@ -27,7 +29,8 @@ ROS-free; from telemetry rows (``TELEMETRY_FIELDS``, SI) of a run, after the swi
   with the motor torque at its limit, alone);
 * status: ``stalled`` when the bit is stuck for good (stuck without a break for the last
   ``STALL_S`` seconds or more of the run; ``stall_time_s`` is when that span began),
-  else ``stick-slip`` when the bit still sticks in the last 20 s, else ``ok``. (A run that
+  else ``stick-slip`` when the stick-slip is not suppressed (time to suppress None), else
+  ``ok``. (A run that
   ends in a numerical fault has no rows to score: its runner reports ``fault``.)
 """
 
@@ -198,12 +201,29 @@ def stall_time_s(time_s: np.ndarray, stuck: np.ndarray, stall_s: float = STALL_S
     return start_s if float(time_s[-1]) - start_s >= stall_s else None
 
 
+def longest_gap_s(t: np.ndarray, stuck: np.ndarray) -> float:
+    """The longest time the bit turned between two of its stick phases (0 with fewer than
+    two): how long a quiet spell of this run's own stick-slip can last."""
+    edges = np.diff(stuck.astype(np.int8))
+    ends, starts = np.flatnonzero(edges == -1), np.flatnonzero(edges == 1) + 1
+    starts = starts[starts > ends[0]] if ends.size else starts
+    gaps = t[starts[:ends.size]] - t[ends[:starts.size]]
+    return float(gaps.max()) if gaps.size else 0.0
+
+
 def _time_to_suppress(t: np.ndarray, stuck: np.ndarray, enable_at_s: float,
                       end_s: float) -> float | None:
+    """From the switch-on to the last stuck sample; None unless the run ends quiet for the
+    severity window and for longer than any spell it turned between sticks after the
+    switch-on: intermittent stick-slip (the default case's sticks come 4-115 s apart) is
+    not suppressed by one quiet window."""
     if not stuck.any():
         return 0.0
     last_s = float(t[stuck][-1])
-    return None if last_s > end_s - WINDOW_S else last_s - enable_at_s
+    quiet_s = end_s - last_s
+    if quiet_s < WINDOW_S or quiet_s <= longest_gap_s(t, stuck):
+        return None
+    return last_s - enable_at_s
 
 
 def status_text(card: dict[str, Any]) -> str:

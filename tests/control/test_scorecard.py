@@ -156,6 +156,33 @@ def test_stick_in_the_last_window_means_not_suppressed() -> None:
     assert score(rows, 20.0, Schedule(60.0, 60e3), RIG, PERIOD_S)["time_to_suppress_s"] is None
 
 
+def intermittent(stick_starts_s: list[float], duration_s: float) -> np.ndarray:
+    """``synthetic`` rows turning at 60 rpm, stuck for 3 s from each of ``stick_starts_s``."""
+    rows = synthetic(duration_s)
+    t = rows[:, F["sim_time_s"]]
+    rows[:, F["bit_rpm"]] = 60.0
+    rows[:, F["mode"]] = 0
+    for start in stick_starts_s:
+        stuck = (t > start) & (t <= start + 3.0)
+        rows[stuck, F["bit_rpm"]] = 0.0
+        rows[stuck, F["mode"]] = 2
+    return rows
+
+
+def test_a_quiet_end_shorter_than_the_runs_own_gaps_is_not_suppressed() -> None:
+    """Sticks 27 s apart (24 s turning between them), the last one ending 22 s before the
+    end: quiet for the 20 s window, but for less than the run's own spells between sticks,
+    so not suppressed. The same sticks 8 s apart (5 s turning) and the same quiet end:
+    suppressed at the last stick's end."""
+    apart = score(intermittent([30.0, 57.0, 84.0], 109.0), 20.0, Schedule(60.0, 60e3), RIG,
+                  PERIOD_S)
+    assert apart["status"] == "stick-slip" and apart["time_to_suppress_s"] is None
+    close = score(intermittent([68.0, 76.0, 84.0], 109.0), 20.0, Schedule(60.0, 60e3), RIG,
+                  PERIOD_S)
+    assert close["status"] == "ok"
+    assert close["time_to_suppress_s"] == pytest.approx(87.0 - 20.0, abs=EDGE_S)
+
+
 def test_ssi_is_model_analysis_on_the_same_windows() -> None:
     rows = run_in_process(
         Scenario(
