@@ -14,7 +14,9 @@ A step reads as three calls on one state:
    bit law, ``string.advance`` after it. ``lumped`` is RGD07's spring C with the BHA at the
    bit (eq. 25, symplectic Euler as eq. C.1 with the updated velocities); ``distributed`` is
    a chain of wave-guide sections carrying torsional and axial waves, moved on by one step
-   between the drive's and the bit's new speeds.
+   between the drive's and the bit's new speeds, or by one step of its own every
+   ``P_SUBSTEPS`` steps between their means, the waves at its ends held in between
+   (:func:`_held_means`).
 
 The loop (:func:`_steps`) keeps the bookkeeping: the sample rows, the statistics, the dry
 step, the status. The physics of a step is in scalar helpers (:func:`_respond`,
@@ -334,9 +336,9 @@ def _steps(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarray
         due = True
         if law.substeps > 1:          # the wave guide once every substeps (_held_means)
             sums = (st[S_SUB_OMEGA_TOP], st[S_SUB_V_TOP], st[S_SUB_OMEGA_BIT], st[S_SUB_V_BIT])
-            due, count, sums, ends_now = _held_means(st[S_SUB_COUNT], sums, ends_now,
-                                                     law.substeps)
-            st[S_SUB_COUNT] = count
+            due, sub_count, sums, ends_now = _held_means(st[S_SUB_COUNT], sums, ends_now,
+                                                         law.substeps)
+            st[S_SUB_COUNT] = sub_count
             st[S_SUB_OMEGA_TOP], st[S_SUB_V_TOP], st[S_SUB_OMEGA_BIT], st[S_SUB_V_BIT] = sums
         if due:
             sg.advance(wave, wave_i, wave_f, lay, ends_now[0], ends_now[1], ends_now[2],
