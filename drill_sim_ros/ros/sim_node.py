@@ -794,6 +794,21 @@ class SimNode(Node):
 
 def main(args: list[str] | None = None) -> int:
     """Console script ``sim_node`` (``ros2 run drill_sim_ros sim_node``)."""
+    # Ctrl-C stops the node through rclpy alone: its handler (installed by rclpy.init, which
+    # calls the one it found) shuts the context down and wakes the executor. Python's own
+    # would also raise KeyboardInterrupt at whatever bytecode the main thread is at, even
+    # between a lock's acquire and its try, and a HandoffLock lost so leaves close() waiting
+    # for ever (seen once in tests/ros/test_colcon.py: the executor's thread in urgent(), the
+    # ticker at the gate).
+    signal.signal(signal.SIGINT, lambda *_: None)
+    try:
+        return _run(args)
+    finally:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+
+
+def _run(args: list[str] | None) -> int:
+    """:func:`main` with Ctrl-C handled by rclpy alone."""
     try:
         init_ros(args)
     except ParameterError as exc:               # a user's mistake: one line, exit 2
