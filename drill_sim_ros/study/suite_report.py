@@ -243,7 +243,8 @@ def report_markdown(entries: Sequence[Entry], results: dict[str, EntryResult],
              "switch-on (mean of whole 20 s windows), stick fraction after it, the "
              "stick-slip period, the RMS of the bit speed above the cut-off (the collars' "
              "ringing, HFTO), mean ROP, MSE at the bit, time from the switch-on to the last "
-             "stick (- while it still sticks in the last 20 s), share of samples with the "
+             "stick (- while it still sticks in the last 20 s or its quiet end is no longer "
+             "than its longest spell between sticks), share of samples with the "
              "motor torque at its limit, status.", ""]
     members = members_of(entries)
     if members > 1:
