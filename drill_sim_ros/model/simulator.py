@@ -589,7 +589,7 @@ class Simulator:
 
     def top_waves(self) -> tuple[float, float]:
         """The torsional waves at the top of the string now, kernel units: (a, the one the
-        drive sent down last step; b, the one arriving from below)."""
+        drive sent down at the last wave step; b, the one arriving from below)."""
         wave, wave_i = self._wave, self._wave_i
         off, n, pos = (int(wave_i[sg.W_OFF, 0]), int(wave_i[sg.W_LEN, 0]),
                        int(wave_i[sg.W_POS, 0]))
