@@ -9,12 +9,6 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from drill_sim_ros.archive.output import (
-    OutputError,
-    OutputExistsError,
-    commit,
-    temporary_beside,
-)
 from drill_sim_ros.control.bench import ClosedLoopRun, run_in_process
 from drill_sim_ros.control.controllers import CONTROL_MODES
 from drill_sim_ros.control.rig import RigPhysics, rig_physics
@@ -32,9 +26,9 @@ from drill_sim_ros.control.schedule import Schedule
 from drill_sim_ros.control.scorecard import SCORE_FIELDS, score, status_text, summarize
 from drill_sim_ros.model.errors import DrillSimError
 from drill_sim_ros.model.presets import Preset
+from drill_sim_ros.plot_file import commit_plot, plot_into
 from drill_sim_ros.terminal import StatusLine
 
-PLOT_SUFFIXES = (".png", ".svg", ".pdf")
 LABELS = {"ssi_before_mean": "SSI before switch-on (mean)", "ssi_mean": "SSI after (mean)",
           "ssi_max": "SSI after (max)", "ssi_last": "SSI last 20 s",
           "stick_fraction": "stick fraction after",
@@ -128,25 +122,6 @@ def _table(columns: dict[str, dict[str, Any]]) -> str:
     return "\n".join(lines)
 
 
-def _plot_target(path: Path | None, overwrite: bool) -> Path | None:
-    """A writable temporary file beside ``--plot`` (checked before the run), or None."""
-    if path is None:
-        return None
-    if path.is_dir():
-        raise DrillSimError(f"--plot {path} is a directory; give a file name such as "
-                            f"{path / 'run.png'}")
-    if path.suffix.lower() not in PLOT_SUFFIXES:
-        raise DrillSimError(f"--plot {path}: unknown suffix {path.suffix!r}; use one of "
-                            f"{', '.join(PLOT_SUFFIXES)}")
-    try:
-        return temporary_beside(path, overwrite, keep_suffix=True)
-    except OutputExistsError as exc:
-        raise DrillSimError(f"--plot: {exc}") from None
-    except OutputError as exc:
-        reason = str(exc).rsplit(": ", 1)[-1]
-        raise DrillSimError(f"--plot {path}: cannot write there ({reason})") from None
-
-
 def cmd_closed_loop(args: argparse.Namespace) -> int:
     check_ensemble(args.ensemble)
     if args.ensemble > 1 and args.ros:
@@ -157,12 +132,8 @@ def cmd_closed_loop(args: argparse.Namespace) -> int:
                             f"end of the run (--t-end = {scenario.duration_s:g} s): nothing "
                             "would be scored after the switch-on")
     preset = scenario.load_preset()
-    plot_tmp = _plot_target(args.plot, args.overwrite)
-    try:
+    with plot_into(args.plot, args.overwrite) as plot_tmp:
         return _closed_loop(args, scenario, preset, plot_tmp)
-    finally:
-        if plot_tmp is not None:
-            plot_tmp.unlink(missing_ok=True)
 
 
 def _interrupted(run: ClosedLoopRun) -> int:
@@ -253,10 +224,7 @@ def _write_plot(args: argparse.Namespace, plot_tmp: Path, title: str, scenario: 
                      status_text(columns[name])) for name, run in runs.items()]
     plot_runs(plot_tmp, plots, PlotContext(title, schedule, scenario.enable_at_s, rig,
                                            schedule_events(schedule)))
-    try:
-        commit(plot_tmp, args.plot, args.overwrite)
-    except OutputError as exc:
-        raise DrillSimError(f"--plot: {exc}") from None
+    commit_plot(plot_tmp, args.plot, args.overwrite)
 
 
 def _closed_loop(args: argparse.Namespace, scenario: Scenario, preset: Preset,

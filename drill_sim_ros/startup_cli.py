@@ -14,8 +14,9 @@ from typing import Any
 from drill_sim_ros.model import startup
 from drill_sim_ros.model.checks import number_in
 from drill_sim_ros.model.defaults import MAX_SURFACE_RPM
-from drill_sim_ros.model.presets import DEFAULT_PRESET, load_preset
-from drill_sim_ros.string_cli import check_plot_path, rounded
+from drill_sim_ros.model.presets import DEFAULT_PRESET, Preset, load_preset
+from drill_sim_ros.plot_file import commit_plot, plot_into
+from drill_sim_ros.string_cli import rounded
 from drill_sim_ros.terminal import StatusLine
 
 DEFINITIONS = (
@@ -44,7 +45,9 @@ def add_parser(sub: Any) -> None:
                    f"simulated time, in (0, {startup.MAX_SECONDS:g}] (default 60)")
     p.add_argument("--json", action="store_true", help="print only the JSON line")
     p.add_argument("--plot", type=Path, help="write a PNG of the speeds, torques and twist "
-                   "against time, the break-away marked (a new file)")
+                   "against time, the break-away marked (also .svg or .pdf); an existing "
+                   "file is kept unless --overwrite")
+    p.add_argument("--overwrite", action="store_true", help="replace an existing --plot file")
 
 
 def _check_args(args: Any) -> None:
@@ -52,14 +55,18 @@ def _check_args(args: Any) -> None:
     number_in("--rpm", args.rpm, 0.0, MAX_SURFACE_RPM, low_open=True)
     number_in("--ramp-s", args.ramp_s, 0.0, startup.MAX_RAMP_S)
     number_in("--seconds", args.seconds, 0.0, startup.MAX_SECONDS, low_open=True)
-    if args.plot is not None:
-        check_plot_path(args.plot)
 
 
 def cmd_startup(args: Any) -> int:
     _check_args(args)
     preset = load_preset(args.params)
     startup.require_startup_preset(preset)
+    with plot_into(args.plot, args.overwrite) as plot_tmp:
+        return _startup(args, preset, plot_tmp)
+
+
+def _startup(args: Any, preset: Preset, plot_tmp: Path | None) -> int:
+    """:func:`cmd_startup` once its arguments are checked; the picture into ``plot_tmp``."""
     line = StatusLine()
 
     def progress(fraction: float) -> None:
@@ -73,10 +80,11 @@ def cmd_startup(args: Any) -> int:
     scores = _json_ready(startup.startup_scores(run))
     if not args.json:
         print(_summary(preset.name, args, scores))
-    if args.plot is not None:
+    if plot_tmp is not None:
         from drill_sim_ros.control.startup_plot import plot_startup
-        plot_startup(args.plot, run, f"{preset.name}: start-up off bottom, 0 to {args.rpm:g} "
+        plot_startup(plot_tmp, run, f"{preset.name}: start-up off bottom, 0 to {args.rpm:g} "
                      f"rpm in {args.ramp_s:g} s", scores["breakaway_s"])
+        commit_plot(plot_tmp, args.plot, args.overwrite)
         print(f"wrote {args.plot}", file=sys.stderr)
     print(json.dumps(scores))
     return 0

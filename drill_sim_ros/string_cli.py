@@ -15,7 +15,8 @@ from drill_sim_ros.control.reflection import measure_reflection_with
 from drill_sim_ros.model import string as sg
 from drill_sim_ros.model import string_instruments as si
 from drill_sim_ros.model.errors import ParameterError
-from drill_sim_ros.model.presets import DEFAULT_PRESET, load_preset
+from drill_sim_ros.model.presets import DEFAULT_PRESET, Preset, load_preset
+from drill_sim_ros.plot_file import commit_plot, plot_into
 
 
 def add_parsers(sub: Any) -> None:
@@ -37,7 +38,10 @@ def add_parsers(sub: Any) -> None:
                       help="length of the record after the pulse, s of simulated time "
                       "(20-3600)")
     refl.add_argument("--json", action="store_true", help="print only the JSON line")
-    refl.add_argument("--plot", type=Path, help="write a PNG of |r| against frequency")
+    refl.add_argument("--plot", type=Path, help="write a PNG of |r| against frequency (also "
+                      ".svg or .pdf); an existing file is kept unless --overwrite")
+    refl.add_argument("--overwrite", action="store_true",
+                      help="replace an existing --plot file")
 
 
 def cmd_modes(args: Any) -> int:
@@ -78,10 +82,15 @@ def _modes_row(i: int, kind: str, d: dict[str, list[float | None]]) -> str:
 def cmd_reflection(args: Any) -> int:
     if not 20.0 <= args.seconds <= 3600.0:
         raise ParameterError(f"--seconds = {args.seconds!r} must be in [20, 3600]")
-    if args.plot is not None:
-        check_plot_path(args.plot)
     preset = load_preset(args.params)
     si.require_distributed(preset)
+    with plot_into(args.plot, args.overwrite) as plot_tmp:
+        return _reflection(args, preset, plot_tmp)
+
+
+def _reflection(args: Any, preset: Preset, plot_tmp: Path | None) -> int:
+    """:func:`cmd_reflection` once its arguments are checked; the picture into
+    ``plot_tmp``."""
     curves: dict[str, list[float]] = {}
     f_hz = si.frequencies_with_modes(preset.string)
     modes = {round(float(f), 6): k + 1 for k, f in enumerate(sg.analytic_modes_hz(preset.string))}
@@ -106,20 +115,12 @@ def cmd_reflection(args: Any) -> int:
             mode = f"  <- torsional mode {modes[f]}" if f in modes else ""
             print(f"{f:6.3f}  " + "".join(f"{c[i]:14.4f}" for c in curves.values())
                   + (f"  {analytic[i]:10.4f}" if analytic else "") + mode)
-    if args.plot is not None:
-        _plot(args.plot, preset.name, out["f_hz"], curves, analytic)
+    if plot_tmp is not None:
+        _plot(plot_tmp, preset.name, out["f_hz"], curves, analytic)
+        commit_plot(plot_tmp, args.plot, args.overwrite)
+        print(f"wrote {args.plot}", file=sys.stderr)
     print(json.dumps(out))
     return 0
-
-
-def check_plot_path(path: Path) -> None:
-    """``--plot``: a new .png in a directory that exists (checked before the run)."""
-    if path.suffix.lower() != ".png":
-        raise ParameterError(f"--plot {path}: the picture is a .png")
-    if path.is_dir() or path.exists():
-        raise ParameterError(f"--plot {path} exists; choose a new file")
-    if not path.parent.is_dir():
-        raise ParameterError(f"--plot {path}: directory {path.parent} does not exist")
 
 
 def _plot(path: Path, name: str, f_hz: list[float], curves: dict[str, list[float]],
@@ -142,4 +143,3 @@ def _plot(path: Path, name: str, f_hz: list[float], curves: dict[str, list[float
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
-    print(f"wrote {path}", file=sys.stderr)

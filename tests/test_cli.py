@@ -200,3 +200,13 @@ def test_startup_in_a_small_deviated_well(capsys: pytest.CaptureFixture[str],
     assert "break-away" in out and "stick-slip" in out
     assert json.loads(lines[-1]) == scores
     assert plot.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    # --plot as closed-loop's (plot_file): an existing picture is kept and named in one line,
+    # before the run; --overwrite replaces it; no partial file is left beside it
+    plot.write_bytes(b"keep")
+    rc, out, err = run_cli(capsys, *args, "--plot", str(plot))
+    one_error_line(rc, err, str(plot), "--overwrite")
+    assert plot.read_bytes() == b"keep" and out == ""
+    rc, out, err = run_cli(capsys, *args, "--plot", str(plot), "--overwrite", "--json")
+    assert rc == 0, err
+    assert plot.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["deviated.yaml", "startup.png"]
