@@ -30,8 +30,8 @@ ROS-free; from telemetry rows (``TELEMETRY_FIELDS``, SI) of a run, after the swi
 * status: ``stalled`` when the bit is stuck for good (stuck without a break for the last
   ``STALL_S`` seconds or more of the run; ``stall_time_s`` is when that span began),
   else ``stick-slip`` when the stick-slip is not suppressed (time to suppress None), else
-  ``ok``. (A run that
-  ends in a numerical fault has no rows to score: its runner reports ``fault``.)
+  ``ok``. (A run that ends in a numerical fault has no rows to score: its runner reports
+  ``fault``.)
 """
 
 from __future__ import annotations
