@@ -56,6 +56,8 @@ from tests.process_probes import cpu_seconds
 
 BIN = Path(sys.prefix) / "bin"
 PUBLISHED = [t for t in topics.MSG_TYPES if t not in topics.COMMANDS]
+if typed.AVAILABLE:                    # the typed telemetry twin, which sim_node publishes
+    PUBLISHED.append(topics.TYPED_TELEMETRY)
 if typed.PROFILE_AVAILABLE:            # (e): the typed profiles are subscribed too
     PUBLISHED.append(topics.TYPED_STRING_TORSION)
 # (e): (label, preset suffix, sim_node parameters)
@@ -126,19 +128,37 @@ def start_reference(preset: str, period_s: float = 0.01) -> subprocess.Popen:
 def reference_publisher(preset: str, period_s: float) -> None:
     """The reference: a thread publishing sim_node's payloads of one block every
     ``period_s``; with 0, as fast as it can in batches of FREE_RUN_BATCH samples (the
-    ceiling of a free run), printing ``monotonic_s samples`` once a second."""
+    ceiling of a free run), printing ``monotonic_s samples`` once a second. The payloads are
+    the node's at its defaults: the 11 sample topics, the typed telemetry twin (when
+    drill_sim_msgs is installed) and, on a distributed string, one typed string profile
+    every 10 samples (string.rate_hz 10)."""
     from drill_sim_ros.model.presets import load_preset
-    from drill_sim_ros.model.session import SessionConfig, SimSession
+    from drill_sim_ros.model.session import SimSession
     from drill_sim_ros.ros.frame import SampleFrame
-    from drill_sim_ros.ros.sim_node import CLOCK_QOS, DATA_QOS, FREE_RUN_BATCH
+    from drill_sim_ros.ros.parameters import yaml_defaults
+    from drill_sim_ros.ros.sim_node import CLOCK_QOS, DATA_QOS, FREE_RUN_BATCH, session_config
+    from drill_sim_ros.ros.string_sink import TYPED, profile_packer
 
     rclpy.init()
     node = Node("bench_reference")
     frame = SampleFrame(with_clock=True)
     pubs = [node.create_publisher(type_of(t), t, CLOCK_QOS if t == topics.CLOCK else DATA_QOS)
             for t in frame.topics]
-    block = SimSession(SessionConfig(preset=load_preset(preset))).run(100)
+    loaded = load_preset(preset)
+    session = SimSession(session_config(yaml_defaults(loaded), loaded))
+    block = session.run(100)
     payloads = frame.pack(block.rows, block.stamps_ns)
+    if typed.AVAILABLE:
+        pubs.append(node.create_publisher(typed.Telemetry, topics.TYPED_TELEMETRY, DATA_QOS))
+        twins = typed.TelemetryPacker("drill_sim").pack(block.rows, block.stamps_ns)
+        payloads = [[*row, twin] for row, twin in zip(payloads, twins, strict=True)]
+    profiles: list[bytes] = []
+    if block.strings and typed.PROFILE_AVAILABLE:
+        profile_pub = node.create_publisher(typed.StringProfile, topics.TYPED_STRING_TORSION,
+                                            DATA_QOS)
+        packer = profile_packer(TYPED, session.string_depths_m, session.string_names,
+                                "drill_sim")
+        profiles = [packer.pack(sample) for sample in block.strings]
     stop_event = threading.Event()
 
     def publish_every_10_ms() -> None:
@@ -147,6 +167,8 @@ def reference_publisher(preset: str, period_s: float) -> None:
         while not stop_event.is_set():
             for pub, payload in zip(pubs, payloads[i % len(payloads)], strict=True):
                 pub.publish(payload)
+            if profiles and i % 10 == 0:
+                profile_pub.publish(profiles[(i // 10) % len(profiles)])
             i += 1
             if period_s > 0:
                 deadline += period_s

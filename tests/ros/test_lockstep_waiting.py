@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import pytest
 from rclpy.node import Node
+from rclpy.parameter import Parameter
 from sensor_msgs.msg import JointState
 from std_srvs.srv import Trigger
 
@@ -89,3 +90,25 @@ def test_a_controller_that_connects_and_does_not_answer_is_reported(capfd):
     assert "answering t = 0.000 s" in lines[1] and "1 command publisher(s) matched" in lines[1]
     assert "reliable + transient local" in lines[1]
     assert values(status)["sim_time_s"] == "0.000"           # it still waits for t = 0
+
+
+def test_a_lockstep_switched_on_while_running_is_watched_too(capfd):
+    """The wait check runs only in lockstep (a node at real time never wakes its executor
+    for it), so switching lockstep on by parameter must arm it: the wait is reported."""
+    with ros_context() as ros:
+        node = SimNode(context=ros.context, parameter_overrides=overrides(
+            status_line=False, lockstep__warn_after_s=0.3))
+        node.start()
+        ros.add(node)
+        probe = ros.add(Probe(ros.context, [topics.DIAGNOSTICS]))
+        assert ros.spin_until(lambda: simulation_status(probe) is not None, 10.0)
+        assert "waiting for a call" not in capfd.readouterr().err
+        result = node.set_parameters([Parameter("lockstep", value=True)])
+        assert result[0].successful, result[0].reason
+        text = ""
+
+        def reported() -> bool:
+            nonlocal text
+            text += capfd.readouterr().err
+            return f"waiting for a call of /{topics.NODE_NAME}/step" in text
+        assert ros.spin_until(reported, 10.0), text
