@@ -2,7 +2,8 @@
 
 (a) real time at 100 Hz: CPU % of one core (process CPU time / wall time, from
     /proc/<pid>/stat) against the reference measured in the same run: a bare rclpy process
-    whose thread publishes sim_node's own payloads (the same bytes, topics and QoS) every
+    whose thread publishes sim_node's own payloads (the same bytes, topics and QoS: the 11
+    sample topics, the typed telemetry twin, a string profile every 10 samples) every
     10 ms through ``Publisher.publish``; and the node's tick lateness p50/p99 (its
     /diagnostics). ``--pairs`` reference/node measurements alternate; the median ratio counts;
 (b0) the ceiling of a free run, measured the same way: the reference publishing the same
