@@ -137,14 +137,13 @@ def reference_publisher(preset: str, period_s: float) -> None:
     from drill_sim_ros.model.session import SimSession
     from drill_sim_ros.ros.frame import SampleFrame
     from drill_sim_ros.ros.parameters import yaml_defaults
-    from drill_sim_ros.ros.sim_node import CLOCK_QOS, DATA_QOS, FREE_RUN_BATCH, session_config
+    from drill_sim_ros.ros.sim_node import DATA_QOS, FREE_RUN_BATCH, session_config, topic_qos
     from drill_sim_ros.ros.string_sink import TYPED, profile_packer
 
     rclpy.init()
     node = Node("bench_reference")
     frame = SampleFrame(with_clock=True)
-    pubs = [node.create_publisher(type_of(t), t, CLOCK_QOS if t == topics.CLOCK else DATA_QOS)
-            for t in frame.topics]
+    pubs = [node.create_publisher(type_of(t), t, topic_qos(t)) for t in frame.topics]
     loaded = load_preset(preset)
     session = SimSession(session_config(yaml_defaults(loaded), loaded))
     block = session.run(100)

@@ -166,6 +166,17 @@ def joint_commands(msg: JointState) -> dict[tuple[str, str], float]:
     return out
 
 
+def topic_qos(topic: str) -> QoSProfile:
+    """The QoS sim_node publishes ``topic`` with (its recording stores the same)."""
+    if topic in (topics.RUN_INFO, topics.TYPED_RUN_INFO):
+        return RUN_INFO_QOS
+    if topic == topics.SURFACE_MEASURED:
+        return LATEST_SAMPLE_QOS
+    if topic == topics.TELEMETRY:
+        return TELEMETRY_QOS
+    return CLOCK_QOS if topic in (topics.CLOCK, topics.DIAGNOSTICS) else DATA_QOS
+
+
 class SimNode(Node):
     """The ``drill_sim`` node; call :meth:`start` before spinning it. ``finished`` completes
     when ``run_seconds`` have passed."""
@@ -176,7 +187,7 @@ class SimNode(Node):
         self._preset, self._values = declare_all(self, load_preset)
         self._init_run_state()
         self._pubs = {t: self.create_publisher(messages.type_of(t), topics.node_relative(t),
-                                               self._qos(t), event_callbacks=QUIET_PUBLISHER)
+                                               topic_qos(t), event_callbacks=QUIET_PUBLISHER)
                       for t in (*SAMPLE_TOPICS, topics.CLOCK, topics.DIAGNOSTICS,
                                 topics.RUN_INFO, *self._string_topics())}
         self._sinks = SampleSinks(self._pubs)
@@ -313,16 +324,6 @@ class SimNode(Node):
                                 self._diagnostics.source.hardware_id)
         return StringProfileSink(self._sinks, chosen[0], self._pubs, packer)
 
-    @staticmethod
-    def _qos(topic: str) -> QoSProfile:
-        if topic in (topics.RUN_INFO, topics.TYPED_RUN_INFO):
-            return RUN_INFO_QOS
-        if topic == topics.SURFACE_MEASURED:
-            return LATEST_SAMPLE_QOS
-        if topic == topics.TELEMETRY:
-            return TELEMETRY_QOS
-        return CLOCK_QOS if topic in (topics.CLOCK, topics.DIAGNOSTICS) else DATA_QOS
-
     def _open_recorder(self, path: str) -> Any:
         """The in-process MCAP recorder of ``record.path`` (None when off). An existing or
         unwritable path raises one ArchiveError line: the node does not start."""
@@ -334,7 +335,7 @@ class SimNode(Node):
                                      **recording_options(self._values))
         types = {**topics.MSG_TYPES, **topics.TYPED_MSG_TYPES}
         for topic, publisher in {**self._pubs, **self._typed_pubs}.items():
-            recorder.add_topic(publisher.topic_name, types[topic], self._qos(topic))
+            recorder.add_topic(publisher.topic_name, types[topic], topic_qos(topic))
         for topic, name in self._command_names.items():
             recorder.add_topic(name, types[topic], COMMAND_QOS)
         self.get_logger().info(f"recording to {path}")
