@@ -127,7 +127,7 @@ def _content(topic: str) -> str:
 def topic_table() -> str:
     """One row per topic of ``topics.MSG_TYPES``: direction, type, QoS, content."""
     from drill_sim_ros import topics
-    from drill_sim_ros.ros.sim_node import COMMAND_QOS, SimNode
+    from drill_sim_ros.ros.sim_node import COMMAND_QOS, topic_qos
 
     missing = [t for t in topics.MSG_TYPES if t not in topics.DESCRIPTIONS]
     if missing:
@@ -136,7 +136,7 @@ def topic_table() -> str:
             "| --- | --- | --- | --- | --- |"]
     for topic, msg_type in topics.MSG_TYPES.items():
         subscribed = topic in topics.COMMANDS
-        qos = COMMAND_QOS if subscribed else SimNode._qos(topic)
+        qos = COMMAND_QOS if subscribed else topic_qos(topic)
         cells = (f"`{topic}`", "subscribes" if subscribed else "publishes",
                  msg_type.replace("/msg/", "/"), _qos_text(qos), _content(topic))
         rows.append("| " + " | ".join(_cell(c) for c in cells) + " |")
