@@ -137,7 +137,7 @@ def reference_publisher(preset: str, period_s: float) -> None:
     from drill_sim_ros.model.session import SimSession
     from drill_sim_ros.ros.frame import SampleFrame
     from drill_sim_ros.ros.parameters import yaml_defaults
-    from drill_sim_ros.ros.sim_node import DATA_QOS, FREE_RUN_BATCH, session_config, topic_qos
+    from drill_sim_ros.ros.sim_node import FREE_RUN_BATCH, session_config, topic_qos
     from drill_sim_ros.ros.string_sink import TYPED, profile_packer
 
     rclpy.init()
@@ -149,13 +149,14 @@ def reference_publisher(preset: str, period_s: float) -> None:
     block = session.run(100)
     payloads = frame.pack(block.rows, block.stamps_ns)
     if typed.AVAILABLE:
-        pubs.append(node.create_publisher(typed.Telemetry, topics.TYPED_TELEMETRY, DATA_QOS))
+        pubs.append(node.create_publisher(typed.Telemetry, topics.TYPED_TELEMETRY,
+                                          topic_qos(topics.TYPED_TELEMETRY)))
         twins = typed.TelemetryPacker("drill_sim").pack(block.rows, block.stamps_ns)
         payloads = [[*row, twin] for row, twin in zip(payloads, twins, strict=True)]
     profiles: list[bytes] = []
     if block.strings and typed.PROFILE_AVAILABLE:
         profile_pub = node.create_publisher(typed.StringProfile, topics.TYPED_STRING_TORSION,
-                                            DATA_QOS)
+                                            topic_qos(topics.TYPED_STRING_TORSION))
         packer = profile_packer(TYPED, session.string_depths_m, session.string_names,
                                 "drill_sim")
         profiles = [packer.pack(sample) for sample in block.strings]
