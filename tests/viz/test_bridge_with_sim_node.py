@@ -75,7 +75,9 @@ def test_sim_node_telemetry_reaches_the_rrd(tmp_path: Path) -> None:
     logged = read_recording(rrd)["/timeseries/rpm/bit"]
     t_logged = logged.time_ns
     t_heard = np.round(heard[:, F["sim_time_s"]] * 1e9).astype(np.int64)
-    start = max(t_logged[0], t_heard[0])      # both had discovered the sim by then
+    # both had discovered the sim by then; the .rrd's times may lie 1 ns below the stamps
+    # (rerun's float seconds), so a first sample logged at stamp - 1 ns still counts
+    start = max(t_logged[0], t_heard[0]) - 1
     keep = t_heard >= start
     np.testing.assert_allclose(t_logged[t_logged >= start], t_heard[keep], atol=1)
     np.testing.assert_array_equal(logged.scalars()[t_logged >= start],
