@@ -26,7 +26,7 @@ from drill_sim_ros.control.schedule import Schedule
 from drill_sim_ros.control.scorecard import SCORE_FIELDS, score, status_text, summarize
 from drill_sim_ros.model.errors import DrillSimError
 from drill_sim_ros.model.presets import Preset
-from drill_sim_ros.plot_file import commit_plot, plot_into
+from drill_sim_ros.plot_file import add_plot_arguments, commit_plot, plot_into
 from drill_sim_ros.terminal import StatusLine
 
 LABELS = {"ssi_before_mean": "SSI before switch-on (mean)", "ssi_mean": "SSI after (mean)",
@@ -59,12 +59,9 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
                    help="a controller parameter, e.g. --set impedance_factor=1.5 (repeatable)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
-    p.add_argument("--plot", type=Path, help="PNG of speeds with the setpoint, quill and "
-                   "motor torque with its limit, WOB; stuck and saturated spans shaded; the "
-                   "last 10 s and the bit speed's spectrum with the string's modes; beside "
-                   "the uncontrolled run; also .svg or .pdf; an existing file is kept "
-                   "unless --overwrite")
-    p.add_argument("--overwrite", action="store_true", help="replace an existing --plot file")
+    add_plot_arguments(p, "speeds with the setpoint, quill and motor torque with its limit, "
+                       "WOB; stuck and saturated spans shaded; the last 10 s and the bit "
+                       "speed's spectrum with the string's modes; beside the uncontrolled run")
     p.add_argument("--no-baseline", action="store_true", help="skip the uncontrolled run "
                    "(by default it runs too, for the comparison)")
     p.add_argument("--ensemble", type=int, default=1, metavar="N",

@@ -7,6 +7,7 @@ from __future__ import annotations
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
+from typing import Any
 
 from drill_sim_ros.archive.output import (
     OutputError,
@@ -19,7 +20,15 @@ from drill_sim_ros.model.errors import DrillSimError
 PLOT_SUFFIXES = (".png", ".svg", ".pdf")
 
 
-def plot_target(path: Path | None, overwrite: bool) -> Path | None:
+def add_plot_arguments(parser: Any, picture: str) -> None:
+    """``--plot FILE`` (``picture``: what it draws) and ``--overwrite`` on ``parser``."""
+    parser.add_argument("--plot", type=Path, help=f"write a PNG of {picture} (also .svg or "
+                        ".pdf); an existing file is kept unless --overwrite")
+    parser.add_argument("--overwrite", action="store_true",
+                        help="replace an existing --plot file")
+
+
+def _plot_target(path: Path | None, overwrite: bool) -> Path | None:
     """A writable temporary file beside ``--plot`` (checked before the run), or None; the
     caller removes it when done (:func:`commit_plot` moves it on)."""
     if path is None:
@@ -49,9 +58,9 @@ def commit_plot(temporary: Path, path: Path, overwrite: bool) -> None:
 
 @contextmanager
 def plot_into(path: Path | None, overwrite: bool) -> Iterator[Path | None]:
-    """:func:`plot_target` for the run inside the ``with``, removed after it whatever
+    """:func:`_plot_target` for the run inside the ``with``, removed after it whatever
     happened (:func:`commit_plot` has moved it on when the picture was done)."""
-    temporary = plot_target(path, overwrite)
+    temporary = _plot_target(path, overwrite)
     try:
         yield temporary
     finally:

@@ -15,7 +15,7 @@ from drill_sim_ros.model import startup
 from drill_sim_ros.model.checks import number_in
 from drill_sim_ros.model.defaults import MAX_SURFACE_RPM
 from drill_sim_ros.model.presets import DEFAULT_PRESET, Preset, load_preset
-from drill_sim_ros.plot_file import commit_plot, plot_into
+from drill_sim_ros.plot_file import add_plot_arguments, commit_plot, plot_into
 from drill_sim_ros.string_cli import rounded
 from drill_sim_ros.terminal import StatusLine
 
@@ -44,10 +44,8 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--seconds", type=float, default=60.0, help="length of the run, s of "
                    f"simulated time, in (0, {startup.MAX_SECONDS:g}] (default 60)")
     p.add_argument("--json", action="store_true", help="print only the JSON line")
-    p.add_argument("--plot", type=Path, help="write a PNG of the speeds, torques and twist "
-                   "against time, the break-away marked (also .svg or .pdf); an existing "
-                   "file is kept unless --overwrite")
-    p.add_argument("--overwrite", action="store_true", help="replace an existing --plot file")
+    add_plot_arguments(p, "the speeds, torques and twist against time, the break-away "
+                       "marked")
 
 
 def _check_args(args: Any) -> None:

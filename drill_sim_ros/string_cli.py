@@ -16,7 +16,7 @@ from drill_sim_ros.model import string as sg
 from drill_sim_ros.model import string_instruments as si
 from drill_sim_ros.model.errors import ParameterError
 from drill_sim_ros.model.presets import DEFAULT_PRESET, Preset, load_preset
-from drill_sim_ros.plot_file import commit_plot, plot_into
+from drill_sim_ros.plot_file import add_plot_arguments, commit_plot, plot_into
 
 
 def add_parsers(sub: Any) -> None:
@@ -38,10 +38,7 @@ def add_parsers(sub: Any) -> None:
                       help="length of the record after the pulse, s of simulated time "
                       "(20-3600)")
     refl.add_argument("--json", action="store_true", help="print only the JSON line")
-    refl.add_argument("--plot", type=Path, help="write a PNG of |r| against frequency (also "
-                      ".svg or .pdf); an existing file is kept unless --overwrite")
-    refl.add_argument("--overwrite", action="store_true",
-                      help="replace an existing --plot file")
+    add_plot_arguments(refl, "|r| against frequency")
 
 
 def cmd_modes(args: Any) -> int:
