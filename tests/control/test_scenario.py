@@ -4,8 +4,16 @@ from __future__ import annotations
 
 import pytest
 
-from drill_sim_ros.control.scenario import load_scenario, save_scenario, scenario_from_dict
+from drill_sim_ros.control.bench import run_in_process
+from drill_sim_ros.control.rig import rig_physics
+from drill_sim_ros.control.scenario import (
+    load_scenario,
+    save_scenario,
+    scenario_from_dict,
+    scenario_path,
+)
 from drill_sim_ros.control.schedule import schedule_from_list
+from drill_sim_ros.control.scorecard import score
 from drill_sim_ros.model.errors import ParameterError
 
 
@@ -62,3 +70,27 @@ def test_off_bottom_is_an_action_at_its_time() -> None:
 def test_off_bottom_must_be_true_or_false(value) -> None:
     with pytest.raises(ParameterError, match=r"'off_bottom' = .* must be true or false"):
         schedule_from_list([{"t_s": 5, "off_bottom": value}], 35.0, 6e4)
+
+
+def test_the_lumped_first_mode_scenario_ranks_the_controllers() -> None:
+    """The league's ranking scenario (docs/league.md): on RGD07's lumped string the stiff
+    drive lets the first-mode stick-slip through, with the period field stick-slip has
+    (0.8-2.5 T1, T1 from the rig's own first mode), and the two soft drives end it
+    without touching their torque limit."""
+    base = load_scenario(scenario_path("lumped_first_mode"))
+    preset = base.load_preset()
+    rig = rig_physics(preset)
+    t1_s = 1.0 / rig.torsional_modes_hz[0]
+    cards = {}
+    for controller in ("stiff", "soft_torque", "z_torque"):
+        scenario = base.with_(controller=controller)
+        run = run_in_process(scenario)
+        cards[controller] = score(run.rows, scenario.enable_at_s, scenario.setpoints(preset),
+                                  rig, scenario.period_s)
+    stiff = cards.pop("stiff")
+    assert stiff["status"] == "stick-slip" and stiff["ssi_mean"] >= 0.8
+    assert 0.8 * t1_s <= stiff["period_s"] <= 2.5 * t1_s
+    for name, card in cards.items():
+        assert card["status"] == "ok", name
+        assert card["ssi_last"] <= 0.15, name
+        assert card["saturation_fraction"] <= 0.05, name
