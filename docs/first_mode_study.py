@@ -1,0 +1,109 @@
+"""How strongly the bit feeds the first torsional mode (docs/string.md): prints the tables.
+
+In process, the closed-loop bench's own runs (``control.bench.run_in_process``) scored by
+the scorecard, on two process workers. Two studies:
+
+1. **The feed.** The stiff drive on the distributed field string at the lumped twin's
+   operating point (60 rpm, 60 kN, a moderately worn bit: sigma l = 3e5 N/m), 600 s, over
+   the string's torsional and axial loss rates and two bit inertias; beside it the lumped
+   twin itself. Printed: the RMS of the low-passed bit speed about its mean over the last
+   300 s, its dominant period over T1, the stick fraction and the ringing above the
+   cut-off. A first mode the bit drives grows to stick-slip (RMS of tens of rpm); one it
+   cannot drive stays at the few rpm of the bit's own noise.
+2. **The default bit under lighter losses.** The field preset's sharp bit at 35 rpm and
+   60 kN, 180 s, switch-on at 60 s: stiff, soft_torque and z_torque at torsional rates
+   below the literature's 0.84 1/s. Printed: the stick fraction after the switch-on, the
+   period over T1 and the share at the torque limit.
+
+Usage: .venv/bin/python docs/first_mode_study.py [--workers 2]   (about 1 min on 2 cores)
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from concurrent.futures import ProcessPoolExecutor
+from typing import Any
+
+import numpy as np
+
+from drill_sim_ros.control.bench import run_in_process
+from drill_sim_ros.control.rig import rig_physics
+from drill_sim_ros.control.scenario import Scenario
+from drill_sim_ros.control.scorecard import F, lowpassed_bit_rpm, score
+
+FIELD, LUMPED = "field_8p5in_shale", "field_8p5in_shale_lumped"
+WORN_BIT = {"contact_stress_times_wearflat_n_per_m": 3.0e5}
+FEED_RATES = ((0.0, 1.35), (0.02, 1.35), (0.05, 1.35), (0.1, 1.35), (0.84, 1.35),
+              (0.0, 0.3), (0.05, 0.3), (0.1, 0.3), (0.2, 0.3))
+FEED_BIT_INERTIAS_KG_M2 = (0.3, 100.0)
+DEFAULT_RATES = (0.1, 0.3, 0.84)
+CONTROLLERS = ("stiff", "soft_torque", "z_torque")
+TAIL_S = 300.0
+
+
+def _run(case: dict[str, Any]) -> dict[str, Any]:
+    """One run of ``case`` (a Scenario's fields), scored; plus the slow speed's RMS over
+    the last TAIL_S seconds."""
+    scenario = Scenario(**case)
+    preset = scenario.load_preset()
+    rig = rig_physics(preset)
+    rows = run_in_process(scenario).rows
+    card = score(rows, scenario.enable_at_s, scenario.setpoints(preset), rig,
+                 scenario.period_s)
+    t_s = rows[:, F["sim_time_s"]]
+    slow = lowpassed_bit_rpm(rows, rig.cutoff_hz)[t_s >= t_s[-1] - TAIL_S]
+    return {**card, "slow_rms_rpm": float(np.std(slow)),
+            "t1_s": 1.0 / rig.torsional_modes_hz[0]}
+
+
+def _string(torsional: float, axial: float, bit_inertia: float) -> dict[str, Any]:
+    return {"string": {"torsional_damping_per_s": torsional, "axial_damping_per_s": axial,
+                       "bit_inertia_kg_m2": bit_inertia}, "physical": WORN_BIT}
+
+
+def feed_cases() -> list[tuple[str, dict[str, Any]]]:
+    cases = [("the lumped twin (no losses) | - | -", {"preset": LUMPED, "controller": "stiff",
+                                          "duration_s": 600.0, "enable_at_s": 200.0})]
+    for inertia in FEED_BIT_INERTIAS_KG_M2:
+        for torsional, axial in FEED_RATES:
+            cases.append((f"{torsional:g} | {axial:g} | {inertia:g}", {
+                "preset": FIELD, "controller": "stiff", "duration_s": 600.0,
+                "enable_at_s": 200.0, "schedule": ({"t_s": 0, "rpm": 60, "wob_n": 60e3},),
+                "overrides": _string(torsional, axial, inertia)}))
+    return cases
+
+
+def default_cases() -> list[tuple[str, dict[str, Any]]]:
+    return [(f"{rate:g} | {controller}", {
+        "preset": FIELD, "controller": controller,
+        "overrides": {"string": {"torsional_damping_per_s": rate}}})
+        for rate in DEFAULT_RATES for controller in CONTROLLERS]
+
+
+def _period(card: dict[str, Any]) -> str:
+    return "-" if card["period_s"] is None else f"{card['period_s'] / card['t1_s']:.2f}"
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--workers", type=int, default=2)
+    args = parser.parse_args()
+    feed, default = feed_cases(), default_cases()
+    with ProcessPoolExecutor(args.workers) as pool:
+        print("| torsional 1/s | axial 1/s | bit inertia kg m² | slow RMS, last 300 s, "
+              "rpm | period / T1 | stuck | ringing, rpm |\n|---|---|---|---|---|---|---|")
+        for (label, _), card in zip(feed, pool.map(_run, [c for _, c in feed]), strict=True):
+            print(f"| {label} | {card['slow_rms_rpm']:.1f} | {_period(card)} | "
+                  f"{card['stick_fraction']:.2f} | {card['hfto_rms_rpm']:.1f} |", flush=True)
+        print("\n| torsional 1/s | controller | stuck after the switch-on | period / T1 | "
+              "at the limit | status |\n|---|---|---|---|---|---|")
+        for (label, _), card in zip(default, pool.map(_run, [c for _, c in default]),
+                                    strict=True):
+            print(f"| {label} | {card['stick_fraction']:.2f} | {_period(card)} | "
+                  f"{card['saturation_fraction']:.3f} | {card['status']} |", flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
