@@ -204,7 +204,12 @@ def _spectrum(ax: Any, rows: np.ndarray, ctx: PlotContext) -> float:
     freq_hz, amplitude = analysis.amplitude_spectrum(after[:, F["bit_rpm"]],
                                                      sample_period_s(after))
     shown = (freq_hz >= SPECTRUM_MIN_HZ) & (freq_hz <= SPECTRUM_MAX_HZ)
-    ax.loglog(freq_hz[shown], amplitude[shown], color="tab:blue", lw=0.7)
+    if (amplitude[shown] > 0.0).any():
+        ax.loglog(freq_hz[shown], amplitude[shown], color="tab:blue", lw=0.7)
+    else:                       # a bit at rest throughout: nothing to put on a log scale
+        ax.set_xscale("log")
+        ax.text(0.5, 0.5, "the bit does not move: no spectrum", ha="center", va="center",
+                fontsize=8, color="0.3", transform=ax.transAxes)
     ax.set_xlim(SPECTRUM_MIN_HZ, min(SPECTRUM_MAX_HZ, float(freq_hz[-1])))
     for i, mode_hz in enumerate(ctx.rig.torsional_modes_hz):
         ax.axvline(mode_hz, color="0.3", ls=":", lw=1.0,
