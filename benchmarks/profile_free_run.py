@@ -7,8 +7,12 @@ through their sink, on loopback DDS with no subscriber.
 Prints the real-time factor, the wall time split into the session (the compiled kernel and
 the SI rows), the packing and the publishing, then cProfile's top functions by own time
 (the profiler slows the small calls most: its figures rank, the split measures).
+With ``--cold N`` it measures instead what one tick costs at real time: N ticks of one
+period, each after a sleep of about a period (so it starts on caches gone cold, as sim_node's
+ticker does at 100 Hz), the thread CPU of the session and of the publishing (packing
+included) per tick, mean and median; then the same N back to back (warm).
 Usage: .venv/bin/python benchmarks/profile_free_run.py [--preset field_8p5in_shale]
-       [--seconds 10] [--string-rate-hz 0] [--string-message typed] [--top 15]
+       [--seconds 10] [--string-rate-hz 0] [--string-message typed] [--top 15] [--cold N]
 """
 
 from __future__ import annotations
@@ -20,6 +24,8 @@ import pstats
 import random
 import sys
 import time
+
+import numpy as np
 
 os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
 os.environ.pop("ROS_LOCALHOST_ONLY", None)
@@ -98,6 +104,25 @@ def run_for(loop: Loop, seconds: float) -> float:
     return time.perf_counter() - start
 
 
+def cold_ticks(loop: Loop, ticks: int) -> None:
+    """Thread CPU per part of a one-period tick, after a sleep (cold) and back to back."""
+    parts_ns = np.zeros((ticks, 2))
+    for label, sleep_s in (("after a sleep of a period (cold)", 0.97 * PERIOD_S),
+                           ("back to back (warm)", 0.0)):
+        for i in range(ticks):
+            if sleep_s:
+                time.sleep(sleep_s)
+            start = time.thread_time_ns()
+            block = loop.session.run(1)
+            ran = time.thread_time_ns()
+            loop.sinks.emit(block, True)
+            parts_ns[i] = (ran - start, time.thread_time_ns() - ran)
+        mean, median = parts_ns.mean(axis=0) / 1e3, np.median(parts_ns, axis=0) / 1e3
+        print(f"{ticks} ticks {label}: SimSession.run(1) {mean[0]:.1f} us mean "
+              f"({median[0]:.1f} median), packing and publishing {mean[1]:.1f} us mean "
+              f"({median[1]:.1f} median) of thread CPU", flush=True)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--preset", default="field_8p5in_shale")
@@ -105,6 +130,8 @@ def main() -> None:
     parser.add_argument("--string-rate-hz", type=float, default=0.0)
     parser.add_argument("--string-message", default="typed", choices=MESSAGES)
     parser.add_argument("--top", type=int, default=15)
+    parser.add_argument("--cold", type=int, metavar="N", help="time N one-period ticks, "
+                        "each after a sleep of a period, then N back to back")
     args = parser.parse_args()
     rclpy.init()
     node = Node("profile_free_run", parameter_overrides=[
@@ -114,6 +141,9 @@ def main() -> None:
     try:
         loop = Loop(node)
         run_for(loop, 1.0)                                  # compiled, caches warm
+        if args.cold:
+            cold_ticks(loop, args.cold)
+            return
         loop.seconds = dict.fromkeys(loop.seconds, 0.0)
         loop.periods = 0
         wall = run_for(loop, args.seconds)
