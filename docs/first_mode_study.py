@@ -9,7 +9,9 @@ the scorecard, on two process workers. Two studies:
    twin itself. Printed: the RMS of the low-passed bit speed about its mean over the last
    300 s, its dominant period over T1, the stick fraction and the ringing above the
    cut-off. A first mode the bit drives grows to stick-slip (RMS of tens of rpm); one it
-   cannot drive stays at the few rpm of the bit's own noise.
+   cannot drive stays at the few rpm of the bit's own noise. Two more rows make the
+   collars 40 times stiffer axially: a BHA that moves axially as one body, as the lumped
+   twin's does.
 2. **The default bit under lighter losses.** The field preset's sharp bit at 35 rpm and
    60 kN, 180 s, switch-on at 60 s: stiff, soft_torque and z_torque at torsional rates
    below the literature's 0.84 1/s. Printed: the stick fraction after the switch-on, the
@@ -26,17 +28,24 @@ from concurrent.futures import ProcessPoolExecutor
 from typing import Any
 
 import numpy as np
+import yaml
 
 from drill_sim_ros.control.bench import run_in_process
 from drill_sim_ros.control.rig import rig_physics
 from drill_sim_ros.control.scenario import Scenario
 from drill_sim_ros.control.scorecard import F, lowpassed_bit_rpm, score
+from drill_sim_ros.model.presets import preset_path
+from drill_sim_ros.model.string import STEEL_YOUNGS_MODULUS_PA
 
 FIELD, LUMPED = "field_8p5in_shale", "field_8p5in_shale_lumped"
 WORN_BIT = {"contact_stress_times_wearflat_n_per_m": 3.0e5}
 FEED_RATES = ((0.0, 1.35), (0.02, 1.35), (0.05, 1.35), (0.1, 1.35), (0.84, 1.35),
               (0.0, 0.3), (0.05, 0.3), (0.1, 0.3), (0.2, 0.3))
 FEED_BIT_INERTIAS_KG_M2 = (0.3, 100.0)
+# the collars' Young's modulus x 40: a BHA nearly rigid in its axial motion, as the lumped
+# twin's (its lowest axial mode from about 6 to 40 Hz, far from the blade passage)
+RIGID_BHA_RATES = ((0.1, 1.35), (0.84, 1.35))
+RIGID_BHA_E_FACTOR = 40.0
 DEFAULT_RATES = (0.1, 0.3, 0.84)
 CONTROLLERS = ("stiff", "soft_torque", "z_torque")
 TAIL_S = 300.0
@@ -57,20 +66,34 @@ def _run(case: dict[str, Any]) -> dict[str, Any]:
             "t1_s": 1.0 / rig.torsional_modes_hz[0]}
 
 
-def _string(torsional: float, axial: float, bit_inertia: float) -> dict[str, Any]:
-    return {"string": {"torsional_damping_per_s": torsional, "axial_damping_per_s": axial,
-                       "bit_inertia_kg_m2": bit_inertia}, "physical": WORN_BIT}
+def _string(torsional: float, axial: float, bit_inertia: float,
+            collar_e_factor: float = 1.0) -> dict[str, Any]:
+    string = {"torsional_damping_per_s": torsional, "axial_damping_per_s": axial,
+              "bit_inertia_kg_m2": bit_inertia}
+    if collar_e_factor != 1.0:
+        pipe, collars = yaml.safe_load(preset_path(FIELD).read_text())["string"]["sections"]
+        string["sections"] = [pipe, {**collars, "youngs_modulus_pa":
+                                     collar_e_factor * STEEL_YOUNGS_MODULUS_PA}]
+    return {"string": string, "physical": WORN_BIT}
+
+
+def _feed_case(torsional: float, axial: float, inertia: float,
+               collar_e_factor: float = 1.0) -> dict[str, Any]:
+    return {"preset": FIELD, "controller": "stiff", "duration_s": 600.0,
+            "enable_at_s": 200.0, "schedule": ({"t_s": 0, "rpm": 60, "wob_n": 60e3},),
+            "overrides": _string(torsional, axial, inertia, collar_e_factor)}
 
 
 def feed_cases() -> list[tuple[str, dict[str, Any]]]:
-    cases = [("the lumped twin (no losses) | - | -", {"preset": LUMPED, "controller": "stiff",
-                                          "duration_s": 600.0, "enable_at_s": 200.0})]
+    cases = [("the lumped twin (no losses) | - | - | -", {
+        "preset": LUMPED, "controller": "stiff", "duration_s": 600.0, "enable_at_s": 200.0})]
     for inertia in FEED_BIT_INERTIAS_KG_M2:
         for torsional, axial in FEED_RATES:
-            cases.append((f"{torsional:g} | {axial:g} | {inertia:g}", {
-                "preset": FIELD, "controller": "stiff", "duration_s": 600.0,
-                "enable_at_s": 200.0, "schedule": ({"t_s": 0, "rpm": 60, "wob_n": 60e3},),
-                "overrides": _string(torsional, axial, inertia)}))
+            cases.append((f"{torsional:g} | {axial:g} | {inertia:g} | steel",
+                          _feed_case(torsional, axial, inertia)))
+    for torsional, axial in RIGID_BHA_RATES:
+        cases.append((f"{torsional:g} | {axial:g} | 0.3 | x {RIGID_BHA_E_FACTOR:g}",
+                      _feed_case(torsional, axial, 0.3, RIGID_BHA_E_FACTOR)))
     return cases
 
 
@@ -91,8 +114,9 @@ def main() -> int:
     args = parser.parse_args()
     feed, default = feed_cases(), default_cases()
     with ProcessPoolExecutor(args.workers) as pool:
-        print("| torsional 1/s | axial 1/s | bit inertia kg m² | slow RMS, last 300 s, "
-              "rpm | period / T1 | stuck | ringing, rpm |\n|---|---|---|---|---|---|---|")
+        print("| torsional 1/s | axial 1/s | bit inertia kg m² | collars' E | slow RMS, last "
+              "300 s, rpm | period / T1 | stuck | ringing, rpm |\n"
+              "|---|---|---|---|---|---|---|---|")
         for (label, _), card in zip(feed, pool.map(_run, [c for _, c in feed]), strict=True):
             print(f"| {label} | {card['slow_rms_rpm']:.1f} | {_period(card)} | "
                   f"{card['stick_fraction']:.2f} | {card['hfto_rms_rpm']:.1f} |", flush=True)
