@@ -11,7 +11,11 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from drill_sim_ros.control.reflection import measure_reflection_with
+from drill_sim_ros.control.reflection import (
+    CONTROL_RATE_HZ,
+    band_top_hz,
+    measure_reflection_with,
+)
 from drill_sim_ros.model import string as sg
 from drill_sim_ros.model import string_instruments as si
 from drill_sim_ros.model.errors import ParameterError
@@ -92,6 +96,7 @@ def _reflection(args: Any, preset: Preset, plot_tmp: Path | None) -> int:
     f_hz = si.frequencies_with_modes(preset.string)
     modes = {round(float(f), 6): k + 1 for k, f in enumerate(sg.analytic_modes_hz(preset.string))}
     if args.controller:
+        f_hz = si.frequencies_with_modes(preset.string, up_to_hz=band_top_hz(CONTROL_RATE_HZ))
         for name in args.controller:
             result = measure_reflection_with(args.params, name, args.mode, args.seconds,
                                              f_hz=f_hz)
@@ -122,21 +127,32 @@ def _reflection(args: Any, preset: Preset, plot_tmp: Path | None) -> int:
 
 def _plot(path: Path, name: str, f_hz: list[float], curves: dict[str, list[float]],
           analytic: list[float] | None) -> None:
+    """|r| against frequency, whole (left) and near 1 from 1 Hz up (right), where a drive
+    that returns a little more than it receives shows."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    fig, ax = plt.subplots(figsize=(7, 4))
-    for label, values in curves.items():
-        ax.semilogx(f_hz, values, "o-", label=f"{label} (measured in the time domain)")
-    if analytic is not None:
-        ax.semilogx(f_hz, analytic, "k--", label="|Z - Z_TD| / |Z + Z_TD|")
-    ax.axhline(1.0, color="0.5", lw=0.8)
-    ax.set_xlabel("frequency, Hz")
+    fig, (ax, zoom) = plt.subplots(1, 2, figsize=(11, 4), width_ratios=(3, 2))
+    for axis in (ax, zoom):
+        for label, values in curves.items():
+            axis.semilogx(f_hz, values, "o-", ms=4, label=f"{label} (measured in the time "
+                          "domain)")
+        if analytic is not None:
+            axis.semilogx(f_hz, analytic, "k--", label="|Z - Z_TD| / |Z + Z_TD|")
+        axis.axhline(1.0, color="0.5", lw=0.8)
+        axis.set_xlabel("frequency, Hz")
+        axis.grid(True, which="both", alpha=0.3)
     ax.set_ylabel("|r| of torsional waves at the top drive")
-    ax.set_title(f"{name}: reflection at the top drive (> 1: the drive feeds the wave)")
     ax.set_ylim(0.0, max(1.05, 1.05 * max(max(v) for v in curves.values())))
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend()
+    ax.legend(fontsize=8)
+    high = [v for values in curves.values() for f, v in zip(f_hz, values, strict=True)
+            if f >= 1.0]
+    spread = max(0.01, max(abs(v - 1.0) for v in high) * 1.2) if high else 0.01
+    zoom.set_xlim(1.0, max(f_hz) * 1.1)
+    zoom.set_ylim(1.0 - spread, 1.0 + spread)
+    zoom.axhspan(1.0, 1.0 + spread, color="tab:red", alpha=0.06)
+    zoom.set_title("near 1, from 1 Hz (shaded: the drive feeds the wave)", fontsize=9)
+    fig.suptitle(f"{name}: reflection at the top drive (> 1: the drive feeds the wave)")
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)

@@ -55,8 +55,19 @@ def _top_waves_through_bench(scenario: Scenario, preset: Preset, pulse: bool,
     return a, b
 
 
+CONTROL_RATE_HZ = 100.0  # the bench's control rate, the default of a scenario
+NYQUIST_SHARE = 0.9      # |r| with a controller is measured up to this share of its Nyquist
+
+
+def band_top_hz(control_rate_hz: float) -> float:
+    """The top of |r|(f) with a controller sampling at ``control_rate_hz``: near its Nyquist
+    rate, where a sampled law lags most (docs/closed-loop.md)."""
+    return NYQUIST_SHARE * 0.5 * control_rate_hz
+
+
 def measure_reflection_with(preset_name: str, controller: str, mode: str = "speed",
-                            seconds: float = 120.0, control_rate_hz: float = 100.0,
+                            seconds: float = 120.0,
+                            control_rate_hz: float = CONTROL_RATE_HZ,
                             settle_s: float = 30.0,
                             f_hz: np.ndarray | None = None,
                             params: dict[str, float] | None = None) -> si.Reflection:

@@ -291,17 +291,25 @@ class Reflection:
     r_analytic: list[float] | None
 
 
+REFLECTION_TOP_HZ = 20.0     # the usual top of |r|(f): past the collars' ring
+
+
 def reflection_frequencies(count: int = 16, f_lo_hz: float = 0.05,
-                           f_hi_hz: float = 20.0) -> np.ndarray:
+                           f_hi_hz: float = REFLECTION_TOP_HZ) -> np.ndarray:
     """Log-spaced frequencies between ``f_lo_hz`` and ``f_hi_hz`` (up to the collars' ring:
     a drive that returns more than it receives there pumps it)."""
     return np.geomspace(f_lo_hz, f_hi_hz, count)
 
 
-def frequencies_with_modes(spec: sg.StringSpec, count: int = 3) -> np.ndarray:
+def frequencies_with_modes(spec: sg.StringSpec, count: int = 3,
+                           up_to_hz: float = REFLECTION_TOP_HZ) -> np.ndarray:
     """:func:`reflection_frequencies` and the string's first ``count`` torsional modes
-    (fixed top, free bit), sorted: |r| at a mode is what decides whether it is absorbed."""
-    return np.unique(np.concatenate((reflection_frequencies(),
+    (fixed top, free bit), sorted: |r| at a mode is what decides whether it is absorbed.
+    With ``up_to_hz`` above the usual top, three more log-spaced frequencies up to it (a
+    sampled controller's |r| up to near its Nyquist rate)."""
+    above = np.geomspace(REFLECTION_TOP_HZ, up_to_hz, 4)[1:] \
+        if up_to_hz > REFLECTION_TOP_HZ else np.empty(0)
+    return np.unique(np.concatenate((reflection_frequencies(), above,
                                      sg.analytic_modes_hz(spec, count))))
 
 

@@ -458,6 +458,28 @@ def test_the_reference_controllers_are_passive_through_the_collars_ring() -> Non
         assert np.max(bare) - 1.0 == pytest.approx(deficit, rel=0.15), (name, bare)
 
 
+def test_the_series_damper_moves_the_holds_excess_above_a_quarter_of_the_control_rate(
+        ) -> None:
+    """Near the control's Nyquist rate the emulated drives return more than they receive,
+    and the series damper makes it more, not less: it acts with a delay of a period P, so
+    its real admittance goes as cos(w P), negative above a quarter of the control rate.
+    With the hold's deficit d = 2 Z (P / 2)(1 / J_v - 1 / J) and the damper's admittance m
+    times it (m = hold_margin, 2), |r| - 1 = d (1 - m cos(w P)): 2.9 d at 45 Hz
+    (controllers.SoftDrive.droop_per_nm_s; docs/closed-loop.md)."""
+    from drill_sim_ros.control.reflection import band_top_hz, measure_reflection_with
+    preset = load_preset("field_8p5in_shale")
+    z = preset.string.sections[0].torsional_impedance_nm_s
+    j = preset.top_drive.physical(preset.scales).inertia_kg_m2
+    period_s, margin = 0.01, 2.0
+    f_hz = np.array([0.7 * band_top_hz(1.0 / period_s), band_top_hz(1.0 / period_s)])
+    for name, fraction in (("soft_torque", 0.2), ("z_torque", 0.15)):
+        r = np.array(measure_reflection_with("field_8p5in_shale", name, seconds=40.0,
+                                             settle_s=10.0, f_hz=f_hz).r_measured)
+        deficit = 2.0 * z * 0.5 * period_s * (1.0 / (fraction * j) - 1.0 / j)
+        expected = deficit * (1.0 - margin * np.cos(2.0 * np.pi * f_hz * period_s))
+        assert r - 1.0 == pytest.approx(expected, rel=0.15), (name, r)
+
+
 def test_an_impedance_matched_drive_reflects_nothing() -> None:
     """A drive whose loop is a pure damper equal to the pipe's Z (kp = Z, ki = 0, a tiny
     inertia): |r| = |Z - kp - i w J| / |Z + kp + i w J| -> nearly 0 at low frequency."""
