@@ -10,7 +10,8 @@ the SI rows), the packing and the publishing, then cProfile's top functions by o
 With ``--cold N`` it measures instead what one tick costs at real time: N ticks of one
 period, each after a sleep of about a period (so it starts on caches gone cold, as sim_node's
 ticker does at 100 Hz), the thread CPU of the session and of the publishing (packing
-included) per tick, mean and median; then the same N back to back (warm).
+included) per tick, and of the simulator's compiled advance alone, mean and median; then
+the same N back to back (warm).
 Usage: .venv/bin/python benchmarks/profile_free_run.py [--preset field_8p5in_shale]
        [--seconds 10] [--string-rate-hz 0] [--string-message typed] [--top 15] [--cold N]
 """
@@ -37,6 +38,7 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 
 from drill_sim_ros import topics
+from drill_sim_ros.model import kernel
 from drill_sim_ros.model.presets import load_preset
 from drill_sim_ros.model.session import SimSession
 from drill_sim_ros.ros import typed
@@ -105,10 +107,15 @@ def run_for(loop: Loop, seconds: float) -> float:
 
 
 def cold_ticks(loop: Loop, ticks: int) -> None:
-    """Thread CPU per part of a one-period tick, after a sleep (cold) and back to back."""
-    parts_ns = np.zeros((ticks, 2))
+    """Thread CPU per part of a one-period tick, after a sleep (cold) and back to back: the
+    session and the packing with publishing, then the compiled advance alone
+    (``Simulator.advance_into``, the kernel and its Python wrapper: what no restructuring
+    of the Python around it removes)."""
+    sim, steps = loop.session.sim, loop.session.steps
+    rows = np.empty((2, kernel.N_COLS))
     for label, sleep_s in (("after a sleep of a period (cold)", 0.97 * PERIOD_S),
                            ("back to back (warm)", 0.0)):
+        parts_ns = np.zeros((ticks, 3))
         for i in range(ticks):
             if sleep_s:
                 time.sleep(sleep_s)
@@ -116,11 +123,18 @@ def cold_ticks(loop: Loop, ticks: int) -> None:
             block = loop.session.run(1)
             ran = time.thread_time_ns()
             loop.sinks.emit(block, True)
-            parts_ns[i] = (ran - start, time.thread_time_ns() - ran)
+            parts_ns[i, :2] = (ran - start, time.thread_time_ns() - ran)
+        for i in range(ticks):
+            if sleep_s:
+                time.sleep(sleep_s)
+            start = time.thread_time_ns()
+            sim.advance_into(rows, steps, steps, sample_end=True)
+            parts_ns[i, 2] = time.thread_time_ns() - start
         mean, median = parts_ns.mean(axis=0) / 1e3, np.median(parts_ns, axis=0) / 1e3
-        print(f"{ticks} ticks {label}: SimSession.run(1) {mean[0]:.1f} us mean "
-              f"({median[0]:.1f} median), packing and publishing {mean[1]:.1f} us mean "
-              f"({median[1]:.1f} median) of thread CPU", flush=True)
+        print(f"{ticks} ticks {label}, us of thread CPU, mean (median): SimSession.run(1) "
+              f"{mean[0]:.1f} ({median[0]:.1f}), packing and publishing {mean[1]:.1f} "
+              f"({median[1]:.1f}); the compiled advance alone {mean[2]:.1f} "
+              f"({median[2]:.1f})", flush=True)
 
 
 def main() -> None:
