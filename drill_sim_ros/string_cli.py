@@ -93,10 +93,11 @@ def _reflection(args: Any, preset: Preset, plot_tmp: Path | None) -> int:
     """:func:`cmd_reflection` once its arguments are checked; the picture into
     ``plot_tmp``."""
     curves: dict[str, list[float]] = {}
-    f_hz = si.frequencies_with_modes(preset.string)
+    # with a controller, on to near its Nyquist rate, where a sampled law lags most
+    f_hz = si.frequencies_with_modes(preset.string, up_to_hz=band_top_hz(CONTROL_RATE_HZ)) \
+        if args.controller else si.frequencies_with_modes(preset.string)
     modes = {round(float(f), 6): k + 1 for k, f in enumerate(sg.analytic_modes_hz(preset.string))}
     if args.controller:
-        f_hz = si.frequencies_with_modes(preset.string, up_to_hz=band_top_hz(CONTROL_RATE_HZ))
         for name in args.controller:
             result = measure_reflection_with(args.params, name, args.mode, args.seconds,
                                              f_hz=f_hz)
