@@ -38,6 +38,7 @@ from drill_sim_ros.model.string import (
     KernelString,
     Section,
     StringSpec,
+    fastest_hook_loop_s,
     kernel_string,
 )
 from drill_sim_ros.model.top_drive import TopDrive, TopDrivePhysical, top_drive_from_dict
@@ -275,6 +276,12 @@ def string_from_dict(values: Any, phys: PhysicalParams) -> StringSpec:
     spec = StringSpec(model=model, sections=sections, **_spec_scalars(values))
     if not spec.distributed and values.get("sections") is None:
         return StringSpec()                  # RGD07's lumped string of pipe_* / bha_*
+    if spec.distributed and spec.hook_wob_time_s <= fastest_hook_loop_s(spec):
+        raise ParameterError(
+            f"'string.hook_wob_time_s' = {spec.hook_wob_time_s:g} s must be longer than "
+            f"{fastest_hook_loop_s(spec):.3g} s on this string (about twice that without "
+            "axial losses): a faster hook loop pushes the axial wave guide harder than it "
+            "answers (gain 2 Z_top x compliance / hook_wob_time_s above 1) and runs away")
     return spec
 
 

@@ -190,6 +190,21 @@ def axial_compliance_m_per_n(spec: StringSpec) -> float:
     return sum(s.length_m / s.axial_stiffness_n for s in spec.sections)
 
 
+def fastest_hook_loop_s(spec: StringSpec) -> float:
+    """A ``hook_wob_time_s`` the hook's loop needs to exceed on a distributed string, s.
+
+    The loop is tuned on the static stiffness K (kp = 2 / (t_w K), :func:`kernel_string`),
+    but the top of a wave guide first answers the hook's speed with its axial impedance Z
+    alone; the loop's gain on that direct path is kp Z = 2 Z / (K t_w), the axial round
+    trip over t_w for a uniform string. Above 1 it runs away: measured on the field
+    string, a non-finite state within a second at t_w = 0.7 s (gain 1.41), and the same at
+    gains of 1.09-1.1 with a twentieth and a thirtieth of steel's E. Necessary, not
+    sufficient: the echo from the bit adds to the direct path, so a string without axial
+    losses needs about twice this (a uniform lossless one ran away at 1.2 times it and held
+    at 1.95 times; the field string's losses halve the echo and it held at 1.0 s)."""
+    return 2.0 * spec.sections[0].axial_impedance_n_s_per_m * axial_compliance_m_per_n(spec)
+
+
 # ---- analytic modes (transfer matrices, fixed top, free or inertia-loaded bit) -------------
 @dataclass(frozen=True)
 class LineProperties:

@@ -21,7 +21,7 @@ import pytest
 from drill_sim_ros.model import kernel as k
 from drill_sim_ros.model import string as sg
 from drill_sim_ros.model import string_instruments as si
-from drill_sim_ros.model.errors import ParameterError
+from drill_sim_ros.model.errors import NumericalFault, ParameterError
 from drill_sim_ros.model.presets import load_preset, preset_from_dict
 from drill_sim_ros.model.simulator import SimConfig, Simulator
 from drill_sim_ros.model.top_drive import TopDrive
@@ -216,6 +216,42 @@ def test_bad_bit_substeps_are_one_line_naming_the_key(value: object,
                   scales=preset.scales, string=preset.kernel_string)
     message = str(err.value)
     assert "\n" not in message and all(p in message for p in pieces), message
+
+
+def test_a_hook_loop_faster_than_the_axial_round_trip_is_refused() -> None:
+    """The hook's WOB loop is tuned on the string's static stiffness; the top of the wave
+    guide first answers with its impedance alone, so the loop's gain on that path is
+    round trip / hook_wob_time_s for one uniform section (2 L / c_a, c_a = sqrt(E / rho)).
+    Below the round trip the preset is one line naming the key, and the refusal is needed:
+    the same string built past the check with a loop at 0.8 of the round trip runs away.
+    This string has no axial losses, so the echo from the bit comes back whole and can
+    double the direct path's gain: at 2.5 round trips (gain 0.4, doubled 0.8) it drills
+    with the mean WOB at the applied weight."""
+    length_m = 2500.0                      # one pipe, in two sections (a preset needs two)
+    uniform = [{**PIPE, "length_m": 2000.0}, {**PIPE, "length_m": 500.0}]
+    round_trip_s = 2.0 * length_m / math.sqrt(FIELD_PHYSICAL["youngs_modulus_pa"]
+                                              / FIELD_PHYSICAL["density_kg_m3"])
+    with pytest.raises(ParameterError) as err:
+        string_preset(uniform, hook_wob_time_s=0.9 * round_trip_s)
+    message = str(err.value)
+    assert "\n" not in message and "string.hook_wob_time_s" in message, message
+    assert f"{round_trip_s:.3g} s" in message, message
+
+    def drill(preset, spec: sg.StringSpec, seconds: float) -> np.ndarray:
+        sc = preset.scales
+        sim = Simulator(preset.params, SimConfig(dtau=preset.dtau), top_drive=preset.top_drive,
+                        scales=sc, string=sg.kernel_string(spec, sc.time_s, sc.torque_nm,
+                                                           sc.length_m, sc.force_n))
+        steps = round(seconds / (sc.time_s * preset.dtau))
+        return sim.advance(steps, every=steps // 100).column(k.C_WOB) * sc.force_n
+
+    steady = string_preset(uniform, hook_wob_time_s=2.5 * round_trip_s)
+    wob_n = drill(steady, steady.string, 20.0)
+    assert np.all(np.isfinite(wob_n))
+    assert wob_n[50:].mean() == pytest.approx(FIELD_PHYSICAL["applied_wob_n"], rel=0.1)
+    fast = dataclasses.replace(steady.string, hook_wob_time_s=0.8 * round_trip_s)
+    with pytest.raises(NumericalFault):
+        drill(steady, fast, 20.0)
 
 
 def test_light_pipe_on_a_heavy_bha_approaches_the_lumped_model() -> None:
