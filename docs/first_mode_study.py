@@ -17,7 +17,8 @@ the scorecard, on two process workers. Two studies:
    below the literature's 0.84 1/s. Printed: the stick fraction after the switch-on, the
    period over T1 and the share at the torque limit.
 
-Usage: .venv/bin/python docs/first_mode_study.py [--workers 2]   (about 1 min on 2 cores)
+Usage: .venv/bin/python docs/first_mode_study.py [--workers 2] [--plot FILE.png]
+       (about 20 s on 2 cores)
 """
 
 from __future__ import annotations
@@ -25,6 +26,7 @@ from __future__ import annotations
 import argparse
 import sys
 from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -108,18 +110,63 @@ def _period(card: dict[str, Any]) -> str:
     return "-" if card["period_s"] is None else f"{card['period_s'] / card['t1_s']:.2f}"
 
 
+def plot_feed(path: Path, feed: list[tuple[str, dict[str, Any]]],
+              cards: list[dict[str, Any]]) -> None:
+    """The slow bit speed's RMS against the torsional loss rate, one line per string, with
+    the lumped twin and the RMS of a sine that touches zero at the setpoint."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(8, 5.5))
+    lines: dict[str, list[tuple[float, float]]] = {}
+    for (label, _), card in zip(feed[1:], cards[1:], strict=True):
+        torsional, axial, inertia, collars = (part.strip() for part in label.split("|"))
+        name = (f"axial {axial} 1/s, bit {inertia} kg m², collars' E {collars}")
+        lines.setdefault(name, []).append((float(torsional), card["slow_rms_rpm"]))
+    for name, points in lines.items():
+        rate, rms = zip(*sorted(points), strict=True)
+        ax.plot(rate, rms, "o-", ms=4, label=name)
+    ax.axhline(cards[0]["slow_rms_rpm"], color="k", lw=1.2,
+               label="the lumped twin (no losses): sticks, 1.03 T1")
+    ax.axhline(60.0 / np.sqrt(2.0), color="tab:red", ls="--", lw=1.0,
+               label="a sine touching zero at 60 rpm (42 rpm RMS)")
+    ax.axvline(0.84, color="0.4", ls=":", lw=1.0)
+    ax.text(0.8, 0.55, "the preset's losses\n(A&vdW 2019) ", color="0.3", fontsize=8,
+            ha="right", transform=ax.get_xaxis_transform())
+    ax.set_xscale("symlog", linthresh=0.02)
+    ticks = sorted({rate for rate, _ in FEED_RATES} | {0.84})
+    ax.set_xticks(ticks, [f"{rate:g}" for rate in ticks])
+    ax.set_xlim(0.0, 1.0)
+    ax.set_yscale("log")
+    ax.set_xlabel("torsional loss rate, 1/s (mode 1 damping ratio = rate / 2.66)")
+    ax.set_ylabel("slow bit speed RMS, last 300 s, rpm")
+    ax.set_title("The stiff drive at 60 rpm, 60 kN: the bit's feed of the first mode",
+                 fontsize=10)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.18), ncol=2,
+              frameon=False)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--plot", type=Path, help="also draw the first table as a PNG")
     args = parser.parse_args()
     feed, default = feed_cases(), default_cases()
     with ProcessPoolExecutor(args.workers) as pool:
         print("| torsional 1/s | axial 1/s | bit inertia kg m² | collars' E | slow RMS, last "
               "300 s, rpm | period / T1 | stuck | ringing, rpm |\n"
               "|---|---|---|---|---|---|---|---|")
+        cards = []
         for (label, _), card in zip(feed, pool.map(_run, [c for _, c in feed]), strict=True):
+            cards.append(card)
             print(f"| {label} | {card['slow_rms_rpm']:.1f} | {_period(card)} | "
                   f"{card['stick_fraction']:.2f} | {card['hfto_rms_rpm']:.1f} |", flush=True)
+        if args.plot:
+            plot_feed(args.plot, feed, cards)
         print("\n| torsional 1/s | controller | stuck after the switch-on | period / T1 | "
               "at the limit | status |\n|---|---|---|---|---|---|")
         for (label, _), card in zip(default, pool.map(_run, [c for _, c in default]),
