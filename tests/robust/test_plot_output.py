@@ -4,6 +4,7 @@ and no run (no table is printed). So do run --trace and map-plot -o."""
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 
 import pytest
@@ -80,3 +81,17 @@ def test_an_existing_map_picture_is_kept_unless_overwrite(capsys, tmp_path: Path
     assert sorted(p.name for p in tmp_path.iterdir() if p.name.startswith("m.")) == [
         "m.nc", "m.png"]                                                  # no temporary left
     assert not [p for p in tmp_path.iterdir() if "partial" in p.name]
+
+
+def test_a_bit_at_rest_all_run_draws_without_warnings(capsys, tmp_path: Path) -> None:
+    """tight_torque_limit stalls at its first stick (57 s): after the switch-on at 60 s the
+    bit never moves, so its spectrum has nothing to put on a log axis. The picture says so
+    in words instead of drawing an empty log-log plot and warning on stderr."""
+    png = tmp_path / "stall.png"
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        rc, _, err = run_cli(capsys, "closed-loop", "--scenario", "tight_torque_limit",
+                             "--no-baseline", "--json", "--plot", str(png))
+    assert rc == 0, err
+    assert png.read_bytes()[:8] == PNG_MAGIC
+    assert not [str(w.message) for w in caught if "positive" in str(w.message)]
