@@ -30,14 +30,14 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import yaml
 
 from drill_sim_ros.control.bench import run_in_process
 from drill_sim_ros.control.rig import rig_physics
 from drill_sim_ros.control.scenario import Scenario
-from drill_sim_ros.control.scorecard import F, lowpassed_bit_rpm, score
+from drill_sim_ros.control.scorecard import F, lowpassed_bit_rpm
 from drill_sim_ros.model.presets import preset_path
 from drill_sim_ros.model.string import STEEL_YOUNGS_MODULUS_PA
+from drill_sim_ros.model.validate_input import read_preset_file
 
 FIELD, LUMPED = "field_8p5in_shale", "field_8p5in_shale_lumped"
 WORN_BIT = {"contact_stress_times_wearflat_n_per_m": 3.0e5}
@@ -59,9 +59,8 @@ def _run(case: dict[str, Any]) -> dict[str, Any]:
     scenario = Scenario(**case)
     preset = scenario.load_preset()
     rig = rig_physics(preset)
-    rows = run_in_process(scenario).rows
-    card = score(rows, scenario.enable_at_s, scenario.setpoints(preset), rig,
-                 scenario.period_s)
+    run = run_in_process(scenario)
+    rows, card = run.rows, run.score()
     t_s = rows[:, F["sim_time_s"]]
     slow = lowpassed_bit_rpm(rows, rig.cutoff_hz)[t_s >= t_s[-1] - TAIL_S]
     return {**card, "slow_rms_rpm": float(np.std(slow)),
@@ -73,7 +72,7 @@ def _string(torsional: float, axial: float, bit_inertia: float,
     string = {"torsional_damping_per_s": torsional, "axial_damping_per_s": axial,
               "bit_inertia_kg_m2": bit_inertia}
     if collar_e_factor != 1.0:
-        pipe, collars = yaml.safe_load(preset_path(FIELD).read_text())["string"]["sections"]
+        pipe, collars = read_preset_file(preset_path(FIELD))["string"]["sections"]
         string["sections"] = [pipe, {**collars, "youngs_modulus_pa":
                                      collar_e_factor * STEEL_YOUNGS_MODULUS_PA}]
     return {"string": string, "physical": WORN_BIT}

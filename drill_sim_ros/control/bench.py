@@ -21,9 +21,11 @@ import json
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, replace
+from typing import Any
 
 import numpy as np
 
+from drill_sim_ros.control import scorecard
 from drill_sim_ros.control.command import (
     Command,
     CommandLimits,
@@ -63,6 +65,14 @@ class ClosedLoopRun:
     accumulators: np.ndarray | None = None
     snapshot: np.ndarray | None = None
     interrupted: bool = False     # Ctrl-C: ``rows`` holds the periods done
+
+    def score(self, from_s: float | None = None) -> dict[str, Any]:
+        """The scorecard of these rows (:func:`scorecard.score`) on the run's own scenario:
+        its preset's rig and setpoints, scored after ``from_s`` (default: the switch-on)."""
+        preset = self.scenario.load_preset()
+        start_s = self.scenario.enable_at_s if from_s is None else from_s
+        return scorecard.score(self.rows, start_s, self.scenario.setpoints(preset),
+                               rig_physics(preset), self.scenario.period_s)
 
 
 def scenario_drive(scenario: Scenario, preset: Preset) -> TopDrivePhysical:

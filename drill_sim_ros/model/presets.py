@@ -276,10 +276,11 @@ def string_from_dict(values: Any, phys: PhysicalParams) -> StringSpec:
     spec = StringSpec(model=model, sections=sections, **_spec_scalars(values))
     if not spec.distributed and values.get("sections") is None:
         return StringSpec()                  # RGD07's lumped string of pipe_* / bha_*
-    if spec.distributed and spec.hook_wob_time_s <= fastest_hook_loop_s(spec):
+    fastest_s = fastest_hook_loop_s(spec) if spec.distributed else 0.0
+    if spec.hook_wob_time_s <= fastest_s:
         raise ParameterError(
             f"'string.hook_wob_time_s' = {spec.hook_wob_time_s:g} s must be longer than "
-            f"{fastest_hook_loop_s(spec):.3g} s on this string (about twice that without "
+            f"{fastest_s:.3g} s on this string (about twice that without "
             "axial losses): a faster hook loop pushes the axial wave guide harder than it "
             "answers (gain 2 Z_top x compliance / hook_wob_time_s above 1) and runs away")
     return spec

@@ -28,9 +28,7 @@ import math
 import numpy as np
 
 from drill_sim_ros.control.bench import ClosedLoopRun, run_in_process
-from drill_sim_ros.control.rig import rig_physics
 from drill_sim_ros.control.scenario import Scenario
-from drill_sim_ros.control.scorecard import score
 from drill_sim_ros.model import analysis
 from drill_sim_ros.model import kernel as k
 from drill_sim_ros.model.defaults import PERTURB_V
@@ -92,10 +90,8 @@ def closed_loop_figures(spec: MapSpec, p: DimensionlessParams,
     """The map variables of a finished closed-loop ``run`` of point ``p`` (module doc)."""
     scenario, sc = run.scenario, spec.scales
     assert sc is not None and run.accumulators is not None and run.snapshot is not None
-    preset = scenario.load_preset()
     start_s = window_start_s(spec, scenario)
-    card = score(run.rows, start_s, scenario.setpoints(preset), rig_physics(preset),
-                 scenario.period_s)
+    card = run.score(start_s)
     acc = run.accumulators.copy()
     acc[_SUMS] -= run.snapshot[_SUMS]
     avg = analysis.cycle_averages(p, acc)

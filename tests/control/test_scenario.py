@@ -13,7 +13,6 @@ from drill_sim_ros.control.scenario import (
     scenario_path,
 )
 from drill_sim_ros.control.schedule import schedule_from_list
-from drill_sim_ros.control.scorecard import score
 from drill_sim_ros.model.errors import ParameterError
 
 
@@ -78,15 +77,9 @@ def test_the_lumped_first_mode_scenario_ranks_the_controllers() -> None:
     (0.8-2.5 T1, T1 from the rig's own first mode), and the two soft drives end it
     without touching their torque limit."""
     base = load_scenario(scenario_path("lumped_first_mode"))
-    preset = base.load_preset()
-    rig = rig_physics(preset)
-    t1_s = 1.0 / rig.torsional_modes_hz[0]
-    cards = {}
-    for controller in ("stiff", "soft_torque", "z_torque"):
-        scenario = base.with_(controller=controller)
-        run = run_in_process(scenario)
-        cards[controller] = score(run.rows, scenario.enable_at_s, scenario.setpoints(preset),
-                                  rig, scenario.period_s)
+    t1_s = 1.0 / rig_physics(base.load_preset()).torsional_modes_hz[0]
+    cards = {controller: run_in_process(base.with_(controller=controller)).score()
+             for controller in ("stiff", "soft_torque", "z_torque")}
     stiff = cards.pop("stiff")
     assert stiff["status"] == "stick-slip" and stiff["ssi_mean"] >= 0.8
     assert 0.8 * t1_s <= stiff["period_s"] <= 2.5 * t1_s

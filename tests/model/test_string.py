@@ -467,6 +467,16 @@ def test_reflection_through_the_bench() -> None:
     assert r_first["stiff"] > 0.95, r_first
 
 
+def hold_deficit(inertia_fraction: float, period_s: float) -> float:
+    """|r| - 1 of a drive emulating J_v = inertia_fraction J through a setpoint held over
+    period_s, on the field preset: 2 Z (P / 2)(1 / J_v - 1 / J)
+    (controllers.SoftDrive.droop_per_nm_s)."""
+    preset = load_preset("field_8p5in_shale")
+    z = preset.string.sections[0].torsional_impedance_nm_s
+    j = preset.top_drive.physical(preset.scales).inertia_kg_m2
+    return 2.0 * z * 0.5 * period_s * (1.0 / (inertia_fraction * j) - 1.0 / j)
+
+
 def test_the_reference_controllers_are_passive_through_the_collars_ring() -> None:
     """|r| <= 1 from 0.05 Hz to 16 Hz (past the collars' c / L = 15.9 Hz) for stiff,
     soft_torque and z_torque. Without their series damper (hold_margin -> 0) the emulated
@@ -475,9 +485,6 @@ def test_the_reference_controllers_are_passive_through_the_collars_ring() -> Non
     and 0.0058 on the field drive; that figure comes from the formula, and the measured
     excess must match it."""
     from drill_sim_ros.control.reflection import measure_reflection_with
-    preset = load_preset("field_8p5in_shale")
-    z = preset.string.sections[0].torsional_impedance_nm_s
-    j = preset.top_drive.physical(preset.scales).inertia_kg_m2
     f_hz = np.array([0.05, 0.2115, 0.5, 1.0, 2.0, 4.0, 8.0, 12.0, 16.0])
 
     def reflection(name: str, **params: float) -> np.ndarray:
@@ -490,8 +497,8 @@ def test_the_reference_controllers_are_passive_through_the_collars_ring() -> Non
         r = reflection(name)
         assert np.all(r <= 1.0), (name, r)
         bare = reflection(name, hold_margin=1e-9)
-        deficit = 2.0 * z * 0.5 * 0.01 * (1.0 / (fraction * j) - 1.0 / j)
-        assert np.max(bare) - 1.0 == pytest.approx(deficit, rel=0.15), (name, bare)
+        assert np.max(bare) - 1.0 == pytest.approx(hold_deficit(fraction, 0.01), rel=0.15), \
+            (name, bare)
 
 
 def test_the_series_damper_moves_the_holds_excess_above_a_quarter_of_the_control_rate(
@@ -503,16 +510,13 @@ def test_the_series_damper_moves_the_holds_excess_above_a_quarter_of_the_control
     times it (m = hold_margin, 2), |r| - 1 = d (1 - m cos(w P)): 2.9 d at 45 Hz
     (controllers.SoftDrive.droop_per_nm_s; docs/closed-loop.md)."""
     from drill_sim_ros.control.reflection import band_top_hz, measure_reflection_with
-    preset = load_preset("field_8p5in_shale")
-    z = preset.string.sections[0].torsional_impedance_nm_s
-    j = preset.top_drive.physical(preset.scales).inertia_kg_m2
     period_s, margin = 0.01, 2.0
     f_hz = np.array([0.7 * band_top_hz(1.0 / period_s), band_top_hz(1.0 / period_s)])
     for name, fraction in (("soft_torque", 0.2), ("z_torque", 0.15)):
         r = np.array(measure_reflection_with("field_8p5in_shale", name, seconds=40.0,
                                              settle_s=10.0, f_hz=f_hz).r_measured)
-        deficit = 2.0 * z * 0.5 * period_s * (1.0 / (fraction * j) - 1.0 / j)
-        expected = deficit * (1.0 - margin * np.cos(2.0 * np.pi * f_hz * period_s))
+        expected = hold_deficit(fraction, period_s) \
+            * (1.0 - margin * np.cos(2.0 * np.pi * f_hz * period_s))
         assert r - 1.0 == pytest.approx(expected, rel=0.15), (name, r)
 
 
