@@ -5,7 +5,10 @@
     whose thread publishes sim_node's own payloads (the same bytes, topics and QoS: the 11
     sample topics, the typed telemetry twin, a string profile every 10 samples) every
     10 ms through ``Publisher.publish``; and the node's tick lateness p50/p99 (its
-    /diagnostics). ``--pairs`` reference/node measurements alternate; the median ratio counts;
+    /diagnostics). ``--pairs`` reference/node measurements alternate; the median ratio counts.
+    With ``--floors``, each pair also measures two floors of any Python node on this model,
+    as ratios to the same reference: the reference plus the simulator's compiled advance of
+    each period, and plus ``SimSession.run(1)`` and the packing of the payloads it publishes;
 (b0) the ceiling of a free run, measured the same way: the reference publishing the same
     payloads as fast as it can (no simulation), as a real-time factor at 100 Hz;
 (b) free run (real_time_factor 0): achieved real-time factor (sim seconds per wall second),
@@ -19,8 +22,8 @@
     ``--rounds`` times; each as x real time (median) and as a ratio to the lumped twin's.
 Targets (issue 10): (a) sim_node <= 1.5x the reference, p99 <= 2 ms; (b) >= 100x, and with
 recording >= a third of that; (issue 35) (e) typed >= 0.85x the lumped twin and >= 50x.
-Usage: .venv/bin/python benchmarks/bench_node.py [--seconds 10] [--pairs 3]
-       [--preset field_8p5in_shale] [--rounds 2] [--strings-only]
+Usage: .venv/bin/python benchmarks/bench_node.py [--seconds 10] [--pairs 3] [--floors]
+       [--preset field_8p5in_shale] [--rounds 2] [--strings-only] [--real-time-only]
 """
 
 from __future__ import annotations
@@ -61,6 +64,9 @@ if typed.AVAILABLE:                    # the typed telemetry twin, which sim_nod
     PUBLISHED.append(topics.TYPED_TELEMETRY)
 if typed.PROFILE_AVAILABLE:            # (e): the typed profiles are subscribed too
     PUBLISHED.append(topics.TYPED_STRING_TORSION)
+# (a) with --floors: the reference plus the simulation's work, by --reference-work
+FLOORS = {"advance": "the reference + the compiled advance of a period",
+          "session": "the reference + SimSession.run(1) and the packing of its payloads"}
 # (e): (label, preset suffix, sim_node parameters)
 STRING_CASES = (("distributed, typed profiles", "", ("string.message:=typed",)),
                 ("distributed, JointState profiles", "", ("string.message:=joint_state",)),
@@ -120,19 +126,26 @@ def start_node(preset: str, factor: float, record_path: str = "",
     return subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
 
 
-def start_reference(preset: str, period_s: float = 0.01) -> subprocess.Popen:
+def start_reference(preset: str, period_s: float = 0.01, work: str = "none") -> subprocess.Popen:
     return subprocess.Popen([sys.executable, __file__, "--reference-publisher", preset,
-                             "--reference-period", str(period_s)],
+                             "--reference-period", str(period_s), "--reference-work", work],
                             stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
 
 
-def reference_publisher(preset: str, period_s: float) -> None:
+def reference_publisher(preset: str, period_s: float, work: str = "none") -> None:
     """The reference: a thread publishing sim_node's payloads of one block every
     ``period_s``; with 0, as fast as it can in batches of FREE_RUN_BATCH samples (the
     ceiling of a free run), printing ``monotonic_s samples`` once a second. The payloads are
     the node's at its defaults: the 11 sample topics, the typed telemetry twin (when
     drill_sim_msgs is installed) and, on a distributed string, one typed string profile
-    every 10 samples (string.rate_hz 10)."""
+    every 10 samples (string.rate_hz 10).
+
+    ``work`` (the floors of a Python node, with none of sim_node's lock, pacer, handshake or
+    executor entities) adds the simulation to each sample: ``advance``, the simulator's
+    compiled advance of one period alone (the payloads stay the prepared ones); ``session``,
+    ``SimSession.run(1)`` and the packing of its sample (and its profile when one is due),
+    whose payloads are the ones published."""
+    from drill_sim_ros.model import kernel
     from drill_sim_ros.model.presets import load_preset
     from drill_sim_ros.model.session import SimSession
     from drill_sim_ros.ros.frame import SampleFrame
@@ -161,15 +174,33 @@ def reference_publisher(preset: str, period_s: float) -> None:
                                 "drill_sim")
         profiles = [packer.pack(sample) for sample in block.strings]
     stop_event = threading.Event()
+    sim, steps = session.sim, session.steps
+    rows = np.empty((2, kernel.N_COLS))
+    twin_packer = typed.TelemetryPacker("drill_sim") if typed.AVAILABLE else None
+
+    def sample_payloads(i: int) -> tuple[list[bytes], bytes | None]:
+        """The payloads of sample ``i`` and its profile (None when none is due)."""
+        if work == "session":
+            block = session.run(1)
+            fresh = frame.pack(block.rows, block.stamps_ns)[0]
+            if twin_packer is not None:
+                fresh = [*fresh, twin_packer.pack(block.rows, block.stamps_ns)[0]]
+            profile = packer.pack(block.strings[0]) if profiles and block.strings else None
+            return fresh, profile
+        if work == "advance":
+            sim.advance_into(rows, steps, steps, sample_end=True)
+        profile = profiles[(i // 10) % len(profiles)] if profiles and i % 10 == 0 else None
+        return payloads[i % len(payloads)], profile
 
     def publish_every_10_ms() -> None:
         deadline = next_report = time.monotonic()
         i = 0
         while not stop_event.is_set():
-            for pub, payload in zip(pubs, payloads[i % len(payloads)], strict=True):
+            sample, profile = sample_payloads(i)
+            for pub, payload in zip(pubs, sample, strict=True):
                 pub.publish(payload)
-            if profiles and i % 10 == 0:
-                profile_pub.publish(profiles[(i // 10) % len(profiles)])
+            if profile is not None:
+                profile_pub.publish(profile)
             i += 1
             if period_s > 0:
                 deadline += period_s
@@ -282,9 +313,14 @@ def main() -> None:
     parser.add_argument("--strings-only", action="store_true", help="(e) only")
     parser.add_argument("--reference-publisher", metavar="PRESET", help=argparse.SUPPRESS)
     parser.add_argument("--reference-period", type=float, default=0.01, help=argparse.SUPPRESS)
+    parser.add_argument("--reference-work", default="none", help=argparse.SUPPRESS)
+    parser.add_argument("--floors", action="store_true",
+                        help="(a) also the floors of a Python node: the reference with the "
+                        "simulation's compiled advance, and with SimSession.run and packing")
     args = parser.parse_args()
     if args.reference_publisher:
-        reference_publisher(args.reference_publisher, args.reference_period)
+        reference_publisher(args.reference_publisher, args.reference_period,
+                            args.reference_work)
         return
     rclpy.init()
     listener = Listener()
@@ -293,8 +329,15 @@ def main() -> None:
             string_profiles(listener, args.preset, args.seconds, args.rounds)
             return
         ratios = []
+        floors: dict[str, list[float]] = {work: [] for work in FLOORS} if args.floors else {}
         for pair in range(1, args.pairs + 1):      # alternated: drift hits both alike
             ref = measure(listener, start_reference(args.preset), args.seconds)
+            for work, label in FLOORS.items() if args.floors else ():
+                floor = measure(listener, start_reference(args.preset, work=work), args.seconds)
+                floors[work].append(floor["cpu_percent"] / ref["cpu_percent"])
+                print(f"(a) pair {pair}: the floor of a Python node, {label}: CPU "
+                      f"{floor['cpu_percent']:.1f} % = {floors[work][-1]:.2f}x the reference",
+                      flush=True)
             rt = measure(listener, start_node(args.preset, 1.0), args.seconds)
             ratios.append(rt["cpu_percent"] / ref["cpu_percent"])
             print(f"(a) pair {pair}: real time, 100 Hz, {len(PUBLISHED)} topics subscribed: "
@@ -305,6 +348,10 @@ def main() -> None:
                   f"(reference {ref['received_per_s']:.0f})", flush=True)
         print(f"(a) CPU ratio, median of {len(ratios)} pairs: {float(np.median(ratios)):.2f}x "
               f"(range {min(ratios):.2f}-{max(ratios):.2f})", flush=True)
+        for work, values in floors.items():
+            print(f"(a) the floor of a Python node, {FLOORS[work]}, median of {len(values)} "
+                  f"pairs: {float(np.median(values)):.2f}x (range {min(values):.2f}-"
+                  f"{max(values):.2f})", flush=True)
         if args.real_time_only:
             return
         ceiling_proc = start_reference(args.preset, period_s=0.0)

@@ -6,7 +6,8 @@ one runs them in sequence, with the commit, the time and the load average before
 that one sitting gives one comparable set:
 - kernel ns/step against the naive reference step (bench_kernel.py);
 - sim_node's free run, distributed and lumped, each against a bare rclpy publisher of the
-  same topics, and its CPU at 100 Hz real time against that publisher (bench_node.py);
+  same topics, and its CPU at 100 Hz real time against that publisher, beside the floors of
+  a Python node (that publisher plus the simulation's own work; bench_node.py --floors);
 - the closed-loop bench in process, both strings (bench_closed_loop.py);
 - the gym's steps/s on every shipped scenario (bench_gym.py).
 Usage: .venv/bin/python benchmarks/bench_summary.py
@@ -25,7 +26,7 @@ RUNS = (
     ("kernel ns/step / the naive step", ["bench_kernel.py", "--repeats", "3"]),
     ("sim_node on the distributed default: real time and free run against the bare "
      "publisher; (e) the string profiles and the lumped twin",
-     ["bench_node.py", "--pairs", "2"]),
+     ["bench_node.py", "--pairs", "2", "--floors"]),
     ("sim_node on the lumped twin against the bare publisher",
      ["bench_node.py", "--preset", "field_8p5in_shale_lumped", "--pairs", "2",
       "--rounds", "0"]),
