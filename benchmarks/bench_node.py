@@ -313,7 +313,8 @@ def main() -> None:
     parser.add_argument("--strings-only", action="store_true", help="(e) only")
     parser.add_argument("--reference-publisher", metavar="PRESET", help=argparse.SUPPRESS)
     parser.add_argument("--reference-period", type=float, default=0.01, help=argparse.SUPPRESS)
-    parser.add_argument("--reference-work", default="none", help=argparse.SUPPRESS)
+    parser.add_argument("--reference-work", default="none", choices=("none", *FLOORS),
+                        help=argparse.SUPPRESS)
     parser.add_argument("--floors", action="store_true",
                         help="(a) also the floors of a Python node: the reference with the "
                         "simulation's compiled advance, and with SimSession.run and packing")
