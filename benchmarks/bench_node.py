@@ -161,10 +161,11 @@ def reference_publisher(preset: str, period_s: float, work: str = "none") -> Non
     session = SimSession(session_config(yaml_defaults(loaded), loaded))
     block = session.run(100)
     payloads = frame.pack(block.rows, block.stamps_ns)
-    if typed.AVAILABLE:
+    twin_packer = typed.TelemetryPacker("drill_sim") if typed.AVAILABLE else None
+    if twin_packer is not None:
         pubs.append(node.create_publisher(typed.Telemetry, topics.TYPED_TELEMETRY,
                                           topic_qos(topics.TYPED_TELEMETRY)))
-        twins = typed.TelemetryPacker("drill_sim").pack(block.rows, block.stamps_ns)
+        twins = twin_packer.pack(block.rows, block.stamps_ns)
         payloads = [[*row, twin] for row, twin in zip(payloads, twins, strict=True)]
     profiles: list[bytes] = []
     if block.strings and typed.PROFILE_AVAILABLE:
@@ -176,7 +177,6 @@ def reference_publisher(preset: str, period_s: float, work: str = "none") -> Non
     stop_event = threading.Event()
     sim, steps = session.sim, session.steps
     rows = np.empty((2, kernel.N_COLS))
-    twin_packer = typed.TelemetryPacker("drill_sim") if typed.AVAILABLE else None
 
     def sample_payloads(i: int) -> tuple[list[bytes], bytes | None]:
         """The payloads of sample ``i`` and its profile (None when none is due)."""

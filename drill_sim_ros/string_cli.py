@@ -94,8 +94,8 @@ def _reflection(args: Any, preset: Preset, plot_tmp: Path | None) -> int:
     ``plot_tmp``."""
     curves: dict[str, list[float]] = {}
     # with a controller, on to near its Nyquist rate, where a sampled law lags most
-    f_hz = si.frequencies_with_modes(preset.string, up_to_hz=band_top_hz(CONTROL_RATE_HZ)) \
-        if args.controller else si.frequencies_with_modes(preset.string)
+    top_hz = band_top_hz(CONTROL_RATE_HZ) if args.controller else si.REFLECTION_TOP_HZ
+    f_hz = si.frequencies_with_modes(preset.string, up_to_hz=top_hz)
     modes = {round(float(f), 6): k + 1 for k, f in enumerate(sg.analytic_modes_hz(preset.string))}
     if args.controller:
         for name in args.controller:
