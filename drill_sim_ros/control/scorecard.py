@@ -5,32 +5,49 @@ ROS-free; from telemetry rows (``TELEMETRY_FIELDS``, SI) of a run, after the swi
 * stick-slip is judged on the bit speed low-passed at the rig's cut-off
   (``RigPhysics.cutoff_hz``, twice the string's third torsional mode;
   ``model.analysis.lowpass``, zero-phase): on a distributed string the collars ring at the
-  bit an order of magnitude faster (high-frequency torsional oscillation, HFTO), and a
+  bit an order of magnitude faster (7-16 Hz on the field string: the "ring" figures
+  below; not the 50-400 Hz HFTO of field logs, which this model does not carry), and a
   ring that touches zero is no stick phase. A sample is stuck when the low-passed bit
-  speed is below ``STUCK_RPM``;
+  speed is below ``STUCK_RPM``; a stick (phase) is a span of consecutive stuck samples;
 * SSI over whole 20 s windows (``model.analysis.stick_slip_index``, the one SSI:
   (max - min) / (2 mean) of the low-passed bit rpm), mean and max, that of the last window
-  (settled), and the mean before the switch-on;
-* stick fraction (share of samples stuck), UTR = (omega_0 - min) / omega_0 of the raw bit
-  speed (``model.analysis.severity_of``, omega_0 the mean setpoint of the schedule);
+  (settled), and the mean before the switch-on (None when no whole window precedes it).
+  The SSI of a window grows without bound as its mean speed falls to 0; it is clipped at
+  ``SSI_MAX``, and a window whose mean is below ``STUCK_RPM`` (the bit stuck nearly
+  throughout) reads ``SSI_MAX``: a run stuck throughout has the largest SSI;
+* stick fraction (share of samples stuck), the longest stick, UTR = (omega_0 - min) /
+  omega_0 and the maximum of the raw bit speed (``model.analysis.severity_of``, omega_0 the
+  mean setpoint of the schedule);
 * time to suppress: from the switch-on to the last stuck sample (0 if none; None when the
   bit still sticks in the last 20 s, or when the quiet end is no longer than the longest
   spell the bit turned between two sticks after the switch-on: an intermittent stick-slip
   is not ended by one quiet window);
 * period: the dominant period of the low-passed bit speed (its spectral peak above
   ``PERIOD_MIN_HZ``; None when it is flat: no spectral line of ``MIN_OSCILLATION_RMS_RPM``);
-* HFTO: the RMS of the bit speed above the cut-off (raw minus low-passed), its dominant
+* ring: the RMS of the bit speed above the cut-off (raw minus low-passed), its dominant
   frequency (None below ``MIN_OSCILLATION_RMS_RPM``), and the cut-off used;
 * mean ROP (m/h); mechanical specific energy at the bit (Teale 1965: <WOB>/A +
   <TOB omega_bit>/(A <ROP>), MPa);
-* peak and RMS string torque at the quill (N m), motor energy (the motor's work
-  sum tau_m omega_drive P, MJ), saturation count (samples at the motor torque limit or with
-  the speed setpoint at 0 or at the rpm limit) and saturation fraction (share of samples
-  with the motor torque at its limit, alone);
-* status: ``stalled`` when the bit is stuck for good (stuck without a break for the last
-  ``STALL_S`` seconds or more of the run; ``stall_time_s`` is when that span began),
-  else ``stick-slip`` when the stick-slip is not suppressed (time to suppress None), else
-  ``ok``. (A run that ends in a numerical fault has no rows to score: its runner reports
+* peak and RMS string torque at the quill (N m);
+* the actuator's effort: the motor torque's RMS about its mean (its standard deviation,
+  N m), its mean absolute rate between consecutive samples (kN m/s), the motor's net work
+  sum tau_m omega_drive P and its positive work sum max(tau_m omega_drive, 0) P (MJ: what
+  a drive that cannot regenerate draws; its braking is burnt), saturation count (samples at
+  the motor torque limit or with the speed setpoint at 0 or at the rpm limit) and
+  saturation fraction (share of samples with the motor torque at its limit, alone);
+* status, by :func:`status_of` (one rule, in this order):
+
+  1. ``stalled`` when the bit got stuck and stayed stuck: stuck without a break for the
+     last ``STALL_S`` seconds or more of the run, and that last stick already lasts
+     ``STALL_FACTOR`` times the longest stick the bit broke out of after the switch-on
+     (any length when it broke out of none). A stick-slip that happens to end inside one
+     of its stick phases is not a stall. ``stall_time_s`` is when that last stick began;
+  2. else ``stick-slip`` when the bit was stuck ``STICK_FRACTION_OK`` (10 %) of the time
+     after the switch-on or more, or the stick-slip is not suppressed (time to suppress
+     None), or the SSI of the last window is ``SSI_OK`` (1) or more;
+  3. else ``ok``.
+
+  (A run that ends in a numerical fault has no rows to score: its runner reports
   ``fault``.)
 """
 
@@ -54,20 +71,33 @@ STUCK_RPM = 1.0           # low-passed bit speed below this: stuck (on the lumpe
 MIN_OSCILLATION_RMS_RPM = 0.1   # below this RMS a component has no frequency (flat)
 PERIOD_MIN_HZ = 0.02      # the slowest stick-slip the period looks for (50 s)
 WINDOW_S = defaults.WINDOW_S  # the severity window of sim_node's /diagnostics
-STALL_S = 10.0            # stuck this long at the end of a run: stalled (a stick phase of
-                          # the field case's stick-slip lasts 2-4 s)
-SCORE_FIELDS = ("ssi_before_mean", "ssi_mean", "ssi_max", "ssi_last", "stick_fraction", "utr",
-                "time_to_suppress_s", "rop_m_h", "mse_mpa", "quill_torque_peak_nm",
-                "quill_torque_rms_nm", "motor_energy_mj", "saturation_count",
-                "saturation_fraction", "period_s", "hfto_rms_rpm", "hfto_hz", "cutoff_hz",
-                "status", "stall_time_s")
+STALL_S = 10.0            # stuck this long at the end of a run: a stall candidate (a stick
+                          # phase of the field case's stick-slip lasts 7-15 s, so STALL_FACTOR
+                          # decides there)
+STALL_FACTOR = 2.0        # ... and this many times the longest stick it broke out of: a
+                          # chaotic stick-slip's sticks vary by tens of percent (field_default
+                          # uncontrolled: 8.1-9.7 s), twice the longest is outside that spread
+STICK_FRACTION_OK = 0.10  # stuck this share of the time after the switch-on: never ok
+SSI_OK = 1.0              # a last window's SSI this high is stick-slip: a symmetric
+                          # oscillation of SSI 1 reaches zero speed at its trough
+SSI_MAX = 10.0            # the SSI of a window is clipped here, and a window whose mean is
+                          # below STUCK_RPM reads it: the SSI of a square-wave stick-slip
+                          # stuck a share s of the time is 1 / (2 (1 - s)); 10 is s = 0.95,
+                          # twice the worst window of the shipped reference runs
+SCORE_FIELDS = ("ssi_before_mean", "ssi_mean", "ssi_max", "ssi_last", "stick_fraction",
+                "stick_longest_s", "utr", "bit_rpm_max", "time_to_suppress_s", "rop_m_h",
+                "mse_mpa", "quill_torque_peak_nm", "quill_torque_rms_nm",
+                "motor_torque_std_nm", "motor_torque_rate_mean_knm_s", "motor_energy_mj",
+                "motor_energy_in_mj", "saturation_count", "saturation_fraction", "period_s",
+                "ring_rms_rpm", "ring_hz", "cutoff_hz", "status", "stall_time_s")
 STATUSES = ("ok", "stick-slip", "stalled", "fault")
 
 
 def window_ssi(time_s: np.ndarray, bit_rpm: np.ndarray, start_s: float, end_s: float,
                window_s: float = WINDOW_S) -> np.ndarray:
     """SSI of each whole window [start + k w, start + (k + 1) w) within [start, end]; the
-    span itself when no whole window fits."""
+    span itself when no whole window fits. Clipped at ``SSI_MAX``, which a window whose
+    mean is below ``STUCK_RPM`` reads (module doc)."""
     count = math.floor((end_s - start_s) / window_s + 1e-9)
     edges = [(start_s + k * window_s, start_s + (k + 1) * window_s) for k in range(count)]
     edges = edges or [(start_s, end_s)]
@@ -78,7 +108,8 @@ def window_ssi(time_s: np.ndarray, bit_rpm: np.ndarray, start_s: float, end_s: f
             lo.append(part.min())
             hi.append(part.max())
             mean.append(part.mean())
-    return analysis.stick_slip_index(lo, hi, mean)
+    ssi = analysis.stick_slip_index(lo, hi, mean)
+    return np.where(np.asarray(mean) < STUCK_RPM, SSI_MAX, np.minimum(ssi, SSI_MAX))
 
 
 def _mean(values: np.ndarray) -> float | None:
@@ -107,29 +138,37 @@ def score(rows: np.ndarray, enable_at_s: float, schedule: Schedule, rig: RigPhys
     omega0_rpm = float(np.mean([schedule.rpm_at(x) for x in ta]))
     sev = analysis.severity_of(float(bit.min()), float(bit.max()), float(bit.mean()),
                                omega0_rpm)
-    suppress_s = _time_to_suppress(ta, stuck, enable_at_s, end_s)
-    stall_s = stall_time_s(t, slow_all < STUCK_RPM)
-    status = "stalled" if stall_s is not None else "stick-slip" if suppress_s is None \
-        else "ok"
-    return {
-        "ssi_before_mean": _mean(before), "ssi_mean": _mean(ssi),
-        "ssi_max": float(np.max(ssi)) if np.isfinite(ssi).all() else None,
-        "ssi_last": float(ssi[-1]) if np.isfinite(ssi[-1]) else None,
-        "stick_fraction": float(stuck.mean()), "utr": sev.utr,
-        "time_to_suppress_s": suppress_s,
+    card = {
+        "ssi_before_mean": _mean(before), "ssi_mean": float(np.mean(ssi)),
+        "ssi_max": float(np.max(ssi)), "ssi_last": float(ssi[-1]),
+        "stick_fraction": float(stuck.mean()),
+        "stick_longest_s": max((b - a for a, b in stick_spans_s(ta, stuck)), default=0.0),
+        "utr": sev.utr, "bit_rpm_max": sev.omega_max,
+        "time_to_suppress_s": _time_to_suppress(ta, stuck, enable_at_s, end_s),
         **_costs(after, rig, period_s),
         "period_s": _period_s(slow, sample_period_s(rows)),
-        **_hfto(bit - slow, sample_period_s(rows), rig.cutoff_hz),
-        "status": status, "stall_time_s": stall_s,
+        **_ring(bit - slow, sample_period_s(rows), rig.cutoff_hz),
     }
+    stall_s = stall_time_s(t, slow_all < STUCK_RPM, enable_at_s)
+    return {**card, "status": status_of(card, stall_s), "stall_time_s": stall_s}
+
+
+def status_of(card: dict[str, Any], stall_s: float | None) -> str:
+    """The status of a scorecard (module doc, rule 1-3): ``stalled`` when the run ends in a
+    stall (``stall_s``, :func:`stall_time_s`, not None), else ``stick-slip`` or ``ok`` from
+    the stick fraction, the suppression and the last window's SSI."""
+    if stall_s is not None:
+        return "stalled"
+    if card["stick_fraction"] >= STICK_FRACTION_OK or card["time_to_suppress_s"] is None \
+            or card["ssi_last"] >= SSI_OK:
+        return "stick-slip"
+    return "ok"
 
 
 def _costs(after: np.ndarray, rig: RigPhysics, period_s: float) -> dict[str, Any]:
-    """ROP, specific energy, quill torque, motor energy and saturation of ``after``."""
+    """ROP, specific energy, quill torque, the motor's effort and saturation of ``after``."""
     rop = after[:, F["rop_m_s"]]
     quill = after[:, F["surface_torque_nm"]]
-    motor = after[:, F["motor_torque_nm"]]
-    drive_rad_s = after[:, F["surface_rpm"]] / RPM_PER_RAD_S
     bit_power_w = after[:, F["tob_nm"]] * after[:, F["bit_rpm"]] / RPM_PER_RAD_S
     mse_pa = (after[:, F["wob_n"]].mean() + bit_power_w.mean() / rop.mean()) / rig.bit_area_m2 \
         if rop.mean() > 0 else math.nan
@@ -138,10 +177,24 @@ def _costs(after: np.ndarray, rig: RigPhysics, period_s: float) -> dict[str, Any
         "mse_mpa": mse_pa * 1e-6 if math.isfinite(mse_pa) else None,
         "quill_torque_peak_nm": float(np.max(np.abs(quill))),
         "quill_torque_rms_nm": float(np.sqrt(np.mean(quill**2))),
-        "motor_energy_mj": float(np.sum(motor * drive_rad_s) * period_s * 1e-6),
+        **motor_effort(after, period_s),
         "saturation_count": int(saturated(after, rig).sum()),
         "saturation_fraction": float(at_torque_limit(after, rig).mean()),
     }
+
+
+def motor_effort(rows: np.ndarray, period_s: float) -> dict[str, float]:
+    """The motor's effort over ``rows`` (consecutive samples ``period_s`` apart): its
+    torque's RMS about its mean (N m), the mean absolute rate of its torque between
+    consecutive samples (kN m/s; 0 for one sample), its net work sum tau_m omega_drive P
+    and its positive work sum max(tau_m omega_drive, 0) P (MJ)."""
+    motor = rows[:, F["motor_torque_nm"]]
+    power_w = motor * rows[:, F["surface_rpm"]] / RPM_PER_RAD_S
+    rate = np.abs(np.diff(motor)) / period_s
+    return {"motor_torque_std_nm": float(np.std(motor)),
+            "motor_torque_rate_mean_knm_s": float(rate.mean() * 1e-3) if rate.size else 0.0,
+            "motor_energy_mj": float(np.sum(power_w) * period_s * 1e-6),
+            "motor_energy_in_mj": float(np.sum(np.maximum(power_w, 0.0)) * period_s * 1e-6)}
 
 
 def sample_period_s(rows: np.ndarray) -> float:
@@ -180,35 +233,46 @@ def _period_s(slow_rpm: np.ndarray, sample_period_s: float) -> float | None:
     return 1.0 / peak[0]
 
 
-def _hfto(fast_rpm: np.ndarray, sample_period_s: float, cutoff_hz: float) -> dict[str, Any]:
+def _ring(fast_rpm: np.ndarray, sample_period_s: float, cutoff_hz: float) -> dict[str, Any]:
     """RMS and dominant frequency of the bit speed above the cut-off, and the cut-off."""
     rms = float(np.sqrt(np.mean(fast_rpm**2)))
     peak = analysis.spectral_peak(fast_rpm, sample_period_s, cutoff_hz) \
         if rms >= MIN_OSCILLATION_RMS_RPM else None
-    return {"hfto_rms_rpm": rms, "hfto_hz": None if peak is None else peak[0],
+    return {"ring_rms_rpm": rms, "ring_hz": None if peak is None else peak[0],
             "cutoff_hz": cutoff_hz if math.isfinite(cutoff_hz) else None}
 
 
-def stall_time_s(time_s: np.ndarray, stuck: np.ndarray, stall_s: float = STALL_S
-                 ) -> float | None:
-    """When the bit got stuck for good: the start of the stuck span that ends the run, if it
-    lasts ``stall_s`` or more; None otherwise."""
-    if not stuck.size or not stuck[-1]:
+def stick_spans_s(t: np.ndarray, stuck: np.ndarray) -> list[tuple[float, float]]:
+    """Each stick of ``stuck`` (samples at times ``t``) as (start, end) in s: from its first
+    stuck sample to the first sample after it (to the last sample for a stick that ends the
+    record), so a stick of n samples P apart lasts n P."""
+    edges = np.diff(np.concatenate(([0], stuck.astype(np.int8), [0])))
+    starts, ends = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
+    step = float(np.median(np.diff(t))) if t.size > 1 else 0.0
+    return [(float(t[a]) - step, float(t[b - 1])) for a, b in zip(starts, ends, strict=True)]
+
+
+def stall_time_s(time_s: np.ndarray, stuck: np.ndarray, enable_at_s: float = 0.0,
+                 stall_s: float = STALL_S) -> float | None:
+    """When the bit got stuck for good (module doc, rule 1): the start of the stick that
+    ends the run, if it lasts ``stall_s`` or more and ``STALL_FACTOR`` times the longest
+    stick that ended after ``enable_at_s``; None otherwise."""
+    spans = stick_spans_s(time_s, stuck)
+    if not spans or not stuck[-1]:
         return None
-    moving = np.flatnonzero(~stuck)
-    first = int(moving[-1]) + 1 if moving.size else 0
-    start_s = float(time_s[first])
-    return start_s if float(time_s[-1]) - start_s >= stall_s else None
+    start_s, end_s = spans[-1]
+    broke_out = [b - a for a, b in spans[:-1] if b > enable_at_s]
+    lasts_s = end_s - start_s
+    if lasts_s < stall_s or lasts_s < STALL_FACTOR * max(broke_out, default=0.0):
+        return None
+    return start_s
 
 
 def longest_gap_s(t: np.ndarray, stuck: np.ndarray) -> float:
-    """The longest time the bit turned between two of its stick phases (0 with fewer than
-    two): how long a quiet spell of this run's own stick-slip can last."""
-    edges = np.diff(stuck.astype(np.int8))
-    ends, starts = np.flatnonzero(edges == -1), np.flatnonzero(edges == 1) + 1
-    starts = starts[starts > ends[0]] if ends.size else starts
-    gaps = t[starts[:ends.size]] - t[ends[:starts.size]]
-    return float(gaps.max()) if gaps.size else 0.0
+    """The longest time the bit turned between two of its sticks (0 with fewer than two):
+    how long a quiet spell of this run's own stick-slip can last."""
+    spans = stick_spans_s(t, stuck)
+    return max((b[0] - a[1] for a, b in zip(spans, spans[1:])), default=0.0)
 
 
 def _time_to_suppress(t: np.ndarray, stuck: np.ndarray, enable_at_s: float,
