@@ -53,6 +53,7 @@ ROS-free; from telemetry rows (``TELEMETRY_FIELDS``, SI) of a run, after the swi
 
 from __future__ import annotations
 
+import itertools
 import math
 from typing import Any
 
@@ -83,7 +84,8 @@ SSI_OK = 1.0              # a last window's SSI this high is stick-slip: a symme
 SSI_MAX = 10.0            # the SSI of a window is clipped here, and a window whose mean is
                           # below STUCK_RPM reads it: the SSI of a square-wave stick-slip
                           # stuck a share s of the time is 1 / (2 (1 - s)); 10 is s = 0.95,
-                          # twice the worst window of the shipped reference runs
+                          # over twice any window field_default's reference runs turn through
+                          # (at most 4.1)
 SCORE_FIELDS = ("ssi_before_mean", "ssi_mean", "ssi_max", "ssi_last", "stick_fraction",
                 "stick_longest_s", "utr", "bit_rpm_max", "time_to_suppress_s", "rop_m_h",
                 "mse_mpa", "quill_torque_peak_nm", "quill_torque_rms_nm",
@@ -272,7 +274,7 @@ def longest_gap_s(t: np.ndarray, stuck: np.ndarray) -> float:
     """The longest time the bit turned between two of its sticks (0 with fewer than two):
     how long a quiet spell of this run's own stick-slip can last."""
     spans = stick_spans_s(t, stuck)
-    return max((b[0] - a[1] for a, b in zip(spans, spans[1:])), default=0.0)
+    return max((b[0] - a[1] for a, b in itertools.pairwise(spans)), default=0.0)
 
 
 def _time_to_suppress(t: np.ndarray, stuck: np.ndarray, enable_at_s: float,

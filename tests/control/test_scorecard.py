@@ -14,7 +14,7 @@ from drill_sim_ros.control.bench import run_in_process
 from drill_sim_ros.control.rig import rig_physics
 from drill_sim_ros.control.scenario import Scenario
 from drill_sim_ros.control.schedule import Schedule
-from drill_sim_ros.control.scorecard import lowpassed_bit_rpm, score, window_ssi
+from drill_sim_ros.control.scorecard import SSI_MAX, lowpassed_bit_rpm, score, window_ssi
 from drill_sim_ros.model import analysis
 from drill_sim_ros.model.params import RPM_PER_RAD_S
 from drill_sim_ros.model.presets import load_preset
@@ -238,3 +238,102 @@ def test_a_switch_on_at_the_end_is_one_error_not_a_crash() -> None:
     with pytest.raises(ParameterError, match="leaves nothing to score"):
         score(rows, scenario.enable_at_s, scenario.setpoints(preset), rig_physics(preset),
               scenario.period_s)
+
+
+# ---- the status rule (scorecard module doc) on the cases of issue 48 ---------------------------
+SWITCH_ON_S, END_S = 60.0, 180.0
+SCHEDULE = Schedule(60.0, 60e3)
+
+
+def judged(rows: np.ndarray) -> dict:
+    return score(rows, SWITCH_ON_S, SCHEDULE, RIG, PERIOD_S)
+
+
+def test_the_uncontrolled_default_stuck_23_percent_is_never_ok() -> None:
+    """The default case without control: sticks of 9.7, 8.6, 8.1 and 1.6 s after the
+    switch-on (28 s of 120: 23 %), then 37 s quiet, longer than any spell it turned
+    between them (25 s). Suppressed by the quiet end, but stuck 10 % or more: stick-slip
+    (the old rule read ok)."""
+    card = judged(intermittent([60.0, 81.4, 107.7, 141.0], END_S, [9.7, 8.6, 8.1, 1.6]))
+    assert card["stick_fraction"] == pytest.approx(28.0 / 120.0, abs=8 * EDGE_S / 120.0)
+    assert card["stick_longest_s"] == pytest.approx(9.7, abs=2 * EDGE_S)   # two edges
+    assert card["time_to_suppress_s"] == pytest.approx(142.6 - 60.0, abs=EDGE_S)
+    assert card["status"] == "stick-slip" and card["stall_time_s"] is None
+
+
+def test_a_bit_held_stuck_then_let_go_is_not_ok_and_has_a_numeric_ssi() -> None:
+    """A controller that holds the bit stuck from 60 to 150 s, then turns it at 60 rpm:
+    stuck 3/4 of the time after the switch-on, so not ok; not stalled, it turned again.
+    Its windows inside the stick read SSI_MAX, the SSI's ceiling, not None."""
+    card = judged(intermittent([60.0], END_S, 90.0))
+    assert card["stick_fraction"] == pytest.approx(0.75, abs=2 * EDGE_S / 120.0)
+    assert card["status"] == "stick-slip" and card["stall_time_s"] is None
+    assert card["time_to_suppress_s"] == pytest.approx(90.0, abs=EDGE_S)
+    assert card["ssi_max"] == SSI_MAX
+    # windows 60-80 .. 120-140 stuck (SSI_MAX), 140-160 turning from 150 s: (60 - 0) /
+    # (2 x 30), the last window turning steadily: 0
+    assert card["ssi_mean"] == pytest.approx((4 * SSI_MAX + 1.0) / 6, abs=0.05)
+    assert card["ssi_last"] == pytest.approx(0.0, abs=0.01)
+
+
+def test_a_stick_slip_ending_inside_a_stick_is_stick_slip_not_stalled() -> None:
+    """Sticks of 12 s every 25 s (as long_string's, which read "stalled" when the run
+    ended 13 s into one): the run ends 11 s into a stick, more than STALL_S but less than
+    twice the sticks the bit broke out of. Judged by the record: stick-slip."""
+    starts = [69.0 + 25.0 * k for k in range(5)]        # the last from 169 s to the end
+    card = judged(intermittent(starts, END_S, 12.0))
+    assert card["stick_longest_s"] == pytest.approx(12.0, abs=2 * EDGE_S)   # two edges
+    assert card["status"] == "stick-slip" and card["stall_time_s"] is None
+
+
+def test_a_bit_that_stuck_and_stayed_stuck_is_stalled() -> None:
+    """Sticks of 3 s every 10 s, then stuck from 140 s to the end: 40 s, more than
+    STALL_FACTOR times the longest stick it broke out of. Stalled at 140 s; its last
+    windows read SSI_MAX."""
+    rows = intermittent([*(65.0 + 10.0 * k for k in range(7)), 140.0], END_S,
+                        [3.0] * 7 + [40.0])
+    card = judged(rows)
+    assert card["status"] == "stalled"
+    assert card["stall_time_s"] == pytest.approx(140.0, abs=EDGE_S)
+    assert card["ssi_last"] == SSI_MAX
+
+
+def test_a_clean_suppression_is_ok() -> None:
+    """Stick-slip before the switch-on (1 s sticks every 5 s, as lumped_first_mode), one
+    1.4 s stick after it, then turning: stuck 1.2 % of the time, none in the last 20 s,
+    SSI of the last window 0. ok."""
+    card = judged(intermittent([*(21.0 + 5.0 * k for k in range(8)), 60.0], END_S,
+                               [1.0] * 8 + [1.4]))
+    assert card["stick_fraction"] == pytest.approx(1.4 / 120.0, abs=2 * EDGE_S / 120.0)
+    assert card["time_to_suppress_s"] == pytest.approx(1.4, abs=EDGE_S)
+    assert card["status"] == "ok" and card["ssi_last"] == pytest.approx(0.0, abs=0.01)
+
+
+def test_a_run_stuck_throughout_has_the_largest_ssi() -> None:
+    """Stuck from before the switch-on to the end: every window reads SSI_MAX, the
+    largest any window can read (a turning window is clipped to it)."""
+    card = judged(intermittent([10.0], END_S, 200.0))
+    assert card["ssi_mean"] == card["ssi_max"] == card["ssi_last"] == SSI_MAX
+    assert card["status"] == "stalled" and card["stall_time_s"] == pytest.approx(10.0, abs=EDGE_S)
+    spike = window_ssi(np.arange(1, 2001) * PERIOD_S, np.r_[np.full(1990, 2.0),
+                                                            np.full(10, 400.0)], 0.0, 20.0)
+    assert spike[0] == SSI_MAX      # (400 - 2) / (2 x 3.99) = 50: clipped
+
+
+def test_the_motor_effort_by_its_definitions() -> None:
+    """A motor torque of 20 kN m sin(2 pi t / 2 s) at a steady 60 rpm: RMS about the mean
+    A / sqrt(2); mean |d tau / dt| = 4 A f (the mean of |cos| is 2 / pi); net work 0 over
+    whole periods, positive work A omega / pi per second. The bit's max speed is 90 rpm."""
+    rows = synthetic(100.0)
+    t = rows[:, F["sim_time_s"]]
+    amplitude_nm, f_hz = 20e3, 0.5
+    rows[:, F["motor_torque_nm"]] = amplitude_nm * np.sin(2 * np.pi * f_hz * t)
+    card = score(rows, 20.0, SCHEDULE, RIG, PERIOD_S)
+    omega = 60.0 / RPM_PER_RAD_S
+    assert card["motor_torque_std_nm"] == pytest.approx(amplitude_nm / math.sqrt(2), rel=1e-3)
+    assert card["motor_torque_rate_mean_knm_s"] == pytest.approx(4 * amplitude_nm * f_hz * 1e-3,
+                                                                 rel=1e-3)
+    assert card["motor_energy_mj"] == pytest.approx(0.0, abs=1e-3 * amplitude_nm * omega * 1e-6)
+    assert card["motor_energy_in_mj"] == pytest.approx(amplitude_nm * omega / math.pi * 80.0
+                                                       * 1e-6, rel=1e-3)
+    assert card["bit_rpm_max"] == pytest.approx(90.0, rel=1e-6)
