@@ -163,7 +163,7 @@ def main() -> int:
         for (label, _), card in zip(feed, pool.map(_run, [c for _, c in feed]), strict=True):
             cards.append(card)
             print(f"| {label} | {card['slow_rms_rpm']:.1f} | {_period(card)} | "
-                  f"{card['stick_fraction']:.2f} | {card['hfto_rms_rpm']:.1f} |", flush=True)
+                  f"{card['stick_fraction']:.2f} | {card['ring_rms_rpm']:.1f} |", flush=True)
         if args.plot:
             plot_feed(args.plot, feed, cards)
         print("\n| torsional 1/s | controller | stuck after the switch-on | period / T1 | "

@@ -11,6 +11,7 @@ from typing import Any
 
 from drill_sim_ros.control.bench import ClosedLoopRun, run_in_process
 from drill_sim_ros.control.controllers import CONTROL_MODES
+from drill_sim_ros.control.registry import display_name
 from drill_sim_ros.control.rig import RigPhysics, rig_physics
 from drill_sim_ros.control.scenario import (
     ENSEMBLE_KEY,
@@ -31,14 +32,19 @@ from drill_sim_ros.terminal import StatusLine
 
 LABELS = {"ssi_before_mean": "SSI before switch-on (mean)", "ssi_mean": "SSI after (mean)",
           "ssi_max": "SSI after (max)", "ssi_last": "SSI last 20 s",
-          "stick_fraction": "stick fraction after",
-          "utr": "UTR", "time_to_suppress_s": "time to suppress [s]",
+          "stick_fraction": "stick fraction after", "stick_longest_s": "longest stick [s]",
+          "utr": "UTR", "bit_rpm_max": "bit speed max [rpm]",
+          "time_to_suppress_s": "time to suppress [s]",
           "rop_m_h": "mean ROP [m/h]", "mse_mpa": "MSE at the bit [MPa]",
           "quill_torque_peak_nm": "quill torque peak [N m]",
           "quill_torque_rms_nm": "quill torque RMS [N m]",
-          "motor_energy_mj": "motor energy [MJ]", "saturation_count": "saturated samples",
+          "motor_torque_std_nm": "motor torque RMS about mean [N m]",
+          "motor_torque_rate_mean_knm_s": "motor torque |rate| [kN m/s]",
+          "motor_energy_mj": "motor work, net [MJ]",
+          "motor_energy_in_mj": "motor work, positive [MJ]",
+          "saturation_count": "saturated samples",
           "saturation_fraction": "at the torque limit", "period_s": "stick-slip period [s]",
-          "hfto_rms_rpm": "HFTO RMS [rpm]", "hfto_hz": "HFTO frequency [Hz]",
+          "ring_rms_rpm": "collar ring RMS [rpm]", "ring_hz": "collar ring freq. [Hz]",
           "cutoff_hz": "cut-off [Hz]", "status": "status", "stall_time_s": "stalled at [s]"}
 
 
@@ -112,9 +118,10 @@ def _table(columns: dict[str, dict[str, Any]]) -> str:
             return str(value)
         return f"{value:.4g}" if math.isfinite(value) else "-"
     names = list(columns)
-    lines = [f"{'':30s}" + "".join(f"{n:>22s}" for n in names)]
+    width = max(22, *(len(n) + 2 for n in names))     # a long name never meets its neighbour
+    lines = [f"{'':34s}" + "".join(f"{n:>{width}s}" for n in names)]
     for key in SCORE_FIELDS:
-        lines.append(f"{LABELS[key]:30s}" + "".join(f"{cell(columns[n][key]):>22s}"
+        lines.append(f"{LABELS[key]:34s}" + "".join(f"{cell(columns[n][key]):>{width}s}"
                                                     for n in names))
     return "\n".join(lines)
 
@@ -181,8 +188,9 @@ ENSEMBLE_ROWS = (("runs", "runs"), ("counts", "stick-slip / ok / stalled / other
 def _ensemble_table(members: dict[str, list[dict[str, Any]]]) -> str:
     cells = {name: summarize(cards) for name, cards in members.items()}
     names = sorted(cells, key=lambda n: n != "no control")
-    lines = [f"{'':34s}" + "".join(f"{n:>24s}" for n in names)]
-    lines += [f"{head:34s}" + "".join(f"{cells[n][key]:>24s}" for n in names)
+    width = max(24, *(len(n) + 2 for n in names))
+    lines = [f"{'':34s}" + "".join(f"{n:>{width}s}" for n in names)]
+    lines += [f"{head:34s}" + "".join(f"{cells[n][key]:>{width}s}" for n in names)
               for key, head in ENSEMBLE_ROWS]
     return "\n".join(lines)
 
@@ -234,7 +242,7 @@ def _closed_loop(args: argparse.Namespace, scenario: Scenario, preset: Preset,
     baseline = _baseline(args, scenario)
     if baseline is not None and baseline.interrupted:
         return _interrupted(baseline)
-    label = f"{scenario.controller.split(':')[-1]} ({scenario.mode})"
+    label = f"{display_name(scenario.controller)} ({scenario.mode})"
     runs = {"no control": baseline} if baseline is not None else {}
     runs[label] = controlled
     columns = {name: score(run.rows, scenario.enable_at_s, schedule, rig, scenario.period_s)

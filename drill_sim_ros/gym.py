@@ -22,7 +22,9 @@ bit for bit.
 * An episode is the scenario's duration (truncated at its end); a numerical fault of the
   model terminates it (``info["fault"]``). The info of the step that ends it carries the
   episode's scorecard (``info["score"]``: :func:`~drill_sim_ros.control.scorecard.score`,
-  the keys of ``SCORE_FIELDS``, as ``drill_sim closed-loop --json`` gives them).
+  the keys of ``SCORE_FIELDS``, as ``drill_sim closed-loop --json`` gives them, with the
+  status and the motor's effort: ``motor_torque_std_nm``, ``motor_torque_rate_mean_knm_s``,
+  ``motor_energy_in_mj``).
 
 Options (constructor or ``reset(options=...)``): ``scenario`` (a name of config/scenarios, a
 YAML path or a :class:`~drill_sim_ros.control.scenario.Scenario`), ``preset``, ``mode``.

@@ -11,8 +11,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from drill_sim_ros.closed_loop_cli import LABELS
+from drill_sim_ros.closed_loop_cli import LABELS, _table
 from drill_sim_ros.control.bench import run_in_process
+from drill_sim_ros.control.registry import display_name
 from drill_sim_ros.control.rig import rig_physics
 from drill_sim_ros.control.scenario import Scenario, seeded
 from drill_sim_ros.control.scorecard import SCORE_FIELDS, score
@@ -87,6 +88,19 @@ def test_user_controller_by_module_and_class(tmp_path: Path) -> None:
     np.testing.assert_allclose(rows[1:, F["speed_setpoint_rpm"]], 75.0, rtol=1e-12)
 
 
+def test_a_column_is_named_by_the_controllers_name_and_never_glued() -> None:
+    """The table's column is the controller's ``name`` (what its errors say), its class name
+    when it keeps the base's; a name longer than the column keeps a space before it."""
+    assert display_name("tests.control.user_controller:TorqueDamper") == "torque_damper"
+    assert display_name("tests.control.user_controller:ConstantSpeed") == "ConstantSpeed"
+    assert display_name("soft_torque") == "soft_torque"
+    long_name = "impedance_matching_with_a_long_name (speed)"
+    card = dict.fromkeys(SCORE_FIELDS, 1.0)
+    header = _table({"no control": card, long_name: card}).splitlines()[0]
+    assert header.split() == ["no", "control", *long_name.split()]
+    assert "control" + long_name[0] not in header
+
+
 @pytest.mark.parametrize(
     ("args", "names"),
     [
@@ -125,7 +139,7 @@ def test_an_ensemble_scores_its_members_as_the_bench_does() -> None:
     preset = scenario.load_preset()
     card = score(run_in_process(scenario).rows, scenario.enable_at_s,
                  scenario.setpoints(preset), rig_physics(preset), scenario.period_s)
-    for key in ("ssi_mean", "stick_fraction", "rop_m_h", "saturation_fraction", "hfto_rms_rpm"):
+    for key in ("ssi_mean", "stick_fraction", "rop_m_h", "saturation_fraction", "ring_rms_rpm"):
         assert members[2][key] == pytest.approx(card[key], rel=1e-12), key
     table = drill_sim("--controller", "soft_torque", "--t-end", "30", "--ensemble", "2")
     assert table.returncode == 0, table.stderr

@@ -98,3 +98,12 @@ def make_controller(name: str, **kwargs: Any) -> Any:
         if not callable(getattr(controller, method, None)):
             raise ParameterError(f"controller {name!r} has no {method}() method")
     return controller
+
+
+def display_name(name: str) -> str:
+    """What tables call controller ``name``: its class's ``name`` attribute (what its
+    errors say), or its class name when it keeps the base class's ``base``."""
+    cls = controller_class(name)
+    label = getattr(cls, "name", None)
+    return label if isinstance(label, str) and label and label != TopDriveController.name \
+        else cls.__name__

@@ -15,23 +15,32 @@ import numpy as np
 import xarray as xr
 
 from drill_sim_ros import __version__
+from drill_sim_ros.control.registry import display_name
 from drill_sim_ros.control.scenario import ENSEMBLE_KEY, ENSEMBLE_STEP, ensemble_caption
 from drill_sim_ros.control.scorecard import status_text, summarize
 from drill_sim_ros.study.suite import Entry, EntryResult
 
 # (card key, column head, format) of the table
 COLUMNS = (("ssi_mean", "SSI after", ".3f"), ("stick_fraction", "stick frac", ".3f"),
-           ("period_s", "period s", ".2f"), ("hfto_rms_rpm", "HFTO rpm", ".1f"),
+           ("period_s", "period s", ".2f"), ("ring_rms_rpm", "ring rpm", ".1f"),
            ("rop_m_h", "ROP m/h", ".2f"), ("mse_mpa", "MSE MPa", ".0f"),
            ("time_to_suppress_s", "suppress s", ".1f"),
-           ("saturation_fraction", "at limit", ".1%"))
-NUMERIC = ("ssi_mean", "ssi_max", "ssi_last", "stick_fraction", "utr", "time_to_suppress_s",
-           "rop_m_h", "mse_mpa", "quill_torque_peak_nm", "quill_torque_rms_nm",
-           "motor_energy_mj", "saturation_count", "saturation_fraction", "period_s",
-           "hfto_rms_rpm", "hfto_hz", "cutoff_hz", "stall_time_s", "wall_s")
+           ("saturation_fraction", "at limit", ".1%"),
+           ("motor_torque_std_nm", "motor std N m", ".0f"),
+           ("motor_torque_rate_mean_knm_s", "motor rate kN m/s", ".1f"),
+           ("motor_energy_in_mj", "motor in MJ", ".2f"))
+NUMERIC = ("ssi_before_mean", "ssi_mean", "ssi_max", "ssi_last", "stick_fraction",
+           "stick_longest_s", "utr", "bit_rpm_max", "time_to_suppress_s", "rop_m_h", "mse_mpa",
+           "quill_torque_peak_nm", "quill_torque_rms_nm", "motor_torque_std_nm",
+           "motor_torque_rate_mean_knm_s", "motor_energy_mj", "motor_energy_in_mj",
+           "saturation_count", "saturation_fraction", "period_s", "ring_rms_rpm", "ring_hz",
+           "cutoff_hz", "stall_time_s", "wall_s")
 UNITS = {"rop_m_h": "m/h", "mse_mpa": "MPa", "time_to_suppress_s": "s", "stall_time_s": "s",
-         "quill_torque_peak_nm": "N m", "quill_torque_rms_nm": "N m", "motor_energy_mj": "MJ",
-         "period_s": "s", "hfto_rms_rpm": "rev/min", "hfto_hz": "Hz", "cutoff_hz": "Hz",
+         "stick_longest_s": "s", "bit_rpm_max": "rev/min",
+         "quill_torque_peak_nm": "N m", "quill_torque_rms_nm": "N m",
+         "motor_torque_std_nm": "N m", "motor_torque_rate_mean_knm_s": "kN m/s",
+         "motor_energy_mj": "MJ", "motor_energy_in_mj": "MJ",
+         "period_s": "s", "ring_rms_rpm": "rev/min", "ring_hz": "Hz", "cutoff_hz": "Hz",
          "wall_s": "s"}
 
 
@@ -54,7 +63,7 @@ def table_rows(entries: Sequence[Entry], results: dict[str, EntryResult]) -> lis
 
 
 def _label(entry: Entry) -> str:
-    name = entry.controller.split(":")[-1]
+    name = display_name(entry.controller)
     return name if entry.controller == "none" else f"{name} ({entry.scenario.mode})"
 
 
@@ -240,12 +249,16 @@ def report_markdown(entries: Sequence[Entry], results: dict[str, EntryResult],
              f"{len(entries)} runs (controller x scenario), {wall_s:.0f} s of wall time for "
              "those computed by the last call. Columns (of the bit speed low-passed at the "
              "rig's cut-off, twice its third torsional mode, unless said): SSI after the "
-             "switch-on (mean of whole 20 s windows), stick fraction after it, the "
-             "stick-slip period, the RMS of the bit speed above the cut-off (the collars' "
-             "ringing, HFTO), mean ROP, MSE at the bit, time from the switch-on to the last "
-             "stick (- while it still sticks in the last 20 s or its quiet end is no longer "
-             "than its longest spell between sticks), share of samples with the "
-             "motor torque at its limit, status.", ""]
+             "switch-on (mean of whole 20 s windows, clipped at 10, which a window stuck "
+             "throughout reads), stick fraction after it, the stick-slip period, the RMS of "
+             "the bit speed above the cut-off (the collars' ringing, 7-16 Hz on the field "
+             "string; not the 50-400 Hz HFTO of field logs), mean ROP, MSE at the bit, time "
+             "from the switch-on to the last stick (- while it still sticks in the last "
+             "20 s or its quiet end is no longer than its longest spell between sticks), "
+             "share of samples with the motor torque at its limit, the motor torque's RMS "
+             "about its mean, its mean absolute rate, the motor's positive work, status "
+             "(ok only when stuck under 10 % of the time after the switch-on, suppressed "
+             "and with an SSI under 1 in the last 20 s; docs/closed-loop.md).", ""]
     members = members_of(entries)
     if members > 1:
         lines += ["Each scenario's first table is member 0; below it, "

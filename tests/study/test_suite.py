@@ -74,10 +74,13 @@ def test_the_table_and_its_files(league: tuple[Path, str, list[Path]]) -> None:
                      scenario.setpoints(preset), rig_physics(preset), scenario.period_s)
         got = by[(name, "soft_torque")]["score"]
         for key in ("ssi_mean", "stick_fraction", "rop_m_h", "mse_mpa", "saturation_count",
-                    "saturation_fraction", "period_s", "hfto_rms_rpm", "cutoff_hz"):
+                    "saturation_fraction", "period_s", "ring_rms_rpm", "cutoff_hz",
+                    "bit_rpm_max", "motor_torque_std_nm", "motor_torque_rate_mean_knm_s",
+                    "motor_energy_in_mj"):
             assert got[key] == pytest.approx(card[key], rel=1e-12), key
     ds = xr.load_dataset(out / "suite.nc", engine="h5netcdf")
-    for key in ("hfto_rms_rpm", "period_s", "saturation_fraction", "cutoff_hz"):
+    for key in ("ring_rms_rpm", "period_s", "saturation_fraction", "cutoff_hz",
+                "motor_torque_std_nm", "motor_torque_rate_mean_knm_s", "motor_energy_in_mj"):
         assert ds[key].sel(scenario="field", controller="soft_torque (speed)").item() == \
             pytest.approx(by[("field", "soft_torque")]["score"][key], rel=1e-12), key
     assert list(ds["scenario"].values) == ["field", "step", "streak"]
