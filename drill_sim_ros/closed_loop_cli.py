@@ -39,7 +39,7 @@ LABELS = {"ssi_before_mean": "SSI before switch-on (mean)", "ssi_mean": "SSI aft
           "quill_torque_peak_nm": "quill torque peak [N m]",
           "quill_torque_rms_nm": "quill torque RMS [N m]",
           "motor_torque_std_nm": "motor torque RMS about mean [N m]",
-          "motor_torque_rate_mean_knm_s": "motor torque |rate| [kN m/s]",
+          "motor_torque_rate_mean_knm_s": "motor torque abs. rate [kN m/s]",
           "motor_energy_mj": "motor work, net [MJ]",
           "motor_energy_in_mj": "motor work, positive [MJ]",
           "saturation_count": "saturated samples",

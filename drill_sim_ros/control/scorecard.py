@@ -245,13 +245,13 @@ def _ring(fast_rpm: np.ndarray, sample_period_s: float, cutoff_hz: float) -> dic
 
 
 def stick_spans_s(t: np.ndarray, stuck: np.ndarray) -> list[tuple[float, float]]:
-    """Each stick of ``stuck`` (samples at times ``t``) as (start, end) in s: from its first
-    stuck sample to the first sample after it (to the last sample for a stick that ends the
-    record), so a stick of n samples P apart lasts n P."""
+    """Each stick of ``stuck`` (samples at times ``t``, P apart) as (start, end) in s: from
+    its first stuck sample to one period after its last, so a stick of n samples lasts n P
+    and the turning between two sticks is P per turning sample."""
     edges = np.diff(np.concatenate(([0], stuck.astype(np.int8), [0])))
     starts, ends = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
     step = float(np.median(np.diff(t))) if t.size > 1 else 0.0
-    return [(float(t[a]) - step, float(t[b - 1])) for a, b in zip(starts, ends, strict=True)]
+    return [(float(t[a]), float(t[b - 1]) + step) for a, b in zip(starts, ends, strict=True)]
 
 
 def stall_time_s(time_s: np.ndarray, stuck: np.ndarray, enable_at_s: float = 0.0,
