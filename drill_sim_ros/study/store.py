@@ -43,7 +43,8 @@ _CONTROL_SOURCES = ("study/closed_loop.py", "model/session.py", "model/top_drive
 CONTROLLED_NOTE = ("closed loop (control/bench.py run_in_process at each point's rpm and WOB; "
                    "the bench's numerics, not --dtau/--nodes/--perturb-v): ssi, utr, "
                    "stick_fraction, rop_m_h from the scorecard over the window (ssi: mean of "
-                   "whole 20 s windows; stick_fraction: share of 10 ms samples); kappa, eta "
+                   "whole 20 s windows, each clipped at 10, which a window stuck throughout "
+                   "reads; stick_fraction: share of 10 ms samples); kappa, eta "
                    "and the means from the kernel's sums over the window; omega_min/max, "
                    "torsional_period, axial_amplitude from the 10 ms telemetry; every "
                    "variable is defined")

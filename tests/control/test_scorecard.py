@@ -14,7 +14,15 @@ from drill_sim_ros.control.bench import run_in_process
 from drill_sim_ros.control.rig import rig_physics
 from drill_sim_ros.control.scenario import Scenario
 from drill_sim_ros.control.schedule import Schedule
-from drill_sim_ros.control.scorecard import SSI_MAX, lowpassed_bit_rpm, score, window_ssi
+from drill_sim_ros.control.scorecard import (
+    SSI_MAX,
+    SSI_OK,
+    STICK_FRACTION_OK,
+    lowpassed_bit_rpm,
+    score,
+    status_of,
+    window_ssi,
+)
 from drill_sim_ros.model import analysis
 from drill_sim_ros.model.params import RPM_PER_RAD_S
 from drill_sim_ros.model.presets import load_preset
@@ -337,3 +345,14 @@ def test_the_motor_effort_by_its_definitions() -> None:
     assert card["motor_energy_in_mj"] == pytest.approx(amplitude_nm * omega / math.pi * 80.0
                                                        * 1e-6, rel=1e-3)
     assert card["bit_rpm_max"] == pytest.approx(90.0, rel=1e-6)
+
+
+def test_the_rule_at_its_edges() -> None:
+    """status_of on the figures alone: 10 % stuck is stick-slip even when suppressed and
+    settled; an SSI of 1 in the last window is stick-slip without a stick; a stall wins."""
+    settled = {"stick_fraction": 0.0999, "time_to_suppress_s": 50.0, "ssi_last": 0.99}
+    assert status_of(settled, None) == "ok"
+    assert status_of({**settled, "stick_fraction": STICK_FRACTION_OK}, None) == "stick-slip"
+    assert status_of({**settled, "ssi_last": SSI_OK}, None) == "stick-slip"
+    assert status_of({**settled, "time_to_suppress_s": None}, None) == "stick-slip"
+    assert status_of(settled, 150.0) == "stalled"
