@@ -19,14 +19,36 @@ where the string gives ``(v0, kick_v, f_ext)`` and ``(omega0, kick_w, t_ext)``:
 the set-valued contact laws need nothing else. The delay (eqs. 6-8, 26-28) is read from the
 bottom-hole profile (production) or from the exact time history (reference, Appendix C).
 Functions never raise; the kernel returns status codes.
+
+The bit law has a seam like the top drive's modes: a law index (``LAW_*``, kernel slot
+``P_BIT_LAW``) and one small function per law giving the sliding torque from the depth of
+cut, the wearflat force and the bit's speed, with two parameters ``a`` and ``b`` (slots
+``P_BIT_LAW_A``, ``P_BIT_LAW_B``). Whatever the law, the stick is RGD07's: the bit stuck holds
+any string torque up to the static torque delta + beta lambda (eqs. 14, 32-33), and a law's
+torque at omega = 0 is that static level (f(0) = 1 below), so the torque is continuous at
+the slip. A new law is one function here, its index, its branch in :func:`sliding_torque`
+and its :class:`BitLaw` parameters.
+
+* ``rgd07`` (0): T = delta + beta W_f (eq. 30), rate-independent.
+* ``weakening_friction`` (1): T = delta + beta W_f f(omega), the wearflat friction falling
+  with the bit's speed (NORCE Simulator4nDOF's form, docs/model.md);
+* ``weakening_bit`` (2): T = (delta + beta W_f) f(omega), the whole bit torque falling
+  (the COPPE/UFRJ form);
+
+with f(omega) = 1 - (1 - a)(1 - exp(-omega / b)): a the floor ratio f(inf) in (0, 1], b the
+e-folding speed (scaled, omega t*). Written so that f(0) = 1 and a = 1 give exactly 1.
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass, fields
 
 import numpy as np
 from numba import njit
+
+from drill_sim_ros.model.checks import check_known_keys, number_in
+from drill_sim_ros.model.errors import ParameterError
 
 # ---- interaction modes ------------------------------------------------------------------
 MODE_CUTTING = 0    # cutting with full wearflat contact
@@ -64,11 +86,62 @@ def stuck_wearflat(f_ext: float, doc: float, lam: float) -> float:
     return min(max(f_ext - doc, 0.0), lam)
 
 
+# ---- the bit laws (one function each; module doc) ----------------------------------------
+LAW_RGD07 = 0
+LAW_WEAKENING_FRICTION = 1
+LAW_WEAKENING_BIT = 2
+LAWS = ("rgd07", "weakening_friction", "weakening_bit")
+
+
+@njit(cache=True, inline="always")
+def weakening(omega: float, floor: float, speed: float) -> float:
+    """f(omega) = 1 - (1 - floor)(1 - exp(-omega / speed)): 1 at rest, ``floor`` fast, the
+    fall e-folding at ``speed``; exactly 1 at omega = 0 and at floor = 1."""
+    return 1.0 - (1.0 - floor) * (1.0 - math.exp(-omega / speed))
+
+
+@njit(cache=True, inline="always")
+def rgd07_torque(doc: float, w_f: float, beta: float, omega: float, a: float,
+                 b: float) -> float:
+    """RGD07 eq. (30): T = delta + beta W_f, whatever the speed."""
+    return doc + beta * w_f
+
+
+@njit(cache=True, inline="always")
+def weakening_friction_torque(doc: float, w_f: float, beta: float, omega: float, a: float,
+                              b: float) -> float:
+    """T = delta + beta W_f f(omega): the wearflat friction falls with the bit's speed."""
+    return doc + beta * w_f * weakening(omega, a, b)
+
+
+@njit(cache=True, inline="always")
+def weakening_bit_torque(doc: float, w_f: float, beta: float, omega: float, a: float,
+                         b: float) -> float:
+    """T = (delta + beta W_f) f(omega): the whole bit torque falls with the bit's speed."""
+    return (doc + beta * w_f) * weakening(omega, a, b)
+
+
+@njit(cache=True, inline="always")
+def sliding_torque(law: int, doc: float, w_f: float, beta: float, omega: float, a: float,
+                   b: float) -> float:
+    """The torque on bit of law ``law`` while the bit turns at ``omega`` (or is about to
+    slip, omega = 0): cutting ``doc`` (the depth that sets the cutting forces), wearflat
+    force ``w_f``, friction ``beta``, the law's parameters ``a``, ``b``."""
+    if law == LAW_WEAKENING_FRICTION:
+        return weakening_friction_torque(doc, w_f, beta, omega, a, b)
+    if law == LAW_WEAKENING_BIT:
+        return weakening_bit_torque(doc, w_f, beta, omega, a, b)
+    return rgd07_torque(doc, w_f, beta, omega, a, b)
+
+
 @njit(cache=True, inline="always")
 def bit_response(v0: float, kick_v: float, f_ext: float, omega0: float, kick_w: float,
-                 t_ext: float, doc: float, stuck: bool, beta: float,
-                 lam: float) -> tuple[float, float, float, float, float, int, bool]:
-    """Bit-rock forces and the bit's new velocities (eqs. 25, 29-33).
+                 t_ext: float, doc: float, stuck: bool, beta: float, lam: float, law: int,
+                 omega_bit: float, law_a: float, law_b: float
+                 ) -> tuple[float, float, float, float, float, int, bool]:
+    """Bit-rock forces and the bit's new velocities (eqs. 25, 29-33), the sliding torque
+    from the bit law ``law`` (:func:`sliding_torque`, parameters ``law_a``, ``law_b``) at
+    the bit's speed at the start of the step ``omega_bit``.
 
     Returns ``(v_new, omega_new, w_f, wob, tob, mode, stuck_new)``.
     """
@@ -83,7 +156,7 @@ def bit_response(v0: float, kick_v: float, f_ext: float, omega0: float, kick_w: 
     if doc >= 0.0:
         v_new, w_f = wearflat_contact(v0, f_ext, doc, lam, kick_v)
         wob = doc + w_f                       # eq. (29): W = delta + W_f
-        tob = doc + beta * w_f                # eq. (30): T = delta + beta W_f
+        tob = sliding_torque(law, doc, w_f, beta, omega_bit, law_a, law_b)   # eq. (30)
         mode = MODE_CUTTING if w_f >= lam else MODE_LOST_CONTACT
     else:
         v_new = v0 + kick_v * f_ext           # off bottom: T = W = 0, the bit falls
@@ -180,3 +253,78 @@ def history_store(hist: np.ndarray, head: int, count: int, cursor: int, phi: flo
 def sector(n_blades: float) -> float:
     """The angle between blades, 2 pi / n (eq. 7)."""
     return 2.0 * math.pi / n_blades
+
+
+# ---- the law's parameters ---------------------------------------------------------------
+APPLIES_TO = ("friction", "bit")       # friction_weakening.applies_to -> LAW_WEAKENING_*
+FLOOR_RANGE = (0.0, 1.0)               # floor_ratio in (0, 1]; 1: RGD07's torque
+SPEED_RANGE_RAD_S = (0.0, 1.0e4)       # speed_rad_s in (0, 1e4]
+
+
+@dataclass(frozen=True)
+class BitLaw:
+    """The bit law in kernel units, what the simulator takes: ``law`` (``LAW_*``) and its
+    parameters ``a``, ``b`` (module doc: for the weakening laws the floor ratio and the
+    e-folding speed, scaled omega t*). The default is RGD07's law."""
+
+    law: int = LAW_RGD07
+    a: float = 1.0
+    b: float = 1.0
+
+    def __post_init__(self) -> None:
+        if self.law not in range(len(LAWS)):
+            raise ParameterError(f"bit law {self.law!r} must be one of 0..{len(LAWS) - 1} "
+                                 f"({', '.join(LAWS)})")
+        if not (math.isfinite(self.a) and math.isfinite(self.b) and self.b > 0.0):
+            raise ParameterError(f"bit law parameters a = {self.a!r}, b = {self.b!r} must "
+                                 "be finite, b > 0")
+
+    def torque(self, doc: float, w_f: float, beta: float, omega: float) -> float:
+        """The law's sliding torque (:func:`sliding_torque`), kernel units."""
+        return float(sliding_torque(self.law, doc, w_f, beta, omega, self.a, self.b))
+
+
+RGD07_LAW = BitLaw()
+
+
+@dataclass(frozen=True)
+class FrictionWeakening:
+    """A bit torque that falls with the bit's speed, SI (a physical preset's
+    ``physical.friction_weakening``; docs/model.md#a-bit-friction-that-falls-with-speed):
+    f(omega) = floor_ratio + (1 - floor_ratio) exp(-omega / speed_rad_s) times the wearflat
+    friction (``applies_to: friction``, NORCE Simulator4nDOF's form) or the whole bit torque
+    (``bit``, the COPPE/UFRJ form). floor_ratio = 1 is RGD07's law."""
+
+    floor_ratio: float = 1.0
+    speed_rad_s: float = 7.0
+    applies_to: str = "friction"
+
+    def __post_init__(self) -> None:
+        where = "'physical.friction_weakening"
+        number_in(f"{where}.floor_ratio'", self.floor_ratio, *FLOOR_RANGE, low_open=True)
+        number_in(f"{where}.speed_rad_s'", self.speed_rad_s, *SPEED_RANGE_RAD_S,
+                  low_open=True)
+        if self.applies_to not in APPLIES_TO:
+            raise ParameterError(f"{where}.applies_to' = {self.applies_to!r} must be one "
+                                 f"of {', '.join(APPLIES_TO)}")
+
+    def scaled(self, time_s: float) -> BitLaw:
+        """The law in kernel units: the e-folding speed times t* (eqs. 19-20)."""
+        law = LAW_WEAKENING_FRICTION if self.applies_to == "friction" else LAW_WEAKENING_BIT
+        return BitLaw(law, self.floor_ratio, self.speed_rad_s * time_s)
+
+
+def friction_weakening_from_dict(values: object) -> FrictionWeakening | None:
+    """A preset's ``physical.friction_weakening`` mapping (None: absent, RGD07's law);
+    ParameterError (one line) on an unknown key or a value out of range."""
+    if values is None:
+        return None
+    where = "physical.friction_weakening"
+    known = tuple(f.name for f in fields(FrictionWeakening))
+    if not isinstance(values, dict):
+        raise ParameterError(f"'{where}' must be a mapping of {', '.join(known)}; "
+                             f"got {values!r}")
+    check_known_keys(values, known, where)
+    numbers = {key: number_in(f"'{where}.{key}'", values[key], -math.inf, math.inf)
+               for key in ("floor_ratio", "speed_rad_s") if key in values}
+    return FrictionWeakening(**{**values, **numbers})

@@ -7,7 +7,8 @@ A step reads as three calls on one state:
 
 1. the bit-rock law (:mod:`drill_sim_ros.model.bit_rock`): the depth of cut from the delay
    (eqs. 6-8, 26-28), then the forces and the bit's new velocities (eqs. 29-33), given the
-   string's bottom end in affine form;
+   string's bottom end in affine form, the sliding torque from the law ``P_BIT_LAW``
+   (RGD07's by default) at the bit's speed at the start of the step;
 2. the top drive (:mod:`drill_sim_ros.model.top_drive`): its speed at the end of the step
    against the string torque at the quill (kinematic, speed loop or torque mode);
 3. the string (:mod:`drill_sim_ros.model.string`), one seam: ``string.ends`` before the
@@ -92,7 +93,10 @@ P_PICKUP = 23       # distributed: the hook's pick-up speed off bottom (L* per t
 P_CLEARANCE = 24    # distributed: the bit's clearance above the rock it picks up to (L*)
 P_TAG_SPEED = 25    # distributed: the hook's lowering speed cap, L* per t* (inf until a tag)
 P_SUBSTEPS = 26     # distributed: steps of the bit law and the drive per wave-guide step
-N_PARAMS = 27
+P_BIT_LAW = 27      # the bit law: bit_rock.LAW_RGD07 | LAW_WEAKENING_FRICTION | ...
+P_BIT_LAW_A = 28    # its parameters (bit_rock.BitLaw): for the weakening laws the floor
+P_BIT_LAW_B = 29    # ratio and the e-folding speed (omega t*)
+N_PARAMS = 30
 OFF_BOTTOM_LIFTED = 3.0
 
 # ---- surface targets (float64) ----------------------------------------------------------
@@ -174,13 +178,14 @@ Loop.__doc__ = """The loop-carried state of a run (the ``S_*`` slots and the his
 Law = namedtuple("Law", (
     "dt", "tau_avg", "beta", "lam", "n_blades", "psi", "off_bottom", "layer_u", "cut_factor",
     "sector", "tgt_w", "w_rate", "inv_spacing", "hook_kp", "hook_ki", "pickup", "clearance",
-    "tag_speed", "substeps"))
+    "tag_speed", "substeps", "bit_law", "law_a", "law_b"))
 Law.__doc__ = """A run's constants of the bit law, the rock and the hook: dtau, the statistics
 window start, beta, lambda, n, psi, off bottom, the next layer's top, the cutting factor, the
 blade sector 2 pi / n, the applied weight's target and ramp rate, the profile's nodes per
 radian, the hook's WOB loop gains, its pick-up speed (0 on bottom), the clearance it picks
-up to, its lowering speed's cap (the tag speed; inf until a tag) and the steps per step of
-the wave guide (:func:`_held_means`)."""
+up to, its lowering speed's cap (the tag speed; inf until a tag), the steps per step of
+the wave guide (:func:`_held_means`) and the bit law with its two parameters
+(bit_rock.sliding_torque)."""
 Drive = namedtuple("Drive", (
     "mode", "omega", "torque", "omega_rate", "inertia", "kp", "ki", "max_torque", "lag_alpha"))
 Drive.__doc__ = """A run's top-drive parameters and commands (top_drive.drive_step)."""
@@ -370,7 +375,7 @@ def _respond(x: Loop, law: Law, surface: float, cursor: int, ends: tuple,
     v0, kick_v, f_ext, omega0, kick_w, t_ext, t_top, f_top = ends
     v_new, omega_new, w_f, wob, tob, mode, stuck = br.bit_response(
         v0, kick_v, f_ext, omega0, kick_w, t_ext, _cutting(law.cut_factor, law.off_bottom, doc),
-        x.stuck, law.beta, law.lam)
+        x.stuck, law.beta, law.lam, law.bit_law, x.omega, law.law_a, law.law_b)
     v_hook, hook_int = x.v_hook, x.hook_int
     if not lumped:                # the hook's WOB loop
         v_hook, hook_int = _hook(law, x.w_app, f_top, hook_int,
@@ -456,7 +461,8 @@ def _law_params(prm: np.ndarray, tgt: np.ndarray, profile: np.ndarray) -> Law:
                prm[P_OFF_BOTTOM] != 0.0 and not lifted, prm[P_LAYER_U], prm[P_CUT], sector,
                tgt[I_W_APP], prm[P_W_RATE], profile.shape[0] / sector, prm[P_HOOK_KP],
                prm[P_HOOK_KI], prm[P_PICKUP] if lifted else 0.0, prm[P_CLEARANCE],
-               prm[P_TAG_SPEED], max(1, int(prm[P_SUBSTEPS])))
+               prm[P_TAG_SPEED], max(1, int(prm[P_SUBSTEPS])), int(prm[P_BIT_LAW]),
+               prm[P_BIT_LAW_A], prm[P_BIT_LAW_B])
 
 
 @njit(cache=True, inline="always")

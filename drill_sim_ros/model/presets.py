@@ -20,6 +20,12 @@ from dataclasses import MISSING, Field, dataclass, field, fields, replace
 from pathlib import Path
 from typing import Any
 
+from drill_sim_ros.model.bit_rock import (
+    RGD07_LAW,
+    BitLaw,
+    FrictionWeakening,
+    friction_weakening_from_dict,
+)
 from drill_sim_ros.model.checks import check_known_keys, number_in
 from drill_sim_ros.model.errors import ParameterError
 from drill_sim_ros.model.formation import Rock
@@ -65,6 +71,15 @@ class Preset:
     n_nodes: int | None
     drive: TopDrivePhysical          # SI (a dimensionless preset: in its unit scales)
     string: StringSpec = field(default_factory=StringSpec)
+    friction_weakening: FrictionWeakening | None = None   # None: RGD07's bit law
+
+    @property
+    def bit_law(self) -> BitLaw:
+        """The bit law in kernel units (what the simulator takes): RGD07's, or the
+        preset's ``physical.friction_weakening`` scaled."""
+        if self.friction_weakening is None:
+            return RGD07_LAW
+        return self.friction_weakening.scaled(self.scales.time_s)
 
     @property
     def is_physical(self) -> bool:
@@ -139,9 +154,11 @@ def preset_from_dict(name: str, data: dict[str, Any]) -> Preset:
     if has_phys == has_dimless:
         raise ParameterError(f"preset '{name}' needs exactly one of 'physical' or "
                              "'dimensionless'")
-    physical, string = None, StringSpec()
+    physical, string, weakening = None, StringSpec(), None
     if has_phys:
-        physical = physical_from_dict(data["physical"])
+        values = dict(data["physical"])
+        weakening = friction_weakening_from_dict(values.pop("friction_weakening", None))
+        physical = physical_from_dict(values)
         string = string_from_dict(data.get("string") or {}, physical)
         shorthand = sorted(key for key in data["physical"] if key.startswith(("pipe_", "bha_")))
         if shorthand and (data.get("string") or {}).get("sections") is not None:
@@ -164,7 +181,7 @@ def preset_from_dict(name: str, data: dict[str, Any]) -> Preset:
                   params=params, scales=scales, physical=physical,
                   dtau=float(numerics.get("dtau", 1e-4)),
                   n_nodes=None if n_nodes is None else int(n_nodes), drive=drive,
-                  string=string)
+                  string=string, friction_weakening=weakening)
 
 
 def _with_well(name: str, data: dict[str, Any], string: StringSpec) -> StringSpec:

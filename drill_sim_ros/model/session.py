@@ -105,7 +105,7 @@ def build_simulator(cfg: SessionConfig, period_tau: float, steps: int) -> Simula
                        w_rate=w_rate)
     return Simulator(params, config, perturb_v=cfg.perturb_v,
                      top_drive=session_drive(cfg).scaled(sc), scales=sc,
-                     string=cfg.preset.kernel_string)
+                     string=cfg.preset.kernel_string, bit_law=cfg.preset.bit_law)
 
 
 def session_drive(cfg: SessionConfig) -> TopDrivePhysical:

@@ -10,10 +10,12 @@ converts to SI. The top drive's commands and readings also come in SI (the ``*_r
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
+from operator import attrgetter
 
 import numpy as np
 
+from drill_sim_ros.model import bit_rock as br
 from drill_sim_ros.model import kernel as k
 from drill_sim_ros.model import string as sg
 from drill_sim_ros.model import top_drive as td
@@ -26,6 +28,39 @@ METHODS = ("profile", "exact")
 REBASE_DEPTH = 1.0e4     # rebase U and angles beyond this, to keep differences exact
 REBASE_CHECK_STEPS = 1 << 16   # steps between rebasing checks (U, PHI move far less)
 DEFAULT_NODES = 2048
+
+# The parameter vector (kernel.P_*), one row a slot: (name, slot, source), the source an
+# attribute of the simulator (dotted). No scale: every source is in kernel units already,
+# converted once where it is built (TopDrivePhysical.scaled, string.kernel_string,
+# FrictionWeakening.scaled).
+# Set elsewhere: the drive's mode (at start and by set_top_drive_mode), the rock of the
+# layer the bit is in (beta, lambda, the cutting factor, the next top: _apply_layer), off
+# bottom and the tag speed (hang_off_bottom, set_off_bottom, start_at_rest).
+PARAMETERS: tuple[tuple[str, int, str], ...] = (
+    ("n", k.P_N, "params.n"),
+    ("psi", k.P_PSI, "params.psi"),
+    ("dtau", k.P_DT, "config.dtau"),
+    ("omega_rate", k.P_OMEGA_RATE, "config.omega_rate"),
+    ("w_rate", k.P_W_RATE, "config.w_rate"),
+    ("tau_avg", k.P_TAU_AVG, "config.tau_avg"),
+    ("td_inertia", k.P_TD_INERTIA, "top_drive.inertia_ratio"),
+    ("td_kp", k.P_TD_KP, "top_drive.kp"),
+    ("td_ki", k.P_TD_KI, "top_drive.ki"),
+    ("td_max_torque", k.P_TD_MAX_TORQUE, "top_drive.max_torque"),
+    ("td_lag_alpha", k.P_TD_LAG_ALPHA, "top_drive_lag_alpha"),
+    ("string", k.P_STRING, "string.model"),
+    ("parts_t", k.P_PARTS_T, "torsional_parts"),
+    ("bit_inertia", k.P_BIT_INERTIA, "string.bit_inertia"),
+    ("hook_kp", k.P_HOOK_KP, "string.hook_kp"),
+    ("hook_ki", k.P_HOOK_KI, "string.hook_ki"),
+    ("bha_part", k.P_BHA_PART, "string.bha_part"),
+    ("pickup", k.P_PICKUP, "string.pickup"),
+    ("clearance", k.P_CLEARANCE, "string.clearance"),
+    ("substeps", k.P_SUBSTEPS, "string.substeps"),
+    ("bit_law", k.P_BIT_LAW, "bit_law.law"),
+    ("bit_law_a", k.P_BIT_LAW_A, "bit_law.a"),
+    ("bit_law_b", k.P_BIT_LAW_B, "bit_law.b"),
+)
 
 
 @dataclass(frozen=True)
@@ -114,14 +149,16 @@ class Simulator:
     being the trivial motion, and the velocity perturbations ``perturb_v`` and
     ``perturb_omega`` added at tau = 0. ``top_drive`` (default: kinematic, the paper's
     imposed speed) turns the top of the string; ``string`` (default: RGD07's lumped spring)
-    is the string in kernel units (:func:`string.kernel_string`); ``scales`` (default: unit
-    scales) converts the SI top-drive members.
+    is the string in kernel units (:func:`string.kernel_string`); ``bit_law`` (default:
+    RGD07's) the bit's torque law in kernel units (:class:`bit_rock.BitLaw`); ``scales``
+    (default: unit scales) converts the SI top-drive members.
     """
 
     def __init__(self, params: DimensionlessParams, config: SimConfig | None = None,
                  perturb_v: float = 0.0, perturb_omega: float = 0.0,
                  top_drive: td.TopDrive | None = None, scales: Scales = UNIT_SCALES,
-                 string: sg.KernelString = sg.LUMPED) -> None:
+                 string: sg.KernelString = sg.LUMPED, bit_law: br.BitLaw = br.RGD07_LAW
+                 ) -> None:
         self.params = params
         self.config = config or SimConfig()
         self.top_drive = top_drive or td.TopDrive()
@@ -135,48 +172,38 @@ class Simulator:
             if not math.isfinite(value):
                 raise ParameterError(f"parameter '{name}' = {value!r} must be finite")
         self._perturb = (float(perturb_v), float(perturb_omega))
+        self.bit_law = bit_law
         self._prm = np.zeros(k.N_PARAMS)
+        self._prm[k.P_TD_MODE] = td.mode_index(self.top_drive.mode)
+        if self.top_drive.mode == "speed":
+            td.check_speed_loop(self.top_drive, self.config.dtau, self.scales)
+        self._prm[k.P_TAG_SPEED] = math.inf      # the WOB loop unbounded until a tag
         self._fill_params()
         self.reset()
 
     # ---- set-up ---------------------------------------------------------------------
-    def _fill_params(self) -> None:
-        p, c = self.params, self.config
-        self._prm[k.P_N] = p.n
-        self._prm[k.P_BETA] = p.beta
-        self._prm[k.P_LAM] = p.lam
-        self._prm[k.P_PSI] = p.psi
-        self._prm[k.P_DT] = c.dtau
-        self._prm[k.P_OMEGA_RATE] = c.omega_rate
-        self._prm[k.P_W_RATE] = c.w_rate
-        self._prm[k.P_TAU_AVG] = c.tau_avg
-        self._prm[k.P_TD_MODE] = td.mode_index(self.top_drive.mode)
-        if self.top_drive.mode == "speed":
-            td.check_speed_loop(self.top_drive, c.dtau, self.scales)
-        self._fill_drive(self.top_drive)
-        self._prm[k.P_CUT] = 1.0
-        self._prm[k.P_LAYER_U] = math.inf
-        s = self.string
-        self._prm[k.P_STRING] = s.model
-        self._prm[k.P_PARTS_T] = self._parts[0] if self._parts else 0
-        self._prm[k.P_BIT_INERTIA] = s.bit_inertia
-        self._prm[k.P_HOOK_KP] = s.hook_kp
-        self._prm[k.P_HOOK_KI] = s.hook_ki
-        self._prm[k.P_BHA_PART] = s.bha_part
-        self._prm[k.P_PICKUP] = s.pickup
-        self._prm[k.P_CLEARANCE] = s.clearance
-        self._prm[k.P_TAG_SPEED] = math.inf       # the WOB loop unbounded until a tag
-        self._prm[k.P_SUBSTEPS] = s.substeps
+    def _fill_params(self, prefix: str = "") -> None:
+        """The parameter vector's slots from :data:`PARAMETERS`, those whose source starts
+        with ``prefix`` (all by default)."""
+        for _, slot, source in PARAMETERS:
+            if source.startswith(prefix):
+                self._prm[slot] = attrgetter(source)(self)
 
     def _fill_drive(self, drive: td.TopDrive) -> None:
         """The drive's inertia ratio, gains, torque limit and lag into the parameters (its
         mode: the callers)."""
         self.top_drive = drive
-        self._prm[k.P_TD_INERTIA] = drive.inertia_ratio
-        self._prm[k.P_TD_KP] = drive.kp
-        self._prm[k.P_TD_KI] = drive.ki
-        self._prm[k.P_TD_MAX_TORQUE] = drive.max_torque
-        self._prm[k.P_TD_LAG_ALPHA] = drive.lag_alpha(self.config.dtau)
+        self._fill_params("top_drive")
+
+    @property
+    def top_drive_lag_alpha(self) -> float:
+        """The drive's motor lag per step (TopDrive.lag_alpha)."""
+        return self.top_drive.lag_alpha(self.config.dtau)
+
+    @property
+    def torsional_parts(self) -> int:
+        """The distributed string's parts of the torsional line (0: lumped)."""
+        return self._parts[0] if self._parts else 0
 
     def _wave_layout(self) -> None:
         """The delay lines of a distributed string at this step (none for the lumped one);
@@ -233,8 +260,13 @@ class Simulator:
 
     @property
     def trivial(self) -> TrivialSolution:
-        """Trivial solution (eq. 34) for the parameters the run started with."""
-        return trivial_solution(self.params)
+        """Trivial solution (eq. 34) for the parameters the run started with, its torque
+        the bit law's at the top-drive speed (RGD07's law: eq. 34 itself)."""
+        triv, p, law = trivial_solution(self.params), self.params, self.bit_law
+        if law.law == br.LAW_RGD07:
+            return triv
+        return replace(triv, torque=law.torque(triv.depth_of_cut, min(p.w0, p.lam), p.beta,
+                                               p.omega0))
 
     def reset(self) -> None:
         """Back to tau = 0 on the trivial solution, perturbations re-applied; the top-drive

@@ -96,7 +96,8 @@ def startup_simulator(preset: Preset, rpm: float, ramp_s: float) -> Simulator:
     if drive.mode != "speed":
         drive = drive.with_(mode="speed")
     sim = Simulator(preset.params, SimConfig(dtau=preset.dtau, n_nodes=64, omega_rate=rate),
-                    top_drive=drive, scales=sc, string=preset.kernel_string)
+                    top_drive=drive, scales=sc, string=preset.kernel_string,
+                    bit_law=preset.bit_law)
     sim.start_at_rest()
     sim.set_inputs(omega_s=omega)
     return sim

@@ -96,7 +96,8 @@ def off_bottom_simulator(preset: Preset, drive: TopDrive, dtau: float | None = N
     if undamped:
         preset = replace(preset, string=preset.string.undamped())
     sim = Simulator(preset.params, SimConfig(dtau=dtau or preset.dtau, n_nodes=64),
-                    top_drive=drive, scales=preset.scales, string=preset.kernel_string)
+                    top_drive=drive, scales=preset.scales, string=preset.kernel_string,
+                    bit_law=preset.bit_law)
     sim.hang_off_bottom(anechoic)
     return sim
 

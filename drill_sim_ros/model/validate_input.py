@@ -26,6 +26,8 @@ from drill_sim_ros.model.top_drive import MODES, TopDrive, TopDrivePhysical
 PRESET_SECTIONS = ("description", "physical", "dimensionless", "numerics", "top_drive",
                    "string", "well")  # 'string' and 'well': checked by model.presets and
                                       # model.well
+# optional mappings in ``physical``: the bit law's (bit_rock.friction_weakening_from_dict)
+PHYSICAL_MAPPINGS = ("friction_weakening",)
 # the lumped string's geometry: given by ``string.sections`` when the preset has them
 GEOMETRY_KEYS = ("pipe_outer_radius_m", "pipe_inner_radius_m", "pipe_length_m",
                  "bha_outer_radius_m", "bha_inner_radius_m", "bha_length_m")
@@ -91,8 +93,12 @@ def check_preset_mapping(data: Any) -> None:
         raise ParameterError("a preset needs exactly one of 'physical' or 'dimensionless'")
     if physical:
         sections = isinstance(data.get("string"), dict) and "sections" in data["string"]
-        check_section("physical", data["physical"], _names(PhysicalParams), required=True,
-                      optional=GEOMETRY_KEYS if sections else ())
+        values = data["physical"]
+        if isinstance(values, dict):        # its mappings: checked by their own readers
+            values = {key: v for key, v in values.items() if key not in PHYSICAL_MAPPINGS}
+        check_section("physical", values, (*_names(PhysicalParams), *PHYSICAL_MAPPINGS),
+                      required=True,
+                      optional=(*(GEOMETRY_KEYS if sections else ()), *PHYSICAL_MAPPINGS))
     else:
         check_section("dimensionless", data["dimensionless"], _names(DimensionlessParams),
                       required=True)

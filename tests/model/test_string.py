@@ -101,6 +101,32 @@ def test_pulse_arrives_after_l_over_c_and_returns_whole() -> None:
     assert -p3 == pytest.approx(p1, rel=0.01)
 
 
+@pytest.mark.parametrize("name", ["field_8p5in_shale", "field_8p5in_deviated"])
+def test_field_losses_keep_eta_per_round_trip(name: str) -> None:
+    """Aarsnes & van de Wouw's eta = 0.70 is the amplitude a torsional wave keeps over a
+    round trip (their code: d omega/dt = -kt omega, kt = -ln eta per one-way travel time).
+    A pulse on a uniform pipe of the field string's one-way travel time, damped at the
+    field preset's torsional rate: its peak at the top after 3 L / c (one round trip after
+    its first arrival) is 0.70 of the first, to the wake that viscous damping leaves."""
+    field = load_preset(name).string
+    rate = field.sections[0].torsional_damping_per_s
+    length_m = field.torsional_travel_s * math.sqrt(79.3e9 / 7850.0)
+    preset = string_preset([{**PIPE, "length_m": 0.5 * length_m}] * 2,
+                           torsional_damping_per_s=rate, damping_points=64)
+    sim = si.off_bottom_simulator(preset, TopDrive(mode="kinematic", inertia_ratio=14.0))
+    dt_s = sim.config.dtau * preset.scales.time_s
+    travel_s = preset.string.torsional_travel_s
+    assert travel_s == pytest.approx(field.torsional_travel_s, rel=1e-9)
+    amplitude = 0.02 * preset.params.omega0 * float(sim.string_arrays()[2][sg.W_Z, 0])
+    si.send_pulse_from_bit(sim, False, amplitude, width_steps=40.0)
+    rows = sim.advance(sim.steps_for(3.3 * travel_s / preset.scales.time_s), every=1).data
+    torque = rows[:, k.C_T_PIPE] - rows[0, k.C_T_PIPE]
+    t_s = np.arange(len(torque)) * dt_s
+    first = np.max(torque[(t_s > 0.5 * travel_s) & (t_s < 1.5 * travel_s)])
+    back = -np.min(torque[(t_s > 2.5 * travel_s) & (t_s < 3.2 * travel_s)])
+    assert back / first == pytest.approx(0.70, abs=0.02)
+
+
 def test_junction_transmits_as_the_impedances_say() -> None:
     """Pipe on collars: the pulse from the bit reaches the top with the transmission
     coefficient of a torque wave from Z_collar into Z_pipe, 2 Z_pipe / (Z_pipe + Z_collar)."""
