@@ -9,7 +9,8 @@ cannot retune the drive's own loop, so this controller runs in torque mode: it c
 PI loop itself on the operator's setpoint and sends the motor torque. Before the switch-on
 the loop has the drive's delivered gains (the base class's).
 
-    .venv/bin/drill_sim closed-loop --controller examples/soft_speed_pi.py:SoftSpeedPI --mode torque
+    .venv/bin/drill_sim closed-loop --mode torque \
+        --controller examples/soft_speed_pi.py:SoftSpeedPI
 """
 
 from __future__ import annotations

@@ -92,10 +92,9 @@ class TopDriveController:
         "loop_bandwidth_rad_s": "bandwidth of the controller's own PI speed loop in torque "
                                 "mode, rad/s (default 3 omega_1)",
     }
-    # what a subclass overrides or calls, in the order the reference in docs/closed-loop.md lists them
+    # what a subclass overrides or calls, in the order docs/closed-loop.md's reference has them
     HOOKS: ClassVar[tuple[str, ...]] = ("defaults", "reset", "reference_rad_s", "loop_gains",
-                                        "delivered_loop_gains",
-                                        "active", "update")
+                                        "delivered_loop_gains", "active", "update")
 
     def __init__(self, rig: RigPhysics, schedule: Schedule, mode: str = "speed",
                  period_s: float = 0.01, enable_at_s: float = 0.0, **params: float) -> None:
