@@ -220,7 +220,9 @@ class DrillStickSlipEnv(gymnasium.Env):
         obs = np.array((m.drive_speed_rad_s, m.motor_torque_nm, m.string_torque_nm,
                         m.hook_load_n, m.applied_wob_estimate_n,
                         self._rpm_setpoint / RPM_PER_RAD_S, self._wob_setpoint_n))
-        np.clip(obs / self._divisors, -OBSERVATION_LIMIT, OBSERVATION_LIMIT, out=obs)
+        obs /= self._divisors
+        np.minimum(obs, OBSERVATION_LIMIT, out=obs)       # (np.clip costs twice as much)
+        np.maximum(obs, -OBSERVATION_LIMIT, out=obs)
         return obs, {"measurement": m, "period": bench.period}
 
 
