@@ -2,8 +2,9 @@
 
 One step is one control period of the closed-loop bench
 (:class:`~drill_sim_ros.control.bench.Bench`, the same stepper as ``drill_sim closed-loop``),
-so a policy that computes what a controller computes gets the bench's run of that controller
-bit for bit.
+so a policy that computes what a controller commands, over the action's scale, gets the
+bench's run of that controller given the same commands rounded through a x scale (bit for
+bit; the rounding is in the last bit of each command).
 
 * Observation (float64, shape (7,), :data:`OBSERVATION`): what the rig measures at the
   surface and the driller's setpoints, never downhole truth, each divided by a scale of the
