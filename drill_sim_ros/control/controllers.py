@@ -127,7 +127,8 @@ class TopDriveController:
 
     def reset(self) -> None:
         """Forget all state (filters, loop integral, counters); called by the constructor
-        and before a run. Build your filters here and call ``super().reset()``. In torque
+        (and by whoever restarts the controller). Build your filters here and call
+        ``super().reset()``. In torque
         mode it loads the compiled loop now, so that the first control period is not
         charged with it."""
         self._integral_nm: float | None = None
