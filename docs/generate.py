@@ -10,7 +10,10 @@ Sources: ``SPECS`` of ``drill_sim_ros/ros/parameters.py`` (the parameter table) 
 ``MSG_TYPES``, ``DESCRIPTIONS``, ``JOINTS`` and ``JOINT_FIELDS`` of ``drill_sim_ros/topics.py``
 with the QoS sim_node uses (the topic table); ``VARIABLES`` of
 ``drill_sim_ros/hil/address_space.py`` (the OPC UA address space of docs/hil.md) and
-``SETTINGS`` of ``drill_sim_ros/ros/opcua_gateway.py`` (the gateway's parameters there).
+``SETTINGS`` of ``drill_sim_ros/ros/opcua_gateway.py`` (the gateway's parameters there);
+the controller API of docs/closed-loop.md from the field metadata (unit, meaning) of
+``Command``, ``SurfaceMeasurement`` and ``RigPhysics``, the signatures and docstrings of
+``TopDriveController.HOOKS`` and ``LowPass``, and the source of ``examples/soft_speed_pi.py``.
 """
 
 from __future__ import annotations
@@ -155,12 +158,108 @@ def gateway_parameter_table() -> str:
     return settings_table()
 
 
+# The controller API that docs/closed-loop.md documents: (module, names); a controller written
+# from the page imports only these (tests/control/test_controller_api.py checks the example).
+CONTROLLER_API: tuple[tuple[str, tuple[str, ...]], ...] = (
+    ("drill_sim_ros.control.command", ("Command", "SurfaceMeasurement")),
+    ("drill_sim_ros.control.rig", ("RigPhysics",)),
+    ("drill_sim_ros.control.controllers", ("LowPass", "TopDriveController")),
+    ("drill_sim_ros.model.errors", ("ParameterError",)),
+)
+CONTROLLER_EXAMPLE = "examples/soft_speed_pi.py"
+_RST_ROLE = re.compile(r":(?:meth|func|class|mod|attr):`~?(?:[\w.]*\.)?(\w+)`")
+
+
+def _markdown_of_doc(text: str) -> str:
+    """A docstring as one line of Markdown: ``x`` -> `x`, :meth:`a.b` -> `b`."""
+    text = _RST_ROLE.sub(r"`\1`", " ".join(text.split()))
+    return text.replace("``", "`")
+
+
+def _field_rows(cls: type) -> list[str]:
+    """One row per field of a dataclass whose fields carry ``unit`` and ``meaning``."""
+    import dataclasses
+
+    rows = ["| field | unit | meaning |", "| --- | --- | --- |"]
+    for f in dataclasses.fields(cls):
+        if "unit" not in f.metadata or "meaning" not in f.metadata:
+            raise ValueError(f"{cls.__name__}.{f.name} has no unit and meaning (quantity())")
+        default = "" if f.default is dataclasses.MISSING else \
+            f" (default {_value(f.default)})"
+        rows.append("| " + " | ".join(_cell(c) for c in (
+            f"`{f.name}`", f.metadata["unit"], _markdown_of_doc(f.metadata["meaning"])
+            + default)) + " |")
+    return rows
+
+
+def _property_rows(cls: type) -> list[str]:
+    """One row per property, its unit in square brackets in its docstring."""
+    rows = []
+    for name, member in vars(cls).items():
+        if not isinstance(member, property):
+            continue
+        doc = _markdown_of_doc(member.__doc__ or "")
+        found = UNIT_IN_TEXT.search(doc)
+        if not found:
+            raise ValueError(f"{cls.__name__}.{name}'s docstring names no [unit]")
+        meaning = (doc[:found.start()].rstrip() + doc[found.end():]).strip()
+        rows.append("| " + " | ".join(_cell(c) for c in (
+            f"`{name}` (property)", found.group(1), meaning)) + " |")
+    return rows
+
+
+def _method_rows(cls: type, names: tuple[str, ...]) -> list[str]:
+    import inspect
+
+    rows = ["| method | what it does, when it is called |", "| --- | --- |"]
+    for name in names:
+        method = getattr(cls, name)
+        signature = str(inspect.signature(method)).replace("'", "")
+        rows.append("| " + " | ".join(_cell(c) for c in (
+            f"`{name}{signature}`", _markdown_of_doc(inspect.getdoc(method) or ""))) + " |")
+    return rows
+
+
+def controller_api() -> str:
+    """The controller API's reference: imports, the classes' fields with their units, the
+    rig's properties, the base class's hooks and LowPass."""
+    import inspect
+
+    from drill_sim_ros.control.command import Command, SurfaceMeasurement
+    from drill_sim_ros.control.controllers import LowPass, TopDriveController
+    from drill_sim_ros.control.rig import RigPhysics
+
+    imports = "\n".join(f"from {module} import {', '.join(names)}"
+                        for module, names in CONTROLLER_API)
+    parts = ["```python", imports, "```", ""]
+    for cls, what in ((SurfaceMeasurement, "what `update` gets each period"),
+                      (Command, "what `update` returns"),
+                      (RigPhysics, "`self.rig`, the rig's physics, SI")):
+        rows = _field_rows(cls) + _property_rows(cls)
+        parts += [f"**`{cls.__name__}`**, {what}: {_markdown_of_doc(cls.__doc__ or '')}",
+                  "", *rows, ""]
+    base = TopDriveController
+    parts += [f"**`{base.__name__}`**: {_markdown_of_doc(inspect.getdoc(base) or '')}", "",
+              *_method_rows(base, base.HOOKS), ""]
+    signature = str(inspect.signature(LowPass)).replace("'", "")
+    parts += [f"**`LowPass{signature}`**: {_markdown_of_doc(inspect.getdoc(LowPass) or '')}"]
+    return "\n".join(parts)
+
+
+def controller_example() -> str:
+    """The worked example's source, as a Python block."""
+    source = (ROOT / CONTROLLER_EXAMPLE).read_text(encoding="utf-8").rstrip("\n")
+    return f"`{CONTROLLER_EXAMPLE}`:\n\n```python\n{source}\n```"
+
+
 # (page, region name) -> the function that writes the region
 REGIONS: dict[tuple[str, str], Callable[[], str]] = {
     ("docs/sim_node.md", "topics"): topic_table,
     ("docs/sim_node.md", "parameters"): parameter_table,
     ("docs/hil.md", "gateway-parameters"): gateway_parameter_table,
     ("docs/hil.md", "address-space"): address_space_table,
+    ("docs/closed-loop.md", "controller-api"): controller_api,
+    ("docs/closed-loop.md", "controller-example"): controller_example,
 }
 
 

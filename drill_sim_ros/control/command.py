@@ -10,7 +10,8 @@ from __future__ import annotations
 
 import math
 import sys
-from dataclasses import dataclass
+from dataclasses import MISSING, dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -21,25 +22,43 @@ from drill_sim_ros.model.telemetry import TELEMETRY_INDEX
 F = TELEMETRY_INDEX
 
 
+def quantity(unit: str, meaning: str, default: Any = MISSING) -> Any:
+    """A dataclass field that says its unit and meaning (``field.metadata["unit"]`` and
+    ``["meaning"]``): the source of the controller API's reference in docs/closed-loop.md
+    (docs/generate.py)."""
+    return field(default=default, metadata={"unit": unit, "meaning": meaning})
+
+
 @dataclass(frozen=True)
 class Command:
-    """What one drill/cmd/top_drive message commands; None commands nothing."""
+    """What one drill/cmd/top_drive message commands; None commands nothing (the drive
+    keeps the last value it was given)."""
 
-    speed_rad_s: float | None = None       # speed setpoint (kinematic and speed modes)
-    motor_torque_nm: float | None = None   # motor torque (torque mode)
-    wob_n: float | None = None             # applied WOB
+    speed_rad_s: float | None = quantity(
+        "rad/s", "speed setpoint of the drive's own PI speed loop (speed mode); clamped to "
+        "[0, the rpm limit]", None)
+    motor_torque_nm: float | None = quantity(
+        "N m", "motor torque (torque mode); the drive applies it within +- its "
+        "max_torque_nm", None)
+    wob_n: float | None = quantity(
+        "N", "applied weight on bit setpoint; clamped to [0, limits.max_wob_n]", None)
 
 
 @dataclass(frozen=True)
 class SurfaceMeasurement:
-    """One sample of the rig's surface sensors, stamped with its simulated time."""
+    """One sample of the rig's surface sensors, stamped with its simulated time (with the
+    scenario's noise, quantisation and delay, ``model.measurement``)."""
 
-    time_s: float
-    drive_speed_rad_s: float     # encoder
-    motor_torque_nm: float       # the drive's own torque estimate
-    string_torque_nm: float      # torque sub at the quill
-    hook_load_n: float = math.nan              # deadline load cell
-    applied_wob_estimate_n: float = math.nan   # submerged string weight - hook load
+    time_s: float = quantity("s", "simulated time of the sample (its stamp)")
+    drive_speed_rad_s: float = quantity("rad/s", "the drive's speed, from its encoder")
+    motor_torque_nm: float = quantity("N m", "the drive's own estimate of its motor torque")
+    string_torque_nm: float = quantity("N m", "the string's torque at the quill, from the "
+                                              "torque sub")
+    hook_load_n: float = quantity("N", "hook load, from the deadline load cell "
+                                       "(NaN when a caller gives none)", math.nan)
+    applied_wob_estimate_n: float = quantity(
+        "N", "applied WOB estimated from it: submerged string weight - hook load "
+        "(NaN when a caller gives none)", math.nan)
 
 
 # the telemetry fields of a SurfaceMeasurement's values, in its order after time_s

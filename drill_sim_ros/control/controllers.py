@@ -9,8 +9,10 @@ reference omega_ref(t) built from the operator's setpoint omega_0(t) (the
 * ``speed``: omega_ref is the setpoint of the drive's own PI speed loop;
 * ``torque``: the controller closes its own PI speed loop on omega_ref and sends the motor
   torque (``model.top_drive.speed_loop``, the same loop as the drive's, with anti-windup),
-  gains kp = 2 J w_c, ki = J w_c^2 (critically damped on the drive's inertia J) for a
-  bandwidth w_c = ``loop_bandwidth_rad_s`` (default 3 omega_1, as the field drive's).
+  gains :meth:`TopDriveController.loop_gains`: by default kp = 2 J w_c, ki = J w_c^2
+  (critically damped on the drive's inertia J) for a bandwidth w_c =
+  ``loop_bandwidth_rad_s`` (default 3 omega_1, as the field drive's); a subclass sets kp
+  and ki independently by overriding it.
 
 Before ``enable_at_s`` every controller sends omega_ref = omega_0 (the drive as delivered);
 its filters run from the first sample, so it switches on without a start-up transient.
@@ -54,8 +56,10 @@ MAX_PARAMETER = 1e9     # every parameter is a positive number at most this (SI)
 
 
 class LowPass:
-    """First-order low-pass, exact for a signal held over each period: y += a (x - y),
-    a = 1 - exp(-w_c P). Starts at its first input."""
+    """First-order low-pass 1 / (1 + s / w_c), exact for a signal held over each period P:
+    y += a (x - y), a = 1 - exp(-w_c P). Its corner w_c is in rad/s (a corner of f Hz is
+    ``LowPass(2 * math.pi * f, period_s)``). Starts at its first input; :meth:`update`
+    returns the filtered value, ``value`` holds it (None before the first input)."""
 
     def __init__(self, corner_rad_s: float, period_s: float) -> None:
         self.alpha = 1.0 - math.exp(-corner_rad_s * period_s)
@@ -69,9 +73,18 @@ class LowPass:
 class TopDriveController:
     """The shared frame: schedule, switch-on, speed or torque output, limits.
 
-    Subclasses set ``name`` and ``PARAMS`` ({name: description with unit}), derive their
-    defaults in :meth:`defaults` and compute :meth:`reference_rad_s`. Call :meth:`update`
-    once per control period with the newest measurement (None before the first one).
+    Built as ``Class(rig, schedule, mode, period_s, enable_at_s, **params)`` (the bench and
+    the controller node do it), it keeps them as ``self.rig`` (a
+    :class:`~drill_sim_ros.control.rig.RigPhysics`), ``self.schedule`` (the operator's
+    setpoints: ``rpm_at(t_s)``, ``wob_at(t_s)``), ``self.mode`` ("speed" or "torque"),
+    ``self.period_s`` (the control period, s), ``self.enable_at_s`` (the switch-on, s) and
+    ``self.params`` (:meth:`defaults` updated with the given parameters, each checked to be
+    a known name and a number in (0, 1e9]).
+
+    Subclasses set ``name`` and ``PARAMS`` ({name: description with unit}) and override the
+    hooks of ``HOOKS``. Every control period the caller calls :meth:`update` with the newest
+    measurement (None before the first one); it calls :meth:`reference_rad_s` and, in
+    torque mode, closes a PI speed loop with :meth:`loop_gains` on the reference.
     """
 
     name = "base"
@@ -79,6 +92,9 @@ class TopDriveController:
         "loop_bandwidth_rad_s": "bandwidth of the controller's own PI speed loop in torque "
                                 "mode, rad/s (default 3 omega_1)",
     }
+    # what a subclass overrides or calls, in the order docs/closed-loop.md's reference has them
+    HOOKS: ClassVar[tuple[str, ...]] = ("defaults", "reset", "reference_rad_s", "loop_gains",
+                                        "delivered_loop_gains", "active", "update")
 
     def __init__(self, rig: RigPhysics, schedule: Schedule, mode: str = "speed",
                  period_s: float = 0.01, enable_at_s: float = 0.0, **params: float) -> None:
@@ -92,6 +108,9 @@ class TopDriveController:
         self.reset()
 
     def defaults(self) -> dict[str, float]:
+        """The parameters' defaults, derived from ``self.rig`` (called once, in the
+        constructor, before ``self.params`` exists); extend ``super().defaults()`` to keep
+        the base class's, or return only your own."""
         return {"loop_bandwidth_rad_s": 3.0 * self.rig.first_mode_rad_s}
 
     def _checked(self, params: dict[str, Any]) -> dict[str, float]:
@@ -107,23 +126,49 @@ class TopDriveController:
         return {key: float(value) for key, value in params.items()}
 
     def reset(self) -> None:
-        """Forget all state (filters, loop integral, counters). In torque mode, load the
-        compiled loop now, so that the first control period is not charged with it."""
+        """Forget all state (filters, loop integral, counters); called by the constructor
+        (and by whoever restarts the controller). Build your filters here and call
+        ``super().reset()``. In torque
+        mode it loads the compiled loop now, so that the first control period is not
+        charged with it."""
         self._integral_nm: float | None = None
         self.clamped_commands = 0
         if self.mode == "torque":
             speed_loop(0.0, 0.0, 0.0, 1.0, 1.0, 1.0, self.period_s)
 
     def reference_rad_s(self, m: SurfaceMeasurement, nominal_rad_s: float) -> float:
-        """The speed reference from the measurement (called every period, also before the
-        switch-on, so filters stay warm)."""
+        """The speed reference omega_ref (rad/s) from the measurement ``m`` and the
+        operator's setpoint ``nominal_rad_s`` at its time; called every period from the
+        first measurement on, also before the switch-on (where it is not used), so filters
+        stay warm. Default: the setpoint."""
         return nominal_rad_s
 
+    def loop_gains(self) -> tuple[float, float]:
+        """(kp N m s/rad, ki N m/rad) of the controller's own PI speed loop in torque mode
+        once switched on: motor torque = kp e + ki int e dt, e = omega_ref - the measured
+        drive speed (the integral held while the torque is at the drive's limit). Called
+        every period from the switch-on; before it the loop runs with
+        :meth:`delivered_loop_gains` (the drive as delivered), and its integral carries
+        over. Default: those same gains; override it to set kp and ki independently."""
+        return self.delivered_loop_gains()
+
+    def delivered_loop_gains(self) -> tuple[float, float]:
+        """(kp N m s/rad, ki N m/rad) critically damped on J: kp = 2 J w_c, ki = J w_c^2
+        with w_c = ``params["loop_bandwidth_rad_s"]``."""
+        w_c, j = self.params["loop_bandwidth_rad_s"], self.rig.drive_inertia_kg_m2
+        return 2.0 * j * w_c, j * w_c**2
+
     def active(self, time_s: float) -> bool:
+        """Whether the controller is switched on at ``time_s`` (s): from ``enable_at_s``."""
         return time_s >= self.enable_at_s
 
     def update(self, m: SurfaceMeasurement | None) -> Command:
-        """The command of this control period."""
+        """The command of this control period, for the newest measurement ``m`` (None
+        before the first): before the switch-on the operator's setpoint, then
+        :meth:`reference_rad_s` within [0, the rpm limit], sent as the speed setpoint
+        (speed mode) or through the PI loop of :meth:`loop_gains` as the motor torque
+        (torque mode); the WOB setpoint from the schedule. Override only to replace the
+        whole frame."""
         time_s = 0.0 if m is None else m.time_s
         nominal = self.schedule.rpm_at(time_s) / RPM_PER_RAD_S
         wob_n = self.schedule.wob_at(time_s)
@@ -145,13 +190,12 @@ class TopDriveController:
     def _torque_loop(self, reference_rad_s: float, m: SurfaceMeasurement) -> float:
         """PI speed loop on the drive's inertia (model.top_drive.speed_loop), starting from
         the measured motor torque (no bump)."""
-        w_c, j = self.params["loop_bandwidth_rad_s"], self.rig.drive_inertia_kg_m2
+        kp, ki = self.loop_gains() if self.active(m.time_s) else self.delivered_loop_gains()
         if self._integral_nm is None:
             self._integral_nm = m.motor_torque_nm
         limit = self.rig.max_torque_nm
         torque, self._integral_nm = speed_loop(reference_rad_s, m.drive_speed_rad_s,
-                                               self._integral_nm, 2.0 * j * w_c, j * w_c**2,
-                                               limit, self.period_s)
+                                               self._integral_nm, kp, ki, limit, self.period_s)
         if abs(torque) >= limit:
             self.clamped_commands += 1
         return float(torque)
@@ -233,8 +277,7 @@ class SoftDrive(TopDriveController):
         the controller's own in torque mode."""
         if self.mode == "speed":
             return self.rig.drive_kp_nm_s, self.rig.drive_ki_nm
-        w_c, j = self.params["loop_bandwidth_rad_s"], self.rig.drive_inertia_kg_m2
-        return 2.0 * j * w_c, j * w_c**2
+        return self.loop_gains()
 
     def reference_rad_s(self, m: SurfaceMeasurement, nominal_rad_s: float) -> float:
         if not self.active(m.time_s):

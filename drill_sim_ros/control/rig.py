@@ -23,6 +23,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from drill_sim_ros.control.command import quantity
 from drill_sim_ros.model.analysis import MODE_COUNT, cutoff_of
 from drill_sim_ros.model.defaults import MAX_SURFACE_RPM
 from drill_sim_ros.model.errors import ParameterError
@@ -33,23 +34,39 @@ from drill_sim_ros.model.string import StringSpec, analytic_modes_hz
 
 @dataclass(frozen=True)
 class RigPhysics:
-    """What the tuning rules use, SI."""
+    """What the tuning rules use, SI: the ``rig`` a controller is built with."""
 
-    stiffness_nm_rad: float          # C
-    bit_inertia_kg_m2: float         # I (eq. 1)
-    drive_inertia_kg_m2: float       # J
-    impedance_nm_s: float            # Z = J_p sqrt(G rho)
-    max_torque_nm: float             # the drive's motor torque limit (inf: none)
-    drive_kp_nm_s: float             # the drive's own speed loop: proportional gain
-    drive_ki_nm: float               # and integral gain
-    bit_area_m2: float               # pi a^2, for the specific energy
-    torsional_modes_hz: tuple[float, ...]   # the first MODE_COUNT, fixed top, free bit
-    cutoff_hz: float                 # stick-slip below, the collars' ringing above
-    max_surface_rpm: float = MAX_SURFACE_RPM   # limits.max_surface_rpm's default
+    stiffness_nm_rad: float = quantity(
+        "N m/rad", "C, the drill pipe's torsional stiffness G J_p / L (of a distributed "
+        "string: its lumped equivalent)")
+    bit_inertia_kg_m2: float = quantity(
+        "kg m^2", "I, the lumped inertia of RGD07 eq. 1: BHA + a third of the pipe")
+    drive_inertia_kg_m2: float = quantity(
+        "kg m^2", "J, the top drive's inertia referred to the quill")
+    impedance_nm_s: float = quantity(
+        "N m s/rad", "Z = J_p sqrt(G rho), the torsional characteristic impedance of the "
+        "(top section's) drill pipe: a top that turns at -T/Z absorbs an arriving wave")
+    max_torque_nm: float = quantity(
+        "N m", "the drive's motor torque limit (inf: none)")
+    drive_kp_nm_s: float = quantity(
+        "N m s/rad", "the drive's own PI speed loop (speed mode): proportional gain")
+    drive_ki_nm: float = quantity(
+        "N m/rad", "the drive's own PI speed loop (speed mode): integral gain")
+    bit_area_m2: float = quantity("m^2", "pi a^2, the bit's area (for the specific energy)")
+    torsional_modes_hz: tuple[float, ...] = quantity(
+        "Hz", "the string's first torsional natural frequencies, fixed top and free bit, "
+        "lowest first (``string.analytic_modes_hz``)")
+    cutoff_hz: float = quantity(
+        "Hz", "the scorecard's cut-off: stick-slip below, the collars' ringing above "
+        "(twice the third mode)")
+    max_surface_rpm: float = quantity(
+        "rev/min", "the speed setpoint's limit (sim_node's limits.max_surface_rpm)",
+        MAX_SURFACE_RPM)
 
     @property
     def first_mode_rad_s(self) -> float:
-        """omega_1 = sqrt(C / I), the torsional mode of the bit on the pipe (1/t*)."""
+        """omega_1 = sqrt(C / I) [rad/s], the torsional mode of the bit on the pipe (RGD07
+        eq. 19: 1/t*)."""
         return math.sqrt(self.stiffness_nm_rad / self.bit_inertia_kg_m2)
 
 
