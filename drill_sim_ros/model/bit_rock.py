@@ -290,7 +290,8 @@ RGD07_LAW = BitLaw()
 @dataclass(frozen=True)
 class FrictionWeakening:
     """A bit torque that falls with the bit's speed, SI (a physical preset's
-    ``physical.friction_weakening``; docs/model.md#a-bit-friction-that-falls-with-speed):
+    ``physical.friction_weakening``;
+    docs/model.md#the-bit-law-one-seam-and-a-bit-friction-that-falls-with-speed):
     f(omega) = floor_ratio + (1 - floor_ratio) exp(-omega / speed_rad_s) times the wearflat
     friction (``applies_to: friction``, NORCE Simulator4nDOF's form) or the whole bit torque
     (``bit``, the COPPE/UFRJ form). floor_ratio = 1 is RGD07's law."""
