@@ -28,6 +28,7 @@ from drill_sim_ros import closed_loop_cli, startup_cli, string_cli
 from drill_sim_ros.archive.output import open_output
 from drill_sim_ros.model import analysis, telemetry
 from drill_sim_ros.model import kernel as k
+from drill_sim_ros.model.bit_rock import LAWS
 from drill_sim_ros.model.checks import check_blade_counts
 from drill_sim_ros.model.errors import DrillSimError
 from drill_sim_ros.model.params import GROUPS, UNIT_SCALES, DimensionlessParams, Scales
@@ -418,6 +419,10 @@ def _cmd_info(args: argparse.Namespace) -> int:
     drive = preset.top_drive
     print(f"  top drive {drive.mode}: J/I={drive.inertia_ratio:.4g}  kp={drive.kp:.4g}  "
           f"ki={drive.ki:.4g}  max torque={drive.max_torque:.4g} (units of C, t*)")
+    weakening = preset.friction_weakening
+    print("  bit law rgd07" if weakening is None else
+          f"  bit law {LAWS[preset.bit_law.law]}: floor ratio {weakening.floor_ratio:.4g}, "
+          f"{weakening.speed_rad_s:.4g} rad/s")
     root = analysis.rightmost_root(p)
     print(f"  tau_n0={analysis.trivial_delay(p):.4g}  critical delay="
           f"{analysis.critical_delay(p):.4g}  rightmost root={root.real:.4g}+{root.imag:.4g}i")

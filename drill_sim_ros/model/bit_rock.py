@@ -257,9 +257,15 @@ def sector(n_blades: float) -> float:
 
 # ---- the law's parameters ---------------------------------------------------------------
 APPLIES_TO = ("friction", "bit")       # friction_weakening.applies_to -> LAW_WEAKENING_*
-FLOOR_RANGE = (0.0, 1.0)               # floor_ratio in (0, 1]; 1: RGD07's torque
-SPEED_RANGE_RAD_S = (0.0, 1.0e4)       # speed_rad_s in (0, 1e4]
+WEAKENING = "physical.friction_weakening"
+WEAKENING_RANGES = {"floor_ratio": (0.0, 1.0),      # (0, 1]; 1: RGD07's torque
+                    "speed_rad_s": (0.0, 1.0e4)}    # (0, 1e4] rad/s
 
+
+def _weakening_number(key: str, value: object) -> float:
+    """``physical.friction_weakening.<key>`` as a float in its range (open below), or one
+    ParameterError line naming it and the range."""
+    return number_in(f"'{WEAKENING}.{key}'", value, *WEAKENING_RANGES[key], low_open=True)
 
 @dataclass(frozen=True)
 class BitLaw:
@@ -290,7 +296,8 @@ RGD07_LAW = BitLaw()
 @dataclass(frozen=True)
 class FrictionWeakening:
     """A bit torque that falls with the bit's speed, SI (a physical preset's
-    ``physical.friction_weakening``; docs/model.md#a-bit-friction-that-falls-with-speed):
+    ``physical.friction_weakening``;
+    docs/model.md#the-bit-law-one-seam-and-a-bit-friction-that-falls-with-speed):
     f(omega) = floor_ratio + (1 - floor_ratio) exp(-omega / speed_rad_s) times the wearflat
     friction (``applies_to: friction``, NORCE Simulator4nDOF's form) or the whole bit torque
     (``bit``, the COPPE/UFRJ form). floor_ratio = 1 is RGD07's law."""
@@ -300,13 +307,11 @@ class FrictionWeakening:
     applies_to: str = "friction"
 
     def __post_init__(self) -> None:
-        where = "'physical.friction_weakening"
-        number_in(f"{where}.floor_ratio'", self.floor_ratio, *FLOOR_RANGE, low_open=True)
-        number_in(f"{where}.speed_rad_s'", self.speed_rad_s, *SPEED_RANGE_RAD_S,
-                  low_open=True)
+        for key in WEAKENING_RANGES:
+            _weakening_number(key, getattr(self, key))
         if self.applies_to not in APPLIES_TO:
-            raise ParameterError(f"{where}.applies_to' = {self.applies_to!r} must be one "
-                                 f"of {', '.join(APPLIES_TO)}")
+            raise ParameterError(f"'{WEAKENING}.applies_to' = {self.applies_to!r} must be "
+                                 f"one of {', '.join(APPLIES_TO)}")
 
     def scaled(self, time_s: float) -> BitLaw:
         """The law in kernel units: the e-folding speed times t* (eqs. 19-20)."""
@@ -319,12 +324,11 @@ def friction_weakening_from_dict(values: object) -> FrictionWeakening | None:
     ParameterError (one line) on an unknown key or a value out of range."""
     if values is None:
         return None
-    where = "physical.friction_weakening"
     known = tuple(f.name for f in fields(FrictionWeakening))
     if not isinstance(values, dict):
-        raise ParameterError(f"'{where}' must be a mapping of {', '.join(known)}; "
+        raise ParameterError(f"'{WEAKENING}' must be a mapping of {', '.join(known)}; "
                              f"got {values!r}")
-    check_known_keys(values, known, where)
-    numbers = {key: number_in(f"'{where}.{key}'", values[key], -math.inf, math.inf)
-               for key in ("floor_ratio", "speed_rad_s") if key in values}
+    check_known_keys(values, known, WEAKENING)
+    numbers = {key: _weakening_number(key, values[key])
+               for key in WEAKENING_RANGES if key in values}
     return FrictionWeakening(**{**values, **numbers})

@@ -8,7 +8,9 @@ dimensionless one; absent: the paper's kinematic drive; either way :attr:`Preset
 it in SI) and, in a physical preset, an
 optional ``string`` (:func:`string_from_dict`: ``lumped``, RGD07's spring, by default, or
 ``distributed`` sections; without ``sections`` the ``pipe_*`` / ``bha_*`` keys are the
-two-section shorthand).
+two-section shorthand). ``physical.friction_weakening`` (optional) is the bit law's
+(:func:`bit_rock.friction_weakening_from_dict`; absent: RGD07's law), :attr:`Preset.bit_law`
+in kernel units.
 """
 
 from __future__ import annotations
