@@ -151,10 +151,11 @@ def _baseline(args: argparse.Namespace, scenario: Scenario) -> ClosedLoopRun | N
 
 def _members(args: argparse.Namespace, scenario: Scenario, label: str,
              columns: dict[str, dict[str, Any]], schedule: Schedule,
-             rig: RigPhysics) -> dict[str, list[dict[str, Any]]] | None:
+             rig: RigPhysics,
+             timed: list[ClosedLoopRun]) -> dict[str, list[dict[str, Any]]] | None:
     """Every column's scorecards over the ensemble: member 0 (the run above) and members
     1 .. N - 1 run here (``control.scenario.seeded``; the seed changes neither the
-    setpoints nor the rig's modes); None after Ctrl-C."""
+    setpoints nor the rig's modes; each run is added to ``timed``); None after Ctrl-C."""
     cases = {label: scenario}
     if "no control" in columns:
         cases["no control"] = scenario.with_(controller="none", mode="speed", params={})
@@ -166,6 +167,7 @@ def _members(args: argparse.Namespace, scenario: Scenario, label: str,
             if run.interrupted:
                 _interrupted(run)
                 return None
+            timed.append(run)
             cards[name].append(score(run.rows, case.enable_at_s, schedule, rig,
                                      case.period_s))
     return cards
@@ -187,11 +189,29 @@ def _ensemble_table(members: dict[str, list[dict[str, Any]]]) -> str:
     return "\n".join(lines)
 
 
+def _throughput(timed: list[ClosedLoopRun], ros: bool) -> str:
+    """The speed of every run timed (``timed[0]`` the controller's; over DDS with ``ros``,
+    the others in process): periods, wall seconds of the runs, periods/s."""
+    periods = sum(len(run.rows) - 1 for run in timed)
+    wall_s = sum(run.wall_s for run in timed)
+    rate = periods / wall_s if wall_s > 0 else math.nan
+    period_s = timed[0].scenario.period_s
+    runs = f"{len(timed)} run{'s' if len(timed) > 1 else ''}"
+    where = "in process"
+    if ros:
+        where = "over DDS" if len(timed) == 1 else "the controller's over DDS, the rest in process"
+    return (f"{periods:,} periods of {period_s * 1e3:g} ms in {runs} ({where}), "
+            f"{wall_s:.1f} s: {rate:,.0f} periods/s ({rate * period_s:,.0f}x real time)")
+
+
 def _print_scores(args: argparse.Namespace, scenario: Scenario,
-                  columns: dict[str, dict[str, Any]], label: str, wall_s: float,
+                  columns: dict[str, dict[str, Any]], label: str,
+                  timed: list[ClosedLoopRun],
                   members: dict[str, list[dict[str, Any]]] | None = None) -> None:
-    """The scorecards as one JSON object (``--json``) or as a table and the run's speed;
-    with an ensemble, its members' scorecards (JSON) or their spread (table)."""
+    """The scorecards as one JSON object (``--json``; ``periods_per_s``: the controller's
+    run) or as a table and the speed of every run timed (:func:`_throughput`); with an
+    ensemble, its members' scorecards (JSON) or their spread (table)."""
+    wall_s = timed[0].wall_s
     rate = scenario.periods / wall_s if wall_s > 0 else math.nan
     if args.json:
         out = {"scenario": scenario.to_dict(), "path": "ros" if args.ros else "in-process",
@@ -204,9 +224,7 @@ def _print_scores(args: argparse.Namespace, scenario: Scenario,
         print(json.dumps(out))
         return
     print(_table(columns))
-    print(f"{scenario.periods:,} periods of {scenario.period_s * 1e3:g} ms "
-          f"{'over DDS' if args.ros else 'in process'}: {rate:,.0f} periods/s "
-          f"({rate * scenario.period_s:,.0f}x real time)")
+    print(_throughput(timed, args.ros))
     if members is not None:
         print("\n" + ensemble_caption(args.ensemble))
         print(_ensemble_table(members))
@@ -239,11 +257,12 @@ def _closed_loop(args: argparse.Namespace, scenario: Scenario, preset: Preset,
     runs[label] = controlled
     columns = {name: score(run.rows, scenario.enable_at_s, schedule, rig, scenario.period_s)
                for name, run in runs.items()}
-    members = _members(args, scenario, label, columns, schedule, rig) \
+    timed = [controlled] + ([baseline] if baseline is not None else [])
+    members = _members(args, scenario, label, columns, schedule, rig, timed) \
         if args.ensemble > 1 else None
     if members is None and args.ensemble > 1:
         return 130
-    _print_scores(args, scenario, columns, label, controlled.wall_s, members)
+    _print_scores(args, scenario, columns, label, timed, members)
     if plot_tmp is not None:
         _write_plot(args, plot_tmp, f"{preset.name}: {label}, switched on at "
                     f"{scenario.enable_at_s:g} s", scenario, runs, columns, schedule, rig)
