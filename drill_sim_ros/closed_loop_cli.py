@@ -6,8 +6,12 @@ import argparse
 import json
 import math
 import sys
+from contextlib import ExitStack
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
+
+import numpy as np
 
 from drill_sim_ros.control.bench import ClosedLoopRun, run_in_process
 from drill_sim_ros.control.controllers import CONTROL_MODES
@@ -26,7 +30,14 @@ from drill_sim_ros.control.schedule import Schedule
 from drill_sim_ros.control.scorecard import SCORE_FIELDS, score, status_text, summarize
 from drill_sim_ros.model.errors import DrillSimError
 from drill_sim_ros.model.presets import Preset
-from drill_sim_ros.plot_file import add_plot_arguments, commit_plot, plot_into
+from drill_sim_ros.model.telemetry import TELEMETRY_FIELDS
+from drill_sim_ros.plot_file import (
+    add_plot_arguments,
+    commit_output,
+    commit_plot,
+    output_into,
+    plot_into,
+)
 from drill_sim_ros.terminal import StatusLine
 
 LABELS = {"ssi_before_mean": "SSI before switch-on (mean)", "ssi_mean": "SSI after (mean)",
@@ -61,7 +72,8 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--json", action="store_true", help="print one JSON object")
     add_plot_arguments(p, "speeds with the setpoint, quill and motor torque with its limit, "
                        "WOB; stuck and saturated spans shaded; the last 10 s and the bit "
-                       "speed's spectrum with the string's modes; beside the uncontrolled run")
+                       "speed's spectrum with the string's modes; beside the uncontrolled run",
+                       others=", --save-traces or --record")
     p.add_argument("--no-baseline", action="store_true", help="skip the uncontrolled run "
                    "(by default it runs too, for the comparison)")
     p.add_argument("--ensemble", type=int, default=1, metavar="N",
@@ -71,6 +83,21 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--ros", action="store_true", help="run sim_node and the "
                    "top_drive_controller node as processes over loopback DDS, score the "
                    "recording")
+    p.add_argument("--record", type=Path, metavar="FILE.mcap", help="with --ros: keep "
+                   "sim_node's recording (MCAP) of the controlled run in FILE.mcap (without "
+                   "it, the recording goes to a temporary directory deleted once scored)")
+    p.add_argument("--save-traces", type=Path, metavar="FILE.npz", help="write the runs' "
+                   "telemetry rows (every TELEMETRY_FIELDS column, SI) to FILE.npz: arrays "
+                   "fields, controlled, baseline (docs/closed-loop.md)")
+
+
+@dataclass(frozen=True)
+class _Outputs:
+    """The temporary files beside --plot, --save-traces and --record (None: not asked)."""
+
+    plot: Path | None = None
+    traces: Path | None = None
+    record: Path | None = None
 
 
 def _scenario(args: argparse.Namespace) -> Scenario:
@@ -91,14 +118,17 @@ def _scenario(args: argparse.Namespace) -> Scenario:
                       duration_s=args.t_end, enable_at_s=enable_at_s, params=params)
 
 
-def _run(scenario: Scenario, ros: bool, label: str) -> ClosedLoopRun:
+def _run(scenario: Scenario, ros: bool, label: str,
+         record_path: Path | None = None) -> ClosedLoopRun:
     line = StatusLine()
     def progress(done: int, total: int) -> None:
         line.show(f"{label}: {done:,}/{total:,} periods ({100 * done / total:4.1f}%)")
     try:
         if ros:
             from drill_sim_ros.ros.closed_loop import run_over_dds
-            return run_over_dds(scenario, progress)
+            if record_path is not None:          # sim_node refuses an existing file
+                record_path.unlink(missing_ok=True)
+            return run_over_dds(scenario, progress, record_path=record_path)
         return run_in_process(scenario, progress)
     finally:
         line.close()
@@ -128,9 +158,17 @@ def cmd_closed_loop(args: argparse.Namespace) -> int:
         raise DrillSimError(f"--enable-at = {scenario.enable_at_s:g} s must come before the "
                             f"end of the run (--t-end = {scenario.duration_s:g} s): nothing "
                             "would be scored after the switch-on")
+    if args.record is not None and not args.ros:
+        raise DrillSimError(f"--record {args.record}: only a run over DDS records (add --ros)")
     preset = scenario.load_preset()
-    with plot_into(args.plot, args.overwrite) as plot_tmp:
-        return _closed_loop(args, scenario, preset, plot_tmp)
+    with ExitStack() as stack:
+        out = _Outputs(
+            stack.enter_context(plot_into(args.plot, args.overwrite)),
+            stack.enter_context(output_into(args.save_traces, args.overwrite,
+                                            "--save-traces", (".npz",))),
+            stack.enter_context(output_into(args.record, args.overwrite, "--record",
+                                            (".mcap",))))
+        return _closed_loop(args, scenario, preset, out)
 
 
 def _interrupted(run: ClosedLoopRun) -> int:
@@ -216,7 +254,8 @@ def _print_scores(args: argparse.Namespace, scenario: Scenario,
     if args.json:
         out = {"scenario": scenario.to_dict(), "path": "ros" if args.ros else "in-process",
                "periods": scenario.periods, "periods_per_s": rate, "score": columns[label],
-               "baseline": columns.get("no control")}
+               "baseline": columns.get("no control"),
+               "recording": str(args.record) if args.record else None}
         if members is not None:
             out["ensemble"] = {"members": args.ensemble, "step": ENSEMBLE_STEP,
                                "seeded": ENSEMBLE_KEY, "score": members[label],
@@ -225,6 +264,8 @@ def _print_scores(args: argparse.Namespace, scenario: Scenario,
         return
     print(_table(columns))
     print(_throughput(timed, args.ros))
+    if (recording := _recording_line(args)) is not None:
+        print(recording)
     if members is not None:
         print("\n" + ensemble_caption(args.ensemble))
         print(_ensemble_table(members))
@@ -242,11 +283,36 @@ def _write_plot(args: argparse.Namespace, plot_tmp: Path, title: str, scenario: 
     commit_plot(plot_tmp, args.plot, args.overwrite)
 
 
+def _recording_line(args: argparse.Namespace) -> str | None:
+    """Where the run over DDS was recorded (None in process)."""
+    if not args.ros:
+        return None
+    if args.record is None:
+        return ("recording: sim_node's MCAP went to a temporary directory, deleted once "
+                "scored (--record FILE.mcap keeps it)")
+    return f"recording: {args.record} (sim_node's MCAP of the controlled run)"
+
+
+def _save_traces(args: argparse.Namespace, temporary: Path, scenario: Scenario,
+                 runs: dict[str, ClosedLoopRun], label: str) -> None:
+    """The runs' telemetry rows into ``temporary``, then onto ``--save-traces``: ``fields``
+    (the column names, TELEMETRY_FIELDS: SI, the unit in each name), ``controlled`` and,
+    when it ran, ``baseline`` (rows, t = 0 first), ``meta`` (JSON: the scenario, labels)."""
+    arrays = {"fields": np.array(TELEMETRY_FIELDS), "controlled": runs[label].rows}
+    if "no control" in runs:
+        arrays["baseline"] = runs["no control"].rows
+    meta = {"scenario": scenario.to_dict(), "controlled": label,
+            "baseline": "no control" if "no control" in runs else None,
+            "path": "ros" if args.ros else "in-process"}
+    np.savez_compressed(temporary, **arrays, meta=np.array(json.dumps(meta)))
+    commit_output(temporary, args.save_traces, args.overwrite, "--save-traces")
+
+
 def _closed_loop(args: argparse.Namespace, scenario: Scenario, preset: Preset,
-                 plot_tmp: Path | None) -> int:
+                 out: _Outputs) -> int:
     rig = rig_physics(preset)
     schedule = scenario.setpoints(preset)
-    controlled = _run(scenario, args.ros, scenario.controller)
+    controlled = _run(scenario, args.ros, scenario.controller, out.record)
     if controlled.interrupted:
         return _interrupted(controlled)
     baseline = _baseline(args, scenario)
@@ -263,7 +329,11 @@ def _closed_loop(args: argparse.Namespace, scenario: Scenario, preset: Preset,
     if members is None and args.ensemble > 1:
         return 130
     _print_scores(args, scenario, columns, label, timed, members)
-    if plot_tmp is not None:
-        _write_plot(args, plot_tmp, f"{preset.name}: {label}, switched on at "
+    if out.record is not None:
+        commit_output(out.record, args.record, args.overwrite, "--record")
+    if out.traces is not None:
+        _save_traces(args, out.traces, scenario, runs, label)
+    if out.plot is not None:
+        _write_plot(args, out.plot, f"{preset.name}: {label}, switched on at "
                     f"{scenario.enable_at_s:g} s", scenario, runs, columns, schedule, rig)
     return 0
