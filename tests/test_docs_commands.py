@@ -5,7 +5,8 @@ A fenced ``bash`` block of README.md or docs/*.md whose first line starts with
 temporary directory holding links to this checkout's ``.venv`` (the venv running the tests)
 and ``config``: the paths the docs use resolve, and the files the commands write land in
 the temporary directory. Each file a command names after ``--plot``, ``-o``, ``--out``,
-``--trace``, ``--save-traces`` or ``--record`` must exist afterwards.
+``--trace``, ``--save-traces`` or ``--record`` must exist afterwards. The selected blocks
+start together, two at a time (the rest of the suite keeps one core of two busy).
 
 A block that takes long states its short form in an HTML comment on the line right above
 its fence (invisible on the rendered page), e.g.::
@@ -25,6 +26,8 @@ import shlex
 import subprocess
 import sys
 import textwrap
+from collections.abc import Iterator
+from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -37,6 +40,7 @@ FENCE = re.compile(r"^([ \t]*)```bash[ \t]*\n(.*?)^\1```", re.MULTILINE | re.DOT
 SHORT = re.compile(r"<!--\s*short:((?:(?!-->).)*)-->\s*\Z", re.DOTALL)
 OUTPUTS = re.compile(r"(?:^|\s)(?:--plot|-o|--out|--trace|--save-traces|--record)\s+(\S+)")
 BLOCK_TIMEOUT_S = 240.0
+PARALLEL_BLOCKS = 2
 
 
 @dataclass(frozen=True)
@@ -93,12 +97,32 @@ def _param(block: Block) -> pytest.param:
 
 def _workdir(tmp_path: Path) -> Path:
     """A directory where the docs' relative paths resolve: .venv and config linked."""
-    venv = Path(sys.prefix)
-    if not (venv / "bin" / "drill_sim").exists():
-        pytest.skip(f"{venv}/bin/drill_sim is not installed (make venv)")
-    (tmp_path / ".venv").symlink_to(venv)
+    (tmp_path / ".venv").symlink_to(sys.prefix)
     (tmp_path / "config").symlink_to(ROOT / "config")
     return tmp_path
+
+
+def _run_block(block: Block, cwd: Path) -> tuple[Path, subprocess.CompletedProcess[str]]:
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(
+        [str(ROOT), *filter(None, [os.environ.get("PYTHONPATH")])])}
+    done = subprocess.run(["bash", "-e", "-c", block.short], cwd=cwd, env=env,
+                          capture_output=True, text=True, timeout=BLOCK_TIMEOUT_S,
+                          stdin=subprocess.DEVNULL)
+    return cwd, done
+
+
+@pytest.fixture(scope="module")
+def block_runs(request: pytest.FixtureRequest,
+               tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Future]]:
+    """The selected blocks, started at once, two at a time (the suite's own tests use one
+    core of two): one future per block id."""
+    if not (Path(sys.prefix) / "bin" / "drill_sim").exists():
+        pytest.skip(f"{sys.prefix}/bin/drill_sim is not installed (make venv)")
+    selected = [item.callspec.params["block"] for item in request.session.items
+                if getattr(item, "originalname", "") == "test_command_block_runs"]
+    with ThreadPoolExecutor(max_workers=PARALLEL_BLOCKS) as pool:
+        yield {f"{b.page}:{b.line}": pool.submit(_run_block, b, _workdir(
+            tmp_path_factory.mktemp("docs_block"))) for b in selected}
 
 
 def test_the_docs_have_command_blocks() -> None:
@@ -109,13 +133,9 @@ def test_the_docs_have_command_blocks() -> None:
 
 
 @pytest.mark.parametrize("block", [_param(b) for b in BLOCKS])
-def test_command_block_runs(block: Block, tmp_path: Path) -> None:
+def test_command_block_runs(block: Block, block_runs: dict[str, Future]) -> None:
     script = block.short
-    cwd = _workdir(tmp_path)
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join(
-        [str(ROOT), *filter(None, [os.environ.get("PYTHONPATH")])])}
-    done = subprocess.run(["bash", "-e", "-c", script], cwd=cwd, env=env, capture_output=True,
-                          text=True, timeout=BLOCK_TIMEOUT_S, stdin=subprocess.DEVNULL)
+    cwd, done = block_runs[f"{block.page}:{block.line}"].result(timeout=2 * BLOCK_TIMEOUT_S)
     assert done.returncode == 0, (f"{block.page}:{block.line} exit {done.returncode}\n"
                                   f"{script}\n{done.stderr[-2000:]}")
     for line in script.replace("\\\n", " ").splitlines():
