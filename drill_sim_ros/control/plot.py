@@ -169,7 +169,7 @@ def _wob(ax: Any, t: np.ndarray, rows: np.ndarray, ctx: PlotContext) -> None:
     ax.plot(t, np.where(off_bottom, np.nan, rows[:, F["applied_wob_n"]]) * 1e-3,
             color="tab:gray", lw=1.5, label="applied WOB")
     ax.plot(t, np.where(off_bottom, np.nan, operator_wob_n) * 1e-3, color="black", lw=0.8,
-            ls="--")
+            ls="--", label="operator setpoint")
     if off_bottom.any():
         ax.fill_between(t, 0, 0.07, where=off_bottom, transform=ax.get_xaxis_transform(),
                         color="0.5", alpha=0.6, lw=0, label="bit off bottom")
