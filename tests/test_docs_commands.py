@@ -1,12 +1,13 @@
 """Every command block of the docs runs as written, or in the short form it states.
 
-A fenced ``bash`` block of README.md or docs/*.md whose first line starts with
-``.venv/bin/drill_sim`` is run by ``bash -e`` (every command must exit 0) in a fresh
-temporary directory holding links to this checkout's ``.venv`` (the venv running the tests)
-and ``config``: the paths the docs use resolve, and the files the commands write land in
-the temporary directory. Each file a command names after ``--plot``, ``-o``, ``--out``,
-``--trace``, ``--save-traces`` or ``--record`` must exist afterwards. The selected blocks
-start together, two at a time (the rest of the suite keeps one core of two busy).
+A fenced block (``bash``, ``sh``, ``shell`` or no language) of README.md or docs/*.md
+whose first line starts with ``.venv/bin/drill_sim`` is run by ``bash -e`` (every command
+must exit 0) in a fresh temporary directory holding links to this checkout's ``.venv``
+(the venv running the tests) and ``config``: the paths the docs use resolve, and the
+files the commands write land in the temporary directory. Each file a command names after
+``--plot``, ``-o``, ``--out``, ``--trace``, ``--save-traces`` or ``--record`` must exist
+afterwards. The selected blocks start together, two at a time (the rest of the suite keeps
+one core of two busy).
 
 A block that takes long states its short form in an HTML comment on the line right above
 its fence (invisible on the rendered page), e.g.::
@@ -36,7 +37,8 @@ import pytest
 ROOT = Path(__file__).resolve().parent.parent
 PAGES = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
 COMMAND = ".venv/bin/drill_sim"
-FENCE = re.compile(r"^([ \t]*)```bash[ \t]*\n(.*?)^\1```", re.MULTILINE | re.DOTALL)
+FENCE = re.compile(r"^([ \t]*)```([^`\n]*)\n(.*?)^\1```", re.MULTILINE | re.DOTALL)
+SHELLS = ("", "bash", "sh", "shell")
 SHORT = re.compile(r"<!--\s*short:((?:(?!-->).)*)-->\s*\Z", re.DOTALL)
 OUTPUTS = re.compile(r"(?:^|\s)(?:--plot|-o|--out|--trace|--save-traces|--record)\s+(\S+)")
 BLOCK_TIMEOUT_S = 240.0
@@ -73,12 +75,12 @@ def _rules(comment: str) -> tuple[tuple[str, str], ...]:
 
 
 def command_blocks(page: Path) -> list[Block]:
-    """The page's bash blocks that start with ``.venv/bin/drill_sim``."""
+    """The page's shell blocks that start with ``.venv/bin/drill_sim``."""
     text = page.read_text(encoding="utf-8")
     blocks = []
     for match in FENCE.finditer(text):
-        body = textwrap.dedent(match.group(2))
-        if not body.startswith(COMMAND):
+        body = textwrap.dedent(match.group(3))
+        if match.group(2).strip() not in SHELLS or not body.startswith(COMMAND):
             continue
         short = SHORT.search(text[:match.start()])
         blocks.append(Block(page.relative_to(ROOT).as_posix(),
