@@ -83,7 +83,8 @@ def command_blocks(page: Path) -> list[Block]:
         if match.group(2).strip() not in SHELLS or not body.startswith(COMMAND):
             continue
         short = SHORT.search(text[:match.start()])
-        blocks.append(Block(page.relative_to(ROOT).as_posix(),
+        name = page.relative_to(ROOT).as_posix() if page.is_relative_to(ROOT) else page.name
+        blocks.append(Block(name,
                             text.count("\n", 0, match.start()) + 1, body,
                             _rules(short.group(1)) if short else ()))
     return blocks
@@ -132,6 +133,21 @@ def test_the_docs_have_command_blocks() -> None:
     pages = {block.page for block in BLOCKS}
     assert {"README.md", "docs/closed-loop.md", "docs/model.md", "docs/string.md",
             "docs/studies.md"} <= pages
+
+
+def test_a_short_form_applies_its_rules_and_refuses_a_stale_one(tmp_path: Path) -> None:
+    page = tmp_path / "page.md"
+    page.write_text("Text.\n\n<!-- short: --t-end 300 => --t-end 20\n--json => -->\n"
+                    "  ```bash\n  .venv/bin/drill_sim closed-loop --t-end 300 --json \\\n"
+                    "      --plot a.png   # comment\n  ```\n\n```yaml\nx: 1\n```\n"
+                    "```\n.venv/bin/drill_sim modes\n```\n```bash\nls\n```\n")
+    first, second = command_blocks(page)
+    assert (first.line, second.line, second.rules) == (5, 13, ())
+    assert first.short == (".venv/bin/drill_sim closed-loop --t-end 20  \\\n"
+                           "    --plot a.png   # comment\n")
+    stale = Block("page.md", 5, first.text, (("--t-end 600", "--t-end 20"),))
+    with pytest.raises(AssertionError, match="matches nothing"):
+        _ = stale.short
 
 
 @pytest.mark.parametrize("block", [_param(b) for b in BLOCKS])
