@@ -6,8 +6,12 @@ import argparse
 import json
 import math
 import sys
+from contextlib import ExitStack
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
+
+import numpy as np
 
 from drill_sim_ros.control.bench import ClosedLoopRun, run_in_process
 from drill_sim_ros.control.controllers import CONTROL_MODES
@@ -27,7 +31,14 @@ from drill_sim_ros.control.schedule import Schedule
 from drill_sim_ros.control.scorecard import SCORE_FIELDS, score, status_text, summarize
 from drill_sim_ros.model.errors import DrillSimError
 from drill_sim_ros.model.presets import Preset
-from drill_sim_ros.plot_file import add_plot_arguments, commit_plot, plot_into
+from drill_sim_ros.model.telemetry import TELEMETRY_FIELDS
+from drill_sim_ros.plot_file import (
+    add_plot_arguments,
+    commit_output,
+    commit_plot,
+    output_into,
+    plot_into,
+)
 from drill_sim_ros.terminal import StatusLine
 
 LABELS = {"ssi_before_mean": "SSI before switch-on (mean)", "ssi_mean": "SSI after (mean)",
@@ -67,7 +78,8 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--json", action="store_true", help="print one JSON object")
     add_plot_arguments(p, "speeds with the setpoint, quill and motor torque with its limit, "
                        "WOB; stuck and saturated spans shaded; the last 10 s and the bit "
-                       "speed's spectrum with the string's modes; beside the uncontrolled run")
+                       "speed's spectrum with the string's modes; beside the uncontrolled run",
+                       others=", --save-traces or --record")
     p.add_argument("--no-baseline", action="store_true", help="skip the uncontrolled run "
                    "(by default it runs too, for the comparison)")
     p.add_argument("--ensemble", type=int, default=1, metavar="N",
@@ -77,6 +89,21 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--ros", action="store_true", help="run sim_node and the "
                    "top_drive_controller node as processes over loopback DDS, score the "
                    "recording")
+    p.add_argument("--record", type=Path, metavar="FILE.mcap", help="with --ros: keep "
+                   "sim_node's recording (MCAP) of the controlled run in FILE.mcap (without "
+                   "it, the recording goes to a temporary directory deleted once scored)")
+    p.add_argument("--save-traces", type=Path, metavar="FILE.npz", help="write the runs' "
+                   "telemetry rows (every TELEMETRY_FIELDS column, SI) to FILE.npz: arrays "
+                   "fields, controlled, baseline (docs/closed-loop.md)")
+
+
+@dataclass(frozen=True)
+class _Outputs:
+    """The temporary files beside --plot, --save-traces and --record (None: not asked)."""
+
+    plot: Path | None = None
+    traces: Path | None = None
+    record: Path | None = None
 
 
 def _scenario(args: argparse.Namespace) -> Scenario:
@@ -97,14 +124,17 @@ def _scenario(args: argparse.Namespace) -> Scenario:
                       duration_s=args.t_end, enable_at_s=enable_at_s, params=params)
 
 
-def _run(scenario: Scenario, ros: bool, label: str) -> ClosedLoopRun:
+def _run(scenario: Scenario, ros: bool, label: str,
+         record_path: Path | None = None) -> ClosedLoopRun:
     line = StatusLine()
     def progress(done: int, total: int) -> None:
         line.show(f"{label}: {done:,}/{total:,} periods ({100 * done / total:4.1f}%)")
     try:
         if ros:
             from drill_sim_ros.ros.closed_loop import run_over_dds
-            return run_over_dds(scenario, progress)
+            if record_path is not None:          # sim_node refuses an existing file
+                record_path.unlink(missing_ok=True)
+            return run_over_dds(scenario, progress, record_path=record_path)
         return run_in_process(scenario, progress)
     finally:
         line.close()
@@ -135,9 +165,17 @@ def cmd_closed_loop(args: argparse.Namespace) -> int:
         raise DrillSimError(f"--enable-at = {scenario.enable_at_s:g} s must come before the "
                             f"end of the run (--t-end = {scenario.duration_s:g} s): nothing "
                             "would be scored after the switch-on")
+    if args.record is not None and not args.ros:
+        raise DrillSimError(f"--record {args.record}: only a run over DDS records (add --ros)")
     preset = scenario.load_preset()
-    with plot_into(args.plot, args.overwrite) as plot_tmp:
-        return _closed_loop(args, scenario, preset, plot_tmp)
+    with ExitStack() as stack:
+        out = _Outputs(
+            stack.enter_context(plot_into(args.plot, args.overwrite)),
+            stack.enter_context(output_into(args.save_traces, args.overwrite,
+                                            "--save-traces", (".npz",))),
+            stack.enter_context(output_into(args.record, args.overwrite, "--record",
+                                            (".mcap",))))
+        return _closed_loop(args, scenario, preset, out)
 
 
 def _interrupted(run: ClosedLoopRun) -> int:
@@ -158,10 +196,11 @@ def _baseline(args: argparse.Namespace, scenario: Scenario) -> ClosedLoopRun | N
 
 def _members(args: argparse.Namespace, scenario: Scenario, label: str,
              columns: dict[str, dict[str, Any]], schedule: Schedule,
-             rig: RigPhysics) -> dict[str, list[dict[str, Any]]] | None:
+             rig: RigPhysics,
+             timed: list[ClosedLoopRun]) -> dict[str, list[dict[str, Any]]] | None:
     """Every column's scorecards over the ensemble: member 0 (the run above) and members
     1 .. N - 1 run here (``control.scenario.seeded``; the seed changes neither the
-    setpoints nor the rig's modes); None after Ctrl-C."""
+    setpoints nor the rig's modes; each run is added to ``timed``); None after Ctrl-C."""
     cases = {label: scenario}
     if "no control" in columns:
         cases["no control"] = scenario.with_(controller="none", mode="speed", params={})
@@ -173,6 +212,7 @@ def _members(args: argparse.Namespace, scenario: Scenario, label: str,
             if run.interrupted:
                 _interrupted(run)
                 return None
+            timed.append(run)
             cards[name].append(score(run.rows, case.enable_at_s, schedule, rig,
                                      case.period_s))
     return cards
@@ -195,16 +235,35 @@ def _ensemble_table(members: dict[str, list[dict[str, Any]]]) -> str:
     return "\n".join(lines)
 
 
+def _throughput(timed: list[ClosedLoopRun], ros: bool) -> str:
+    """The speed of every run timed (``timed[0]`` the controller's; over DDS with ``ros``,
+    the others in process): periods, wall seconds of the runs, periods/s."""
+    periods = sum(len(run.rows) - 1 for run in timed)
+    wall_s = sum(run.wall_s for run in timed)
+    rate = periods / wall_s if wall_s > 0 else math.nan
+    period_s = timed[0].scenario.period_s
+    runs = f"{len(timed)} run{'s' if len(timed) > 1 else ''}"
+    where = "in process"
+    if ros:
+        where = "over DDS" if len(timed) == 1 else "the controller's over DDS, the rest in process"
+    return (f"{periods:,} periods of {period_s * 1e3:g} ms in {runs} ({where}), "
+            f"{wall_s:.1f} s: {rate:,.0f} periods/s ({rate * period_s:,.0f}x real time)")
+
+
 def _print_scores(args: argparse.Namespace, scenario: Scenario,
-                  columns: dict[str, dict[str, Any]], label: str, wall_s: float,
+                  columns: dict[str, dict[str, Any]], label: str,
+                  timed: list[ClosedLoopRun],
                   members: dict[str, list[dict[str, Any]]] | None = None) -> None:
-    """The scorecards as one JSON object (``--json``) or as a table and the run's speed;
-    with an ensemble, its members' scorecards (JSON) or their spread (table)."""
+    """The scorecards as one JSON object (``--json``; ``periods_per_s``: the controller's
+    run) or as a table and the speed of every run timed (:func:`_throughput`); with an
+    ensemble, its members' scorecards (JSON) or their spread (table)."""
+    wall_s = timed[0].wall_s
     rate = scenario.periods / wall_s if wall_s > 0 else math.nan
     if args.json:
         out = {"scenario": scenario.to_dict(), "path": "ros" if args.ros else "in-process",
                "periods": scenario.periods, "periods_per_s": rate, "score": columns[label],
-               "baseline": columns.get("no control")}
+               "baseline": columns.get("no control"),
+               "recording": str(args.record) if args.record else None}
         if members is not None:
             out["ensemble"] = {"members": args.ensemble, "step": ENSEMBLE_STEP,
                                "seeded": ENSEMBLE_KEY, "score": members[label],
@@ -212,9 +271,9 @@ def _print_scores(args: argparse.Namespace, scenario: Scenario,
         print(json.dumps(out))
         return
     print(_table(columns))
-    print(f"{scenario.periods:,} periods of {scenario.period_s * 1e3:g} ms "
-          f"{'over DDS' if args.ros else 'in process'}: {rate:,.0f} periods/s "
-          f"({rate * scenario.period_s:,.0f}x real time)")
+    print(_throughput(timed, args.ros))
+    if (recording := _recording_line(args)) is not None:
+        print(recording)
     if members is not None:
         print("\n" + ensemble_caption(args.ensemble))
         print(_ensemble_table(members))
@@ -232,11 +291,36 @@ def _write_plot(args: argparse.Namespace, plot_tmp: Path, title: str, scenario: 
     commit_plot(plot_tmp, args.plot, args.overwrite)
 
 
+def _recording_line(args: argparse.Namespace) -> str | None:
+    """Where the run over DDS was recorded (None in process)."""
+    if not args.ros:
+        return None
+    if args.record is None:
+        return ("recording: sim_node's MCAP went to a temporary directory, deleted once "
+                "scored (--record FILE.mcap keeps it)")
+    return f"recording: {args.record} (sim_node's MCAP of the controlled run)"
+
+
+def _save_traces(args: argparse.Namespace, temporary: Path, scenario: Scenario,
+                 runs: dict[str, ClosedLoopRun], label: str) -> None:
+    """The runs' telemetry rows into ``temporary``, then onto ``--save-traces``: ``fields``
+    (the column names, TELEMETRY_FIELDS: SI, the unit in each name), ``controlled`` and,
+    when it ran, ``baseline`` (rows, t = 0 first), ``meta`` (JSON: the scenario, labels)."""
+    arrays = {"fields": np.array(TELEMETRY_FIELDS), "controlled": runs[label].rows}
+    if "no control" in runs:
+        arrays["baseline"] = runs["no control"].rows
+    meta = {"scenario": scenario.to_dict(), "controlled": label,
+            "baseline": "no control" if "no control" in runs else None,
+            "path": "ros" if args.ros else "in-process"}
+    np.savez_compressed(temporary, **arrays, meta=np.array(json.dumps(meta)))
+    commit_output(temporary, args.save_traces, args.overwrite, "--save-traces")
+
+
 def _closed_loop(args: argparse.Namespace, scenario: Scenario, preset: Preset,
-                 plot_tmp: Path | None) -> int:
+                 out: _Outputs) -> int:
     rig = rig_physics(preset)
     schedule = scenario.setpoints(preset)
-    controlled = _run(scenario, args.ros, scenario.controller)
+    controlled = _run(scenario, args.ros, scenario.controller, out.record)
     if controlled.interrupted:
         return _interrupted(controlled)
     baseline = _baseline(args, scenario)
@@ -247,12 +331,17 @@ def _closed_loop(args: argparse.Namespace, scenario: Scenario, preset: Preset,
     runs[label] = controlled
     columns = {name: score(run.rows, scenario.enable_at_s, schedule, rig, scenario.period_s)
                for name, run in runs.items()}
-    members = _members(args, scenario, label, columns, schedule, rig) \
+    timed = [controlled] + ([baseline] if baseline is not None else [])
+    members = _members(args, scenario, label, columns, schedule, rig, timed) \
         if args.ensemble > 1 else None
     if members is None and args.ensemble > 1:
         return 130
-    _print_scores(args, scenario, columns, label, controlled.wall_s, members)
-    if plot_tmp is not None:
-        _write_plot(args, plot_tmp, f"{preset.name}: {label}, switched on at "
+    _print_scores(args, scenario, columns, label, timed, members)
+    if out.record is not None:
+        commit_output(out.record, args.record, args.overwrite, "--record")
+    if out.traces is not None:
+        _save_traces(args, out.traces, scenario, runs, label)
+    if out.plot is not None:
+        _write_plot(args, out.plot, f"{preset.name}: {label}, switched on at "
                     f"{scenario.enable_at_s:g} s", scenario, runs, columns, schedule, rig)
     return 0

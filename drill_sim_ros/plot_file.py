@@ -1,6 +1,7 @@
-"""``--plot FILE`` of the offline commands: checked before the run, drawn into a temporary
-file beside it, moved onto it when done (an existing file only with ``--overwrite``), so a
-run that fails or is interrupted leaves nothing half-written."""
+"""``--plot FILE`` (and the other files written at the end of a run) of the offline
+commands: checked before the run, written into a temporary file beside it, moved onto it
+when done (an existing file only with ``--overwrite``), so a run that fails or is
+interrupted leaves nothing half-written."""
 
 from __future__ import annotations
 
@@ -20,49 +21,62 @@ from drill_sim_ros.model.errors import DrillSimError
 PLOT_SUFFIXES = (".png", ".svg", ".pdf")
 
 
-def add_plot_arguments(parser: Any, picture: str) -> None:
-    """``--plot FILE`` (``picture``: what it draws) and ``--overwrite`` on ``parser``."""
+def add_plot_arguments(parser: Any, picture: str, others: str = "") -> None:
+    """``--plot FILE`` (``picture``: what it draws) and ``--overwrite`` on ``parser``;
+    ``others`` names the command's other output options that ``--overwrite`` covers."""
     parser.add_argument("--plot", type=Path, help=f"write a PNG of {picture} (also .svg or "
                         ".pdf); an existing file is kept unless --overwrite")
     parser.add_argument("--overwrite", action="store_true",
-                        help="replace an existing --plot file")
+                        help=f"replace an existing --plot{others} file")
 
 
-def _plot_target(path: Path | None, overwrite: bool) -> Path | None:
-    """A writable temporary file beside ``--plot`` (checked before the run), or None; the
-    caller removes it when done (:func:`commit_plot` moves it on)."""
+def _output_target(path: Path | None, overwrite: bool, option: str,
+                   suffixes: tuple[str, ...]) -> Path | None:
+    """A writable temporary path beside the file of ``option`` (checked before the run), or
+    None; the caller removes it when done (:func:`commit_output` moves it on)."""
     if path is None:
         return None
     if path.is_dir():
-        raise DrillSimError(f"--plot {path} is a directory; give a file name such as "
-                            f"{path / 'run.png'}")
-    if path.suffix.lower() not in PLOT_SUFFIXES:
-        raise DrillSimError(f"--plot {path}: unknown suffix {path.suffix!r}; use one of "
-                            f"{', '.join(PLOT_SUFFIXES)}")
+        raise DrillSimError(f"{option} {path} is a directory; give a file name such as "
+                            f"{path / ('run' + suffixes[0])}")
+    if path.suffix.lower() not in suffixes:
+        allowed = f"one of {', '.join(suffixes)}" if len(suffixes) > 1 else suffixes[0]
+        raise DrillSimError(f"{option} {path}: unknown suffix {path.suffix!r}; use {allowed}")
     try:
         return temporary_beside(path, overwrite, keep_suffix=True)
     except OutputExistsError as exc:
-        raise DrillSimError(f"--plot: {exc}") from None
+        raise DrillSimError(f"{option}: {exc}") from None
     except OutputError as exc:
         reason = str(exc).rsplit(": ", 1)[-1]
-        raise DrillSimError(f"--plot {path}: cannot write there ({reason})") from None
+        raise DrillSimError(f"{option} {path}: cannot write there ({reason})") from None
+
+
+def commit_output(temporary: Path, path: Path, overwrite: bool, option: str) -> None:
+    """The finished file ``temporary`` onto ``path`` (the file of ``option``)."""
+    try:
+        commit(temporary, path, overwrite)
+    except OutputError as exc:
+        raise DrillSimError(f"{option}: {exc}") from None
 
 
 def commit_plot(temporary: Path, path: Path, overwrite: bool) -> None:
     """The finished picture ``temporary`` onto ``--plot`` ``path``."""
-    try:
-        commit(temporary, path, overwrite)
-    except OutputError as exc:
-        raise DrillSimError(f"--plot: {exc}") from None
+    commit_output(temporary, path, overwrite, "--plot")
 
 
 @contextmanager
-def plot_into(path: Path | None, overwrite: bool) -> Iterator[Path | None]:
-    """:func:`_plot_target` for the run inside the ``with``, removed after it whatever
-    happened (:func:`commit_plot` has moved it on when the picture was done)."""
-    temporary = _plot_target(path, overwrite)
+def output_into(path: Path | None, overwrite: bool, option: str = "--plot",
+                suffixes: tuple[str, ...] = PLOT_SUFFIXES) -> Iterator[Path | None]:
+    """:func:`_output_target` for the run inside the ``with``, removed after it whatever
+    happened (:func:`commit_output` has moved it on when the file was done)."""
+    temporary = _output_target(path, overwrite, option, suffixes)
     try:
         yield temporary
     finally:
         if temporary is not None:
             temporary.unlink(missing_ok=True)
+
+
+def plot_into(path: Path | None, overwrite: bool) -> Any:
+    """:func:`output_into` for ``--plot``."""
+    return output_into(path, overwrite)

@@ -17,7 +17,7 @@ from drill_sim_ros.control.registry import display_name
 from drill_sim_ros.control.rig import rig_physics
 from drill_sim_ros.control.scenario import Scenario, seeded
 from drill_sim_ros.control.scorecard import SCORE_FIELDS, score
-from drill_sim_ros.model.telemetry import TELEMETRY_INDEX
+from drill_sim_ros.model.telemetry import TELEMETRY_FIELDS, TELEMETRY_INDEX
 
 ROOT = Path(__file__).resolve().parents[1]
 F = TELEMETRY_INDEX
@@ -115,6 +115,9 @@ def test_a_column_is_named_by_the_controllers_name_and_never_glued() -> None:
         (("--ensemble", "0"), "--ensemble"),
         (("--ensemble", "65"), "--ensemble"),
         (("--ensemble", "2", "--ros"), "--ensemble"),
+        (("--record", "run.mcap"), "--record"),
+        (("--ros", "--record", "run.rrd"), "--record"),
+        (("--save-traces", "traces.csv"), "--save-traces"),
     ],
 )
 def test_bad_input_is_one_line(args: tuple[str, ...], names: str) -> None:
@@ -145,3 +148,37 @@ def test_an_ensemble_scores_its_members_as_the_bench_does() -> None:
     assert table.returncode == 0, table.stderr
     assert "the ensemble of 2 members" in table.stdout
     assert "stick-slip / ok / stalled / other" in table.stdout
+
+
+def test_save_traces_holds_both_runs_as_the_bench_runs_them(tmp_path: Path) -> None:
+    """--save-traces: every telemetry column of the controller's run and of the uncontrolled
+    one, equal to the bench's own runs of the same scenario; the throughput line counts
+    both runs (2 x 2000 periods)."""
+    npz = tmp_path / "traces.npz"
+    result = drill_sim("--controller", "soft_torque", "--t-end", "20", "--save-traces",
+                       str(npz))
+    assert result.returncode == 0, result.stderr
+    assert "4,000 periods of 10 ms in 2 runs (in process)" in result.stdout
+    scenario = Scenario(controller="soft_torque", duration_s=20.0, enable_at_s=20.0 / 3.0)
+    with np.load(npz) as saved:
+        assert tuple(saved["fields"]) == TELEMETRY_FIELDS
+        assert json.loads(str(saved["meta"]))["controlled"] == "soft_torque (speed)"
+        np.testing.assert_array_equal(saved["controlled"], run_in_process(scenario).rows)
+        np.testing.assert_array_equal(
+            saved["baseline"], run_in_process(scenario.with_(controller="none")).rows)
+    again = drill_sim("--controller", "soft_torque", "--t-end", "1", "--save-traces", str(npz))
+    assert again.returncode == 2 and "exists" in again.stderr
+
+
+@pytest.mark.ros
+def test_record_keeps_the_recording_it_scored(tmp_path: Path) -> None:
+    """--ros --record FILE.mcap: the command says where the recording is, and its telemetry
+    is the run the command saved (--save-traces)."""
+    from drill_sim_ros.ros.closed_loop import read_telemetry
+    mcap, npz = tmp_path / "run.mcap", tmp_path / "traces.npz"
+    result = drill_sim("--controller", "soft_torque", "--t-end", "10", "--no-baseline", "--ros",
+                       "--record", str(mcap), "--save-traces", str(npz))
+    assert result.returncode == 0, result.stderr
+    assert f"recording: {mcap}" in result.stdout
+    with np.load(npz) as saved:
+        np.testing.assert_array_equal(read_telemetry(mcap), saved["controlled"])

@@ -8,7 +8,8 @@ one scenario), six panels:
    mode) and the operator's setpoint;
 2. the string torque at the quill (torque sub);
 3. the motor torque with its limit (+-);
-4. the WOB at the bit and the applied WOB with the operator's setpoint;
+4. the WOB at the bit and the applied WOB with the operator's setpoint (these two only while
+   the bit is on bottom; a grey band along the bottom where it is picked up);
 5. the last ``ZOOM_S`` seconds of the bit and drive speeds, where a ring of the collars
    (which paints the 180 s panels solid) can be seen;
 6. the amplitude spectrum of the bit speed after the switch-on (log-log,
@@ -131,7 +132,6 @@ def _column(axes: Sequence[Any], rows: np.ndarray, run: PlotRun, ctx: PlotContex
     """The four panels over the whole run (module doc, 1-4)."""
     t = rows[:, F["sim_time_s"]]
     operator_rpm = np.array([ctx.schedule.rpm_at(x) for x in t])
-    operator_wob = np.array([ctx.schedule.wob_at(x) for x in t])
     ax_speed, ax_quill, ax_motor, ax_wob = axes
     ax_speed.plot(t, operator_rpm, color="black", lw=0.8, ls="--", label="operator setpoint")
     _speeds(ax_speed, t, rows, ctx, run.speed_mode)
@@ -145,11 +145,7 @@ def _column(axes: Sequence[Any], rows: np.ndarray, run: PlotRun, ctx: PlotContex
         for sign in (1, -1) if low else (1,):
             ax_motor.axhline(sign * limit_nm * 1e-3, color="tab:red", lw=1.0, ls="-.",
                              label="torque limit" if sign > 0 else None)
-    ax_wob.plot(t, rows[:, F["wob_n"]] * 1e-3, color="tab:cyan", lw=0.5, alpha=0.5,
-                label="WOB at bit")
-    ax_wob.plot(t, rows[:, F["applied_wob_n"]] * 1e-3, color="tab:gray", lw=1.5,
-                label="applied WOB")
-    ax_wob.plot(t, operator_wob * 1e-3, color="black", lw=0.8, ls="--")
+    _wob(ax_wob, t, rows, ctx)
     for ax in axes:
         _shade(ax, t, rows, ctx)
         ax.axvline(ctx.enable_at_s, color="tab:red", ls="--", lw=1.0)
@@ -160,6 +156,25 @@ def _column(axes: Sequence[Any], rows: np.ndarray, run: PlotRun, ctx: PlotContex
     for at_s, text in ctx.events:
         ax_speed.text(at_s, 0.86, f" {text}", color="0.3", fontsize=8,
                       transform=ax_speed.get_xaxis_transform())
+
+
+def _wob(ax: Any, t: np.ndarray, rows: np.ndarray, ctx: PlotContext) -> None:
+    """The WOB at the bit; the applied WOB and the operator's setpoint only while the bit is
+    on bottom (picked up, the hook carries the string and no WOB is applied: a grey band
+    along the bottom marks those spans)."""
+    off_bottom = np.array([ctx.schedule.off_bottom_at(x) for x in t], dtype=bool)
+    operator_wob_n = np.array([ctx.schedule.wob_at(x) for x in t])
+    ax.plot(t, rows[:, F["wob_n"]] * 1e-3, color="tab:cyan", lw=0.5, alpha=0.5,
+            label="WOB at bit")
+    ax.plot(t, np.where(off_bottom, np.nan, rows[:, F["applied_wob_n"]]) * 1e-3,
+            color="tab:gray", lw=1.5, label="applied WOB")
+    ax.plot(t, np.where(off_bottom, np.nan, operator_wob_n) * 1e-3, color="black", lw=0.8,
+            ls="--", label="operator setpoint")
+    if off_bottom.any():
+        ax.fill_between(t, 0, 0.07, where=off_bottom, transform=ax.get_xaxis_transform(),
+                        color="0.5", alpha=0.6, lw=0, label="bit off bottom")
+    low_kn, high_kn = ax.get_ylim()          # at least 0-10 kN: a zero WOB is not magnified
+    ax.set_ylim(min(low_kn, 0.0), max(high_kn, 10.0))
 
 
 def _speeds(ax: Any, t: np.ndarray, rows: np.ndarray, ctx: PlotContext,

@@ -137,11 +137,11 @@ def _check_exits(controller: subprocess.CompletedProcess[str], sim_rc: int,
 
 
 def _run_processes(scenario: Scenario, preset: Preset, tmp: Path, env: dict[str, str],
-                   timeout_s: float) -> ClosedLoopRun:
-    """sim_node and the controller node on ``scenario``, their files in ``tmp``; the
-    recording's telemetry (``interrupted`` and the rows so far on Ctrl-C)."""
-    scenario_path = tmp / "scenario.yaml"
-    record_path, log_path = tmp / "run.mcap", tmp / "sim_node.log"
+                   timeout_s: float, record_path: Path) -> ClosedLoopRun:
+    """sim_node (recording to ``record_path``) and the controller node on ``scenario``,
+    their other files in ``tmp``; the recording's telemetry (``interrupted`` and the rows
+    so far on Ctrl-C)."""
+    scenario_path, log_path = tmp / "scenario.yaml", tmp / "sim_node.log"
     save_scenario(scenario, scenario_path)
     sim, sim_log = _start_sim(scenario, preset, record_path, log_path, env)
     try:
@@ -164,8 +164,11 @@ def _run_processes(scenario: Scenario, preset: Preset, tmp: Path, env: dict[str,
 
 def run_over_dds(scenario: Scenario,
                  progress: Callable[[int, int], None] | None = None,
-                 timeout_s: float | None = None) -> ClosedLoopRun:
-    """Run ``scenario`` over DDS; the telemetry of the recording, t = 0 sample first."""
+                 timeout_s: float | None = None,
+                 record_path: Path | None = None) -> ClosedLoopRun:
+    """Run ``scenario`` over DDS; the telemetry of the recording, t = 0 sample first.
+    sim_node records to ``record_path`` (a file that must not exist yet; the caller keeps
+    it), else to a temporary directory removed when the run is read."""
     scenario.check_supported()
     if scenario.overrides:
         raise DrillSimError("over DDS, a scenario's 'overrides' do not reach sim_node: put "
@@ -180,7 +183,8 @@ def run_over_dds(scenario: Scenario,
     timeout_s = timeout_s or 120.0 + periods / 50.0
     env = ros_environment()
     with tempfile.TemporaryDirectory(prefix="drill_closed_loop_") as tmp:
-        run = _run_processes(scenario, preset, Path(tmp), env, timeout_s)
+        run = _run_processes(scenario, preset, Path(tmp), env, timeout_s,
+                             record_path or Path(tmp) / "run.mcap")
     if run.interrupted:
         return run
     if progress is not None:
