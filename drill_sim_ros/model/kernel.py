@@ -92,7 +92,8 @@ P_PICKUP = 23       # distributed: the hook's pick-up speed off bottom (L* per t
 P_CLEARANCE = 24    # distributed: the bit's clearance above the rock it picks up to (L*)
 P_TAG_SPEED = 25    # distributed: the hook's lowering speed cap, L* per t* (inf until a tag)
 P_SUBSTEPS = 26     # distributed: steps of the bit law and the drive per wave-guide step
-N_PARAMS = 27
+P_TD_TORQUE_RATE = 27  # motor torque rate limit, scaled rate_SI t* / C (inf: none)
+N_PARAMS = 28
 OFF_BOTTOM_LIFTED = 3.0
 
 # ---- surface targets (float64) ----------------------------------------------------------
@@ -182,7 +183,8 @@ radian, the hook's WOB loop gains, its pick-up speed (0 on bottom), the clearanc
 up to, its lowering speed's cap (the tag speed; inf until a tag) and the steps per step of
 the wave guide (:func:`_held_means`)."""
 Drive = namedtuple("Drive", (
-    "mode", "omega", "torque", "omega_rate", "inertia", "kp", "ki", "max_torque", "lag_alpha"))
+    "mode", "omega", "torque", "omega_rate", "inertia", "kp", "ki", "max_torque", "lag_alpha",
+    "max_torque_rate"))
 Drive.__doc__ = """A run's top-drive parameters and commands (top_drive.drive_step)."""
 Response = namedtuple("Response", (
     "cursor", "doc", "t_top", "f_top", "v_new", "omega_new", "u_new", "phi_new", "w_f", "wob",
@@ -407,7 +409,7 @@ def _drive(x: Loop, drive: Drive, dt: float, last_motor: float, t_top: float) ->
     return DriveStep(*drive_step(drive.mode, x.omega_s, x.omega_ref, x.integral, last_motor,
                                  t_top, drive.omega, drive.torque, drive.omega_rate,
                                  drive.inertia, drive.kp, drive.ki, drive.max_torque,
-                                 drive.lag_alpha, dt))
+                                 drive.lag_alpha, drive.max_torque_rate, dt))
 
 
 @njit(cache=True, inline="always")
@@ -474,7 +476,7 @@ def _drive_params(prm: np.ndarray, tgt: np.ndarray) -> Drive:
     """The drive's parameters and commands for a run, read once (top_drive.drive_step)."""
     return Drive(int(prm[P_TD_MODE]), tgt[I_OMEGA_S], tgt[I_MOTOR_TORQUE], prm[P_OMEGA_RATE],
                  prm[P_TD_INERTIA], prm[P_TD_KP], prm[P_TD_KI], prm[P_TD_MAX_TORQUE],
-                 prm[P_TD_LAG_ALPHA])
+                 prm[P_TD_LAG_ALPHA], prm[P_TD_TORQUE_RATE])
 
 
 @njit(cache=True, inline="always")

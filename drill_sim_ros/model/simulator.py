@@ -169,14 +169,15 @@ class Simulator:
         self._prm[k.P_SUBSTEPS] = s.substeps
 
     def _fill_drive(self, drive: td.TopDrive) -> None:
-        """The drive's inertia ratio, gains, torque limit and lag into the parameters (its
-        mode: the callers)."""
+        """The drive's inertia ratio, gains, torque limit, lag and torque rate limit into the
+        parameters (its mode: the callers)."""
         self.top_drive = drive
         self._prm[k.P_TD_INERTIA] = drive.inertia_ratio
         self._prm[k.P_TD_KP] = drive.kp
         self._prm[k.P_TD_KI] = drive.ki
         self._prm[k.P_TD_MAX_TORQUE] = drive.max_torque
         self._prm[k.P_TD_LAG_ALPHA] = drive.lag_alpha(self.config.dtau)
+        self._prm[k.P_TD_TORQUE_RATE] = drive.max_torque_rate
 
     def _wave_layout(self) -> None:
         """The delay lines of a distributed string at this step (none for the lumped one);
