@@ -88,7 +88,8 @@ def kinematic_torque(omega_s: float, omega_next: float, t_string: float, inertia
 def within_limit(torque: float, max_torque: float) -> float:
     """``torque`` within the drive's limit, ``|m| <= max_torque`` (inf: no limit): the one
     clip of the motor torque (the speed loop's output and integral, the torque mode's
-    command, the bumpless switch's held torque)."""
+    command, the motor's torque after its lag and rate limit, the bumpless switch's held
+    torque)."""
     return min(max(torque, -max_torque), max_torque)
 
 
@@ -126,11 +127,15 @@ def motor_lag(previous: float, command: float, alpha: float) -> float:
 
 @njit(cache=True, inline="always")
 def motor_response(previous: float, command: float, alpha: float, max_rate: float,
-                   dt: float) -> float:
-    """The motor torque after one step: the first-order lag toward ``command``
-    (:func:`motor_lag`), then at most ``max_rate * dt`` away from ``previous`` (the drive's
-    torque rate limit, :func:`ramp`; inf: none, the lagged torque exactly)."""
-    return ramp(previous, motor_lag(previous, command, alpha), max_rate, dt)
+                   max_torque: float, dt: float) -> float:
+    """The motor torque after one step: the first-order lag toward ``command`` (within the
+    limit already, :func:`motor_lag`), then at most ``max_rate * dt`` away from ``previous``
+    (the drive's torque rate limit, :func:`ramp`; inf: none, the lagged torque exactly),
+    within the limit: a torque that starts beyond it (at t = 0, or the limit lowered at run
+    time) is held to it at once, as a drive's current loop holds its torque limit; from
+    within the limit the lag and the ramp never leave it."""
+    return within_limit(ramp(previous, motor_lag(previous, command, alpha), max_rate, dt),
+                        max_torque)
 
 
 @njit(cache=True, inline="always")
@@ -152,7 +157,7 @@ def drive_step(mode: int, omega_s: float, omega_ref: float, integral: float, mot
         command, integral = speed_loop(omega_ref, omega_s, integral, kp, ki, max_torque, dt)
     else:
         command = within_limit(tgt_torque, max_torque)
-    motor = motor_response(motor, command, lag_alpha, max_torque_rate, dt)
+    motor = motor_response(motor, command, lag_alpha, max_torque_rate, max_torque, dt)
     return (omega_s + drive_acceleration(motor, t_string, inertia) * dt, omega_ref, integral,
             motor)
 

@@ -13,8 +13,8 @@ from drill_sim_ros.control.scenario import Scenario
 from drill_sim_ros.model.presets import load_preset, preset_from_dict, preset_path
 from drill_sim_ros.model.session import SessionConfig, SimSession
 from drill_sim_ros.model.telemetry import TELEMETRY_INDEX
-from drill_sim_ros.model.validate_input import read_preset_file
 from drill_sim_ros.model.top_drive import TopDrivePhysical, limit_of_setting, setting_of_limit
+from drill_sim_ros.model.validate_input import read_preset_file
 from drill_sim_ros.ros.parameters import (
     RUNTIME_DRIVE_PARAMETERS,
     SPEC_BY_NAME,
@@ -88,7 +88,9 @@ def test_every_drive_field_but_the_inertia_may_change_at_runtime() -> None:
 
 
 @pytest.mark.parametrize("drive", [{}, {"max_torque_nm": 8000.0}, {"motor_lag_s": 0.05},
-                                   {"max_torque_nm": 20e3, "motor_lag_s": 0.01}])
+                                   {"max_torque_nm": 20e3, "motor_lag_s": 0.01},
+                                   {"max_torque_rate_nm_s": 2e6},
+                                   {"max_torque_rate_nm_s": 0.0, "motor_lag_s": 0.0}])
 @pytest.mark.parametrize("mode", ["speed", "torque"])
 def test_the_bench_runs_the_drive_sim_node_makes_of_its_parameters(drive, mode) -> None:
     # two roads to one drive: sim_node's parameters for a scenario (over the preset's
