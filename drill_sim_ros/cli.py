@@ -20,7 +20,7 @@ import signal
 import sys
 import time
 from collections.abc import Iterator, Sequence
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, fields, replace
 from pathlib import Path
 from typing import Any, TextIO
 
@@ -34,7 +34,13 @@ from drill_sim_ros.model.errors import DrillSimError
 from drill_sim_ros.model.params import GROUPS, UNIT_SCALES, DimensionlessParams, Scales
 from drill_sim_ros.model.presets import DEFAULT_PRESET, Preset, available_presets, load_preset
 from drill_sim_ros.model.simulator import SimConfig, Simulator
-from drill_sim_ros.model.top_drive import MODES, TopDrive
+from drill_sim_ros.model.top_drive import (
+    MODES,
+    TopDrive,
+    TopDrivePhysical,
+    limit_of_setting,
+    paper_drive,
+)
 from drill_sim_ros.study import cli as study_cli
 from drill_sim_ros.study import suite_cli
 from drill_sim_ros.terminal import StatusLine
@@ -87,8 +93,9 @@ def _add_model_args(p: argparse.ArgumentParser) -> None:
     d.add_argument("--drive-inertia-ratio", type=float, help="J / I (default 14)")
     d.add_argument("--drive-kp", type=float, help="speed loop kp_SI / (C t*) (default 83)")
     d.add_argument("--drive-ki", type=float, help="speed loop ki_SI / C (default 123)")
-    d.add_argument("--drive-max-torque", type=float, help="motor torque limit / C (default: "
-                   "none)")
+    d.add_argument("--drive-max-torque-nm", type=float, help="motor torque limit, N m (in "
+                   "SI, scaled once by the preset's C; 0 or inf: none; default: the preset's, "
+                   "else none)")
     d.add_argument("--motor-torque", type=float, help="torque mode: motor torque / C "
                    "(default: the trivial torque T0, held)")
     r = p.add_argument_group("run")
@@ -163,17 +170,24 @@ def _resolve(args: argparse.Namespace) -> RunSpec:
                             "few minutes of the kernel): shorten the run or raise --dtau")
     return RunSpec(params, scales, physical, tau_end, config.dtau, average_from,
                    args.perturb_v, args.perturb_omega, args.method, config.n_nodes,
-                   _top_drive(args, preset.top_drive if preset else TopDrive()),
+                   _top_drive(args, preset.drive if preset else paper_drive(scales), scales),
                    args.motor_torque)
 
 
-def _top_drive(args: argparse.Namespace, base: TopDrive) -> TopDrive:
-    """The preset's drive with the command line's changes."""
+def _top_drive(args: argparse.Namespace, base: TopDrivePhysical, scales: Scales) -> TopDrive:
+    """The preset's drive (SI) with the command line's changes: its torque limit in N m
+    (``limit_of_setting``: 0 is none) before the one scaling, the scaled flags after it."""
+    limit_nm = args.drive_max_torque_nm
+    if limit_nm is not None:
+        if not limit_nm >= 0.0:
+            raise DrillSimError(f"--drive-max-torque-nm = {limit_nm!r} must be >= 0 N m (0 or "
+                                "inf: no limit)")
+        base = replace(base, max_torque_nm=limit_of_setting(limit_nm))
     changes = {name: value for name, value in (
         ("mode", args.top_drive), ("inertia_ratio", args.drive_inertia_ratio),
-        ("kp", args.drive_kp), ("ki", args.drive_ki), ("max_torque", args.drive_max_torque))
-        if value is not None}
-    return base.with_(**changes) if changes else base
+        ("kp", args.drive_kp), ("ki", args.drive_ki)) if value is not None}
+    drive = base.scaled(scales)
+    return drive.with_(**changes) if changes else drive
 
 
 def _tau_end(args: argparse.Namespace, scales: Scales, physical: bool) -> float:

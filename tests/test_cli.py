@@ -90,7 +90,7 @@ def test_top_drive_options_and_the_field_preset_drive() -> None:
     assert paper["top_drive"]["mode"] == "kinematic"           # the paper's presets
     result = drill_sim("run", "--params", "fig5_8a", "--tau-end", "2", "--json",
                        "--top-drive", "torque", "--drive-inertia-ratio", "3",
-                       "--motor-torque", "4", "--drive-max-torque", "10")
+                       "--motor-torque", "4", "--drive-max-torque-nm", "10")
     assert result.returncode == 0, result.stderr
     drive = json.loads(result.stdout)["top_drive"]
     assert drive == {"mode": "torque", "inertia_ratio": 3.0, "kp": drive["kp"],

@@ -43,7 +43,7 @@ from drill_sim_ros.model.measurement import SIGNALS
 from drill_sim_ros.model.presets import Preset, submerged_string_weight_n
 from drill_sim_ros.model.session import SessionConfig, SimSession
 from drill_sim_ros.model.telemetry import N_FIELDS
-from drill_sim_ros.model.top_drive import TopDrivePhysical
+from drill_sim_ros.model.top_drive import TopDrivePhysical, limit_of_setting
 
 
 def command_limits(preset: Preset, rig: RigPhysics) -> CommandLimits:
@@ -77,10 +77,15 @@ class ClosedLoopRun:
 
 def scenario_drive(scenario: Scenario, preset: Preset) -> TopDrivePhysical:
     """The drive sim_node runs for ``scenario`` (SI): the preset's, with the scenario's torque
-    limit (:meth:`Scenario.load_preset`), in its mode and with its ``drive.motor_lag_s``."""
-    lag = {"motor_lag_s": float(scenario.drive["motor_lag_s"])} \
-        if "motor_lag_s" in scenario.drive else {}
-    return replace(preset.drive, mode=scenario.mode, **lag)
+    limit (:meth:`Scenario.load_preset`), in its mode and with its ``drive.motor_lag_s`` and
+    ``drive.max_torque_rate_nm_s`` (0: none, ``limit_of_setting``, as sim_node reads it)."""
+    motor: dict[str, float] = {}
+    if "motor_lag_s" in scenario.drive:
+        motor["motor_lag_s"] = float(scenario.drive["motor_lag_s"])
+    if "max_torque_rate_nm_s" in scenario.drive:
+        motor["max_torque_rate_nm_s"] = limit_of_setting(
+            float(scenario.drive["max_torque_rate_nm_s"]))
+    return replace(preset.drive, mode=scenario.mode, **motor)
 
 
 def session_config(scenario: Scenario, preset: Preset) -> SessionConfig:
@@ -122,7 +127,8 @@ SCENARIO_DRIVE_PARAMETERS = {"accel_rpm_s": "limits.top_drive_accel_rpm_s",
                              "wob_rate_n_s": "limits.wob_rate_n_s",
                              "max_torque_nm": "top_drive.max_torque_nm",
                              "command_delay_s": "commands.delay_s",
-                             "motor_lag_s": "top_drive.motor_lag_s"}
+                             "motor_lag_s": "top_drive.motor_lag_s",
+                             "max_torque_rate_nm_s": "top_drive.max_torque_rate_nm_s"}
 
 
 def build_controller(scenario: Scenario, preset: Preset) -> IsolatedController:

@@ -28,6 +28,8 @@ does not give it)::
       command_delay_s: 0.004      # command transport delay, s, also < a period
                                   # (commands.delay_s)
       motor_lag_s: 0.05           # first-order motor torque lag, s (top_drive.motor_lag_s)
+      max_torque_rate_nm_s: 2.0e6 # motor torque rate limit, N m/s, 0: none
+                                  # (top_drive.max_torque_rate_nm_s)
     formation:                    # rock layers by depth below the start (model.formation)
       - {top_m: 0.2, intrinsic_specific_energy_pa: 460e6, mu_gamma: 0.6}
     needs: [distributed_string]   # model features the scenario needs (see MODEL_FEATURES)
@@ -64,7 +66,7 @@ SCENARIO_KEYS = ("preset", "duration_s", "control_rate_hz", "mode", "controller"
                  "enable_at_s", "schedule", "sensors", "description", "overrides", "drive",
                  "formation", "needs")
 DRIVE_KEYS = ("accel_rpm_s", "wob_rate_n_s", "max_torque_nm", "command_delay_s",
-              "motor_lag_s")
+              "motor_lag_s", "max_torque_rate_nm_s")
 # what this model core can run beyond the keys above; the lead's kernel adds the others
 MODEL_FEATURES: frozenset[str] = frozenset(
     ("formation_layers", "motor_lag", "distributed_string"))
@@ -205,8 +207,13 @@ def _check_drive(drive: Any) -> None:
         delay = key in ("command_delay_s", "motor_lag_s")
         number = not isinstance(value, bool) and isinstance(value, (int, float)) and \
             math.isfinite(value)
-        if not (number and (0.0 <= value <= 60.0 if delay else value > 0.0)):
-            allowed = "in [0, 60]" if delay else "> 0"
+        if delay:
+            ok, allowed = number and 0.0 <= value <= 60.0, "in [0, 60]"
+        elif key == "max_torque_rate_nm_s":             # 0: none, as sim_node's parameter
+            ok, allowed = number and value >= 0.0, ">= 0 (0: no limit)"
+        else:
+            ok, allowed = number and value > 0.0, "> 0"
+        if not ok:
             raise ParameterError(f"scenario: drive.{key} = {value!r} must be a number "
                                  f"{allowed}")
 

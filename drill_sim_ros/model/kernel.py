@@ -96,7 +96,8 @@ P_SUBSTEPS = 26     # distributed: steps of the bit law and the drive per wave-g
 P_BIT_LAW = 27      # the bit law: bit_rock.LAW_RGD07 | LAW_WEAKENING_FRICTION | ...
 P_BIT_LAW_A = 28    # its parameters (bit_rock.BitLaw): for the weakening laws the floor
 P_BIT_LAW_B = 29    # ratio and the e-folding speed (omega t*)
-N_PARAMS = 30
+P_TD_TORQUE_RATE = 30  # motor torque rate limit, scaled rate_SI t* / C (inf: none)
+N_PARAMS = 31
 OFF_BOTTOM_LIFTED = 3.0
 
 # ---- surface targets (float64) ----------------------------------------------------------
@@ -187,7 +188,8 @@ up to, its lowering speed's cap (the tag speed; inf until a tag), the steps per 
 the wave guide (:func:`_held_means`) and the bit law with its two parameters
 (bit_rock.sliding_torque)."""
 Drive = namedtuple("Drive", (
-    "mode", "omega", "torque", "omega_rate", "inertia", "kp", "ki", "max_torque", "lag_alpha"))
+    "mode", "omega", "torque", "omega_rate", "inertia", "kp", "ki", "max_torque", "lag_alpha",
+    "max_torque_rate"))
 Drive.__doc__ = """A run's top-drive parameters and commands (top_drive.drive_step)."""
 Response = namedtuple("Response", (
     "cursor", "doc", "t_top", "f_top", "v_new", "omega_new", "u_new", "phi_new", "w_f", "wob",
@@ -412,7 +414,7 @@ def _drive(x: Loop, drive: Drive, dt: float, last_motor: float, t_top: float) ->
     return DriveStep(*drive_step(drive.mode, x.omega_s, x.omega_ref, x.integral, last_motor,
                                  t_top, drive.omega, drive.torque, drive.omega_rate,
                                  drive.inertia, drive.kp, drive.ki, drive.max_torque,
-                                 drive.lag_alpha, dt))
+                                 drive.lag_alpha, drive.max_torque_rate, dt))
 
 
 @njit(cache=True, inline="always")
@@ -480,7 +482,7 @@ def _drive_params(prm: np.ndarray, tgt: np.ndarray) -> Drive:
     """The drive's parameters and commands for a run, read once (top_drive.drive_step)."""
     return Drive(int(prm[P_TD_MODE]), tgt[I_OMEGA_S], tgt[I_MOTOR_TORQUE], prm[P_OMEGA_RATE],
                  prm[P_TD_INERTIA], prm[P_TD_KP], prm[P_TD_KI], prm[P_TD_MAX_TORQUE],
-                 prm[P_TD_LAG_ALPHA])
+                 prm[P_TD_LAG_ALPHA], prm[P_TD_TORQUE_RATE])
 
 
 @njit(cache=True, inline="always")

@@ -176,9 +176,7 @@ def preset_from_dict(name: str, data: dict[str, Any]) -> Preset:
         params, scales = dimensionless_from_dict(data["dimensionless"]), UNIT_SCALES
     n_nodes = numerics.get("n_nodes")
     section = data.get("top_drive")
-    drive = top_drive_from_dict(section, scales, has_phys)
-    if has_phys and section is not None:
-        drive = rounded_as_before(drive, scales)
+    drive = top_drive_from_dict(section, scales, has_phys)    # SI, as the file gives it
     return Preset(name=name, description=str(data.get("description", "")).strip(),
                   params=params, scales=scales, physical=physical,
                   dtau=float(numerics.get("dtau", 1e-4)),
@@ -195,16 +193,6 @@ def _with_well(name: str, data: dict[str, Any], string: StringSpec) -> StringSpe
         raise ParameterError(f"preset '{name}': 'well' needs string.model: distributed (the "
                              "wall's friction acts along the string)")
     return replace(string, well=well_from_dict(data["well"]))
-
-
-def rounded_as_before(drive: TopDrivePhysical, scales: Scales) -> TopDrivePhysical:
-    """A physical preset's drive rounded as sim_node and the bench ran it before issue 34,
-    when the preset held it in kernel units and they read it back in SI: through
-    :meth:`TopDrivePhysical.scaled` and :meth:`TopDrive.physical` once (on the field preset
-    kp_nm_s 23200 becomes 23199.999999999996, max_torque_nm 50000.00000000001; the kernel's
-    kp moves by one ulp). It keeps their telemetry bit-identical; without it every road runs
-    the file's own values, which changes the bits of the field preset's speed-loop runs."""
-    return drive.scaled(scales).physical(scales)
 
 
 SECTION_FIELDS = {f.name: f for f in fields(Section)}

@@ -48,6 +48,7 @@ PARAMETERS: tuple[tuple[str, int, str], ...] = (
     ("td_ki", k.P_TD_KI, "top_drive.ki"),
     ("td_max_torque", k.P_TD_MAX_TORQUE, "top_drive.max_torque"),
     ("td_lag_alpha", k.P_TD_LAG_ALPHA, "top_drive_lag_alpha"),
+    ("td_torque_rate", k.P_TD_TORQUE_RATE, "top_drive.max_torque_rate"),
     ("string", k.P_STRING, "string.model"),
     ("parts_t", k.P_PARTS_T, "torsional_parts"),
     ("bit_inertia", k.P_BIT_INERTIA, "string.bit_inertia"),
@@ -190,8 +191,8 @@ class Simulator:
                 self._prm[slot] = attrgetter(source)(self)
 
     def _fill_drive(self, drive: td.TopDrive) -> None:
-        """The drive's inertia ratio, gains, torque limit and lag into the parameters (its
-        mode: the callers)."""
+        """The drive's inertia ratio, gains, torque limit, lag and torque rate limit into the
+        parameters (its mode: the callers)."""
         self.top_drive = drive
         self._fill_params("top_drive")
 

@@ -15,7 +15,16 @@ one group, the inertia ratio ``j = J / I``. Modes, one small compiled function e
   ``e = omega_ref - omega_s``, anti-windup by conditional integration, ``|m| <= max_torque``.
 * ``torque`` (2): the motor torque is commanded from outside, ``|m| <= max_torque``.
 
-Scaled gains: ``kp = kp_SI / (C t*)``, ``ki = ki_SI / C``, ``max_torque = max_SI / C``.
+In the speed and torque modes the motor torque follows its command through a first-order
+lag (the drive's torque bandwidth) and then a rate limit (the largest dm/dtau), each off
+when its setting says none.
+
+Scaled gains: ``kp = kp_SI / (C t*)``, ``ki = ki_SI / C``, ``max_torque = max_SI / C``,
+``max_torque_rate = rate_SI t* / C``.
+
+A limit's "none" is inf here; where a setting cannot hold inf (a ROS double parameter, a
+command-line number) it is written 0, and :func:`limit_of_setting` and
+:func:`setting_of_limit` are the one decoding of it.
 """
 
 from __future__ import annotations
@@ -42,6 +51,19 @@ def mode_index(mode: str) -> int:
     return MODES.index(mode)
 
 
+NO_LIMIT_SETTING = 0.0      # a limit's "none" where a setting has no inf (module doc)
+
+
+def limit_of_setting(value: float) -> float:
+    """The limit of a setting: 0 (``NO_LIMIT_SETTING``) or inf -> inf (none), else itself."""
+    return math.inf if value == NO_LIMIT_SETTING else value
+
+
+def setting_of_limit(limit: float) -> float:
+    """The setting of a limit (inverse of :func:`limit_of_setting`): inf -> 0."""
+    return NO_LIMIT_SETTING if math.isinf(limit) else limit
+
+
 # ---- the modes (compiled) -------------------------------------------------------------
 @njit(cache=True, inline="always")
 def ramp(current: float, target: float, max_rate: float, dt: float) -> float:
@@ -66,7 +88,8 @@ def kinematic_torque(omega_s: float, omega_next: float, t_string: float, inertia
 def within_limit(torque: float, max_torque: float) -> float:
     """``torque`` within the drive's limit, ``|m| <= max_torque`` (inf: no limit): the one
     clip of the motor torque (the speed loop's output and integral, the torque mode's
-    command, the bumpless switch's held torque)."""
+    command, the motor's torque after its lag and rate limit, the bumpless switch's held
+    torque)."""
     return min(max(torque, -max_torque), max_torque)
 
 
@@ -103,12 +126,28 @@ def motor_lag(previous: float, command: float, alpha: float) -> float:
 
 
 @njit(cache=True, inline="always")
+def motor_response(previous: float, command: float, alpha: float, max_rate: float,
+                   max_torque: float, dt: float) -> float:
+    """The motor torque after one step: the first-order lag toward ``command`` (within the
+    limit already, :func:`motor_lag`), then at most ``max_rate * dt`` away from ``previous``
+    (the drive's torque rate limit, :func:`ramp`; inf: none, the lagged torque exactly),
+    within the limit: a torque that starts beyond it (at t = 0, or the limit lowered at run
+    time) is held to it at once, as a drive's current loop holds its torque limit; from
+    within the limit the lag and the ramp never leave it."""
+    return within_limit(ramp(previous, motor_lag(previous, command, alpha), max_rate, dt),
+                        max_torque)
+
+
+@njit(cache=True, inline="always")
 def drive_step(mode: int, omega_s: float, omega_ref: float, integral: float, motor: float,
                t_string: float, tgt_omega: float, tgt_torque: float, omega_rate: float,
                inertia: float, kp: float, ki: float, max_torque: float, lag_alpha: float,
-               dt: float) -> tuple[float, float, float, float]:
+               max_torque_rate: float, dt: float) -> tuple[float, float, float, float]:
     """One step of the drive in its mode, against the string torque ``t_string`` at the
-    quill: ``(omega_s at the end of the step, omega_ref, integral, motor torque)``."""
+    quill: ``(omega_s at the end of the step, omega_ref, integral, motor torque)``. In the
+    speed and torque modes the motor torque follows its command through the lag and the
+    rate limit (:func:`motor_response`); the kinematic mode's torque is what the imposed
+    speed takes."""
     if mode == TD_KINEMATIC:                  # the paper's imposed speed
         omega_next = ramp(omega_s, tgt_omega, omega_rate, dt)
         return omega_next, omega_next, integral, kinematic_torque(omega_s, omega_next,
@@ -118,23 +157,24 @@ def drive_step(mode: int, omega_s: float, omega_ref: float, integral: float, mot
         command, integral = speed_loop(omega_ref, omega_s, integral, kp, ki, max_torque, dt)
     else:
         command = within_limit(tgt_torque, max_torque)
-    motor = motor_lag(motor, command, lag_alpha)
+    motor = motor_response(motor, command, lag_alpha, max_torque_rate, max_torque, dt)
     return (omega_s + drive_acceleration(motor, t_string, inertia) * dt, omega_ref, integral,
             motor)
 
 
 # ---- parameters -------------------------------------------------------------------------
-def _check_fields(drive: Any, inertia: str, gains: tuple[str, str], limit: str,
+def _check_fields(drive: Any, inertia: str, gains: tuple[str, str], limits: tuple[str, str],
                   lag: str) -> None:
     """ParameterError naming ``top_drive.<field>`` of ``drive`` unless its mode is known, its
-    ``inertia`` finite and > 0, its ``gains`` finite and >= 0, its ``limit`` > 0 (inf: no
-    limit) and its ``lag`` finite and >= 0: the one check of a drive, in either units."""
+    ``inertia`` finite and > 0, its ``gains`` finite and >= 0, its ``limits`` (the torque and
+    its rate) > 0 (inf: no limit) and its ``lag`` finite and >= 0: the one check of a drive,
+    in either units."""
     mode_index(drive.mode)
     value = getattr(drive, lag)
     if not (math.isfinite(value) and value >= 0.0):
         raise ParameterError(f"parameter 'top_drive.{lag}' = {value!r} must be finite and "
                              ">= 0")
-    for name in (inertia, limit):
+    for name in (inertia, *limits):
         value = getattr(drive, name)
         if math.isnan(value) or value <= 0.0:
             raise ParameterError(f"parameter 'top_drive.{name}' = {value!r} must be > 0")
@@ -154,7 +194,8 @@ class TopDrive:
 
     mode: 'kinematic' | 'speed' | 'torque'; inertia_ratio: J / I; kp: kp_SI / (C t*);
     ki: ki_SI / C; max_torque: max_SI / C (inf: no limit); motor_lag: time constant of the
-    first-order motor torque lag (the drive's torque bandwidth), in t* (0: none).
+    first-order motor torque lag (the drive's torque bandwidth), in t* (0: none);
+    max_torque_rate: the largest rate of the motor torque, rate_SI t* / C (inf: no limit).
     The defaults are the field preset's drive (J = 2900 kg m^2 on I = 207 kg m^2).
     """
 
@@ -164,9 +205,11 @@ class TopDrive:
     ki: float = 123.0
     max_torque: float = math.inf
     motor_lag: float = 0.0
+    max_torque_rate: float = math.inf
 
     def __post_init__(self) -> None:
-        _check_fields(self, "inertia_ratio", ("kp", "ki"), "max_torque", "motor_lag")
+        _check_fields(self, "inertia_ratio", ("kp", "ki"), ("max_torque", "max_torque_rate"),
+                      "motor_lag")
 
     def with_(self, **changes: Any) -> TopDrive:
         """A copy with ``changes`` applied (validated)."""
@@ -179,7 +222,8 @@ class TopDrive:
         return TopDrivePhysical(mode=self.mode, inertia_kg_m2=self.inertia_ratio * c * t_star**2,
                                 kp_nm_s=self.kp * c * t_star, ki_nm=self.ki * c,
                                 max_torque_nm=self.max_torque * c,
-                                motor_lag_s=self.motor_lag * t_star)
+                                motor_lag_s=self.motor_lag * t_star,
+                                max_torque_rate_nm_s=self.max_torque_rate * c / t_star)
 
     def lag_alpha(self, dtau: float) -> float:
         """The lag's share per step, 1 - exp(-dtau / lag) (1: no lag)."""
@@ -197,7 +241,8 @@ class TopDrivePhysical:
     mode; inertia_kg_m2: J; kp_nm_s: proportional gain, N m per rad/s; ki_nm: integral gain,
     N m per rad; max_torque_nm: motor torque limit, N m (inf: no limit); motor_lag_s: time
     constant of the first-order lag of the motor torque behind its command (VFD torque
-    bandwidth), s.
+    bandwidth), s; max_torque_rate_nm_s: the largest rate of change of the motor torque
+    after the lag, N m/s (inf: no limit).
     """
 
     mode: str = "speed"
@@ -206,10 +251,11 @@ class TopDrivePhysical:
     ki_nm: float = 46_400.0
     max_torque_nm: float = 50_000.0
     motor_lag_s: float = 0.0
+    max_torque_rate_nm_s: float = math.inf
 
     def __post_init__(self) -> None:
-        _check_fields(self, "inertia_kg_m2", ("kp_nm_s", "ki_nm"), "max_torque_nm",
-                      "motor_lag_s")
+        _check_fields(self, "inertia_kg_m2", ("kp_nm_s", "ki_nm"),
+                      ("max_torque_nm", "max_torque_rate_nm_s"), "motor_lag_s")
 
     def scaled(self, scales: Scales) -> TopDrive:
         """The paper's scaling: I = C t*^2, so j = J / (C t*^2) (eqs. 19-20)."""
@@ -217,7 +263,8 @@ class TopDrivePhysical:
         return TopDrive(mode=self.mode, inertia_ratio=self.inertia_kg_m2 / (c * t_star**2),
                         kp=self.kp_nm_s / (c * t_star), ki=self.ki_nm / c,
                         max_torque=self.max_torque_nm / c,
-                        motor_lag=self.motor_lag_s / t_star)
+                        motor_lag=self.motor_lag_s / t_star,
+                        max_torque_rate=self.max_torque_rate_nm_s * t_star / c)
 
 
 def check_speed_loop(drive: TopDrive, dtau: float, scales: Scales) -> None:

@@ -29,7 +29,13 @@ from drill_sim_ros.model.errors import ParameterError
 from drill_sim_ros.model.measurement import MAX_DELAY_PERIODS, SIGNALS
 from drill_sim_ros.model.params import UNIT_SCALES
 from drill_sim_ros.model.presets import DEFAULT_PRESET, Preset, submerged_string_weight_n
-from drill_sim_ros.model.top_drive import MODES, TopDrivePhysical, paper_drive
+from drill_sim_ros.model.top_drive import (
+    MODES,
+    TopDrivePhysical,
+    limit_of_setting,
+    paper_drive,
+    setting_of_limit,
+)
 from drill_sim_ros.ros.params_file_check import check_params_content
 from drill_sim_ros.topics import NODE_NAME
 
@@ -71,20 +77,9 @@ def _max_wob_n(preset: Preset | None) -> float:
     return defaults.max_wob_n(_preset_wob_n(preset))
 
 
-# top_drive.max_torque_nm's "no limit": a ROS double parameter has a finite range, so the
-# parameter says 0 where the drive (TopDrivePhysical, the kernel) says inf. These two
-# functions are the only places that know it.
-NO_TORQUE_LIMIT_PARAMETER = 0.0
-
-
-def torque_limit_parameter(max_torque_nm: float) -> float:
-    """The ``top_drive.max_torque_nm`` value of a drive's limit (inf: none -> 0)."""
-    return NO_TORQUE_LIMIT_PARAMETER if math.isinf(max_torque_nm) else max_torque_nm
-
-
-def torque_limit_nm(parameter: float) -> float:
-    """The drive's limit of a ``top_drive.max_torque_nm`` value (0: none -> inf)."""
-    return math.inf if parameter == NO_TORQUE_LIMIT_PARAMETER else parameter
+# the top_drive.* limits whose "no limit" is 0 in a ROS double parameter (a finite range) and
+# inf in the drive: decoded by top_drive.limit_of_setting / setting_of_limit, nowhere else
+LIMIT_PARAMETERS = ("max_torque_nm", "max_torque_rate_nm_s")
 
 
 def _drive_value(name: str) -> Callable[[Preset | None], Any]:
@@ -92,15 +87,17 @@ def _drive_value(name: str) -> Callable[[Preset | None], Any]:
     def default(preset: Preset | None) -> Any:
         drive = paper_drive(UNIT_SCALES) if preset is None else preset.drive
         value = getattr(drive, name)
-        return torque_limit_parameter(value) if name == "max_torque_nm" else value
+        return setting_of_limit(value) if name in LIMIT_PARAMETERS else value
     return default
 
 
 def top_drive_of(values: dict[str, Any]) -> TopDrivePhysical:
     """The drive of the ``top_drive.<field>`` parameters in ``values``: one parameter per
-    field of :class:`TopDrivePhysical`, the torque limit through :func:`torque_limit_nm`."""
+    field of :class:`TopDrivePhysical`, in SI as given (the session scales it once), the
+    limits' 0 = none through :func:`~drill_sim_ros.model.top_drive.limit_of_setting`."""
     drive = {f.name: values[f"top_drive.{f.name}"] for f in fields(TopDrivePhysical)}
-    drive["max_torque_nm"] = torque_limit_nm(drive["max_torque_nm"])
+    for name in LIMIT_PARAMETERS:
+        drive[name] = limit_of_setting(drive[name])
     return TopDrivePhysical(**drive)
 
 
@@ -215,6 +212,9 @@ SPECS: tuple[ParamSpec, ...] = (
               "Time constant of the first-order lag of the motor torque behind its command "
               "(the drive's torque bandwidth) [s] (speed and torque modes); 0 = none.",
               0.0, 60.0),
+    ParamSpec("top_drive.max_torque_rate_nm_s", DOUBLE, _drive_value("max_torque_rate_nm_s"),
+              "Largest rate of change of the motor torque, after the lag [N m/s] (speed and "
+              "torque modes); 0 = none.", 0.0, 1e12, unit="N m/s"),
     ParamSpec("formation.layers", STRING, "",
               "Rock layers by depth below the start, as a JSON list of {top_m, "
               "intrinsic_specific_energy_pa, mu_gamma, contact_stress_times_wearflat_n_per_m} "

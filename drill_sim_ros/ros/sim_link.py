@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import concurrent.futures
 import contextlib
-import sys
 import time
 from collections.abc import Callable
 from typing import Any
@@ -28,6 +27,7 @@ from drill_sim_ros.control.command import Command
 from drill_sim_ros.hil.address_space import SAMPLE_VARIABLES
 from drill_sim_ros.hil.rig_server import RigSettings
 from drill_sim_ros.model.params import RPM_PER_RAD_S
+from drill_sim_ros.model.top_drive import limit_of_setting
 from drill_sim_ros.ros.lockstep_driver import LOCKSTEP_QOS, top_drive_command
 from drill_sim_ros.ros.messages import LATEST_SAMPLE_QOS, stamp_ns
 
@@ -55,7 +55,7 @@ def sample_values(msg: JointState) -> tuple[dict[str, float], int]:
 def rig_settings(sim: dict[str, Any]) -> RigSettings:
     """The rig object's settings from sim_node's parameters (``SIM_PARAMETERS``); its
     kinematic mode, which takes speed setpoints too, shows as ``speed``."""
-    torque_nm = sim["top_drive.max_torque_nm"] or sys.float_info.max     # 0: no limit
+    torque_nm = limit_of_setting(sim["top_drive.max_torque_nm"])        # 0: no limit (inf)
     return RigSettings(
         max_speed_rad_s=sim["limits.max_surface_rpm"] / RPM_PER_RAD_S, max_torque_nm=torque_nm,
         max_wob_n=sim["limits.max_wob_n"], speed_rad_s=sim["model.surface_rpm"] / RPM_PER_RAD_S,

@@ -121,7 +121,8 @@ def drive_speed(delay_s: float, at_s: float = 1.0, torque_nm: float = 20e3) -> n
         mode="torque",
         duration_s=1.5,
         enable_at_s=0.0,
-        drive={"command_delay_s": delay_s},
+        # no motor (no lag, no rate limit): the step acts at once, the delay alone moves it
+        drive={"command_delay_s": delay_s, "motor_lag_s": 0.0, "max_torque_rate_nm_s": 0.0},
     )
     bench = Bench(scenario)
     controller = TorqueStep(at_s, torque_nm)

@@ -43,7 +43,7 @@ def test_a_run_away_state_ends_as_a_fault() -> None:
 ])
 def test_the_stiff_drive_of_the_issue_is_one_line(preset: tuple[str, ...]) -> None:
     result = drill_sim("run", "--params", *preset, "--t-end", "1", "--drive-kp", "1e6",
-                       "--drive-max-torque", "inf", timeout=120)
+                       "--drive-max-torque-nm", "inf", timeout=120)
     assert result.returncode == 2, result.stderr
     lines = result.stderr.strip().splitlines()
     assert len(lines) == 1 and "kp dt / J" in lines[0] and "Traceback" not in result.stderr

@@ -181,8 +181,8 @@ def test_switching_modes_mid_run_leaves_no_jump(sequence: tuple[str, ...]) -> No
 def test_si_commands_and_readings_use_the_scales_of_the_field_preset() -> None:
     preset = load_preset("field_8p5in_shale_lumped")
     sc = preset.scales
-    sim = Simulator(preset.params, SimConfig(dtau=preset.dtau), top_drive=preset.top_drive,
-                    scales=sc)
+    motorless = preset.top_drive.with_(motor_lag=0.0, max_torque_rate=math.inf)  # m = command
+    sim = Simulator(preset.params, SimConfig(dtau=preset.dtau), top_drive=motorless, scales=sc)
     assert sim.top_drive_mode == "speed"
     rpm60 = 2.0 * math.pi
     assert sim.drive_speed_rad_s == pytest.approx(rpm60)            # 60 rpm at the start
@@ -259,11 +259,13 @@ DRILLING_NM = 20_000.0                        # the string's torque once it turn
 
 def _speed_loop_step(omega_s: float, integral: float, t_string: float,
                      max_torque_nm: float) -> tuple[float, float]:
-    """One step of the drive's own speed loop (SI, no lag, no ramp): (omega_s, integral)."""
+    """One step of the drive's own speed loop (SI, no lag, no rate limit, no ramp):
+    (omega_s, integral)."""
     d = WINDUP_DRIVE
     omega_next, _, integral, _ = td.drive_step(
         td.TD_SPEED, omega_s, WINDUP_REF_RAD_S, integral, 0.0, t_string, WINDUP_REF_RAD_S,
-        0.0, math.inf, d.inertia_kg_m2, d.kp_nm_s, d.ki_nm, max_torque_nm, 1.0, WINDUP_DT_S)
+        0.0, math.inf, d.inertia_kg_m2, d.kp_nm_s, d.ki_nm, max_torque_nm, 1.0, math.inf,
+        WINDUP_DT_S)
     return omega_next, integral
 
 

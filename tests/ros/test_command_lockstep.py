@@ -100,8 +100,10 @@ def test_one_period_of_latency_and_identical_bytes_run_after_run(tmp_path):
 
 def test_torque_mode_applies_the_commanded_motor_torque_within_the_limit(tmp_path):
     periods = 100
+    # no motor (no lag, no rate limit): each sample shows its period's torque as commanded
     driver = run_sim(tmp_path, "torque", periods, 60.0, "top_drive.mode:=torque",
-                     f"top_drive.max_torque_nm:={MAX_TORQUE_NM}", policy=torque_schedule)
+                     f"top_drive.max_torque_nm:={MAX_TORQUE_NM}", "top_drive.motor_lag_s:=0.0",
+                     "top_drive.max_torque_rate_nm_s:=0.0", policy=torque_schedule)
     rows = np.array(driver.rows)
     commanded = np.array([torque_schedule(driver.first_sample).motor_torque_nm]
                          + [torque_schedule(r).motor_torque_nm for r in rows[:-1]])

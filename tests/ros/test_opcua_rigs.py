@@ -183,7 +183,7 @@ async def switch_modes(url: str, sim: SimParameters) -> None:
                         CommandCounter=ua.Variant(1, UINT32))
         await wait_sample(rig, 1)
         assert await asyncio.to_thread(sim.get, "top_drive.mode") == "torque"
-        assert await rig.value("MotorTorque") == 12345.0     # the drive's lag is 0
+        assert await rig.value("MotorTorque") == 12345.0     # no lag, no rate limit
         await check_wrong_modes(rig)
         assert await asyncio.to_thread(sim.get, "top_drive.mode") == "torque"
         await rig.write(DriveMode=ua.Variant("speed", STRING),
@@ -210,7 +210,9 @@ async def check_wrong_modes(rig: Rig) -> None:
 
 
 def test_drive_mode_switches_sim_nodes_drive(tmp_path: Path) -> None:
-    with sims_and_gateway(tmp_path, ("/",)) as (sims, gateway, url), ros_context() as ros:
+    motorless = ("-p", "top_drive.motor_lag_s:=0.0", "-p", "top_drive.max_torque_rate_nm_s:=0.0")
+    with sims_and_gateway(tmp_path, ("/",), sim_options=motorless) as (sims, gateway, url), \
+            ros_context() as ros:
         run(switch_modes(url, SimParameters(ros)))
         assert stop(gateway, signal.SIGINT) == 0, (tmp_path / "gateway.log").read_text()
         assert stop(sims["/"], signal.SIGINT) == 0

@@ -5,12 +5,16 @@ from __future__ import annotations
 import dataclasses
 import math
 
+import numpy as np
 import pytest
 
 from drill_sim_ros.control.bench import session_config, sim_node_parameters
 from drill_sim_ros.control.scenario import Scenario
-from drill_sim_ros.model.presets import load_preset
-from drill_sim_ros.model.top_drive import TopDrivePhysical
+from drill_sim_ros.model.presets import load_preset, preset_from_dict, preset_path
+from drill_sim_ros.model.session import SessionConfig, SimSession
+from drill_sim_ros.model.telemetry import TELEMETRY_INDEX
+from drill_sim_ros.model.top_drive import TopDrivePhysical, limit_of_setting, setting_of_limit
+from drill_sim_ros.model.validate_input import read_preset_file
 from drill_sim_ros.ros.parameters import (
     RUNTIME_DRIVE_PARAMETERS,
     SPEC_BY_NAME,
@@ -18,8 +22,6 @@ from drill_sim_ros.ros.parameters import (
     descriptor,
     submerged_string_weight_n,
     top_drive_of,
-    torque_limit_nm,
-    torque_limit_parameter,
     validate,
     yaml_defaults,
 )
@@ -74,8 +76,9 @@ def test_the_drive_parameters_give_the_presets_drive_back() -> None:
     unlimited = load_preset("fig5_8a")             # the paper's drive: no torque limit
     assert math.isinf(unlimited.drive.max_torque_nm)
     assert yaml_defaults(unlimited)["top_drive.max_torque_nm"] == 0.0
-    assert torque_limit_nm(0.0) == math.inf and torque_limit_parameter(math.inf) == 0.0
-    assert torque_limit_nm(torque_limit_parameter(8000.0)) == 8000.0
+    assert yaml_defaults(unlimited)["top_drive.max_torque_rate_nm_s"] == 0.0
+    assert limit_of_setting(0.0) == math.inf and setting_of_limit(math.inf) == 0.0
+    assert limit_of_setting(setting_of_limit(8000.0)) == 8000.0
 
 
 def test_every_drive_field_but_the_inertia_may_change_at_runtime() -> None:
@@ -85,7 +88,9 @@ def test_every_drive_field_but_the_inertia_may_change_at_runtime() -> None:
 
 
 @pytest.mark.parametrize("drive", [{}, {"max_torque_nm": 8000.0}, {"motor_lag_s": 0.05},
-                                   {"max_torque_nm": 20e3, "motor_lag_s": 0.01}])
+                                   {"max_torque_nm": 20e3, "motor_lag_s": 0.01},
+                                   {"max_torque_rate_nm_s": 2e6},
+                                   {"max_torque_rate_nm_s": 0.0, "motor_lag_s": 0.0}])
 @pytest.mark.parametrize("mode", ["speed", "torque"])
 def test_the_bench_runs_the_drive_sim_node_makes_of_its_parameters(drive, mode) -> None:
     # two roads to one drive: sim_node's parameters for a scenario (over the preset's
@@ -95,3 +100,32 @@ def test_the_bench_runs_the_drive_sim_node_makes_of_its_parameters(drive, mode) 
     values = {**yaml_defaults(load_preset(scenario.preset)),
               **sim_node_parameters(scenario, preset)}
     assert session_config(scenario, preset).top_drive == top_drive_of(values)
+
+
+def limit_off_the_round_trip(torque_unit_nm: float) -> float:
+    """A torque limit (N m) that SI -> scaled -> SI does not give back bit for bit."""
+    return next(x for x in (50_000.0 + 0.1 * i for i in range(1, 1000))
+                if (x / torque_unit_nm) * torque_unit_nm != x)
+
+
+def test_the_torque_limit_is_converted_once_and_clipped_once_on_either_road() -> None:
+    # issue 48: a preset's max_torque_nm and sim_node's top_drive.max_torque_nm reach the
+    # kernel through the one division by C, and the drive's step is the one clip
+    name = "field_8p5in_shale_lumped"
+    data = read_preset_file(preset_path(name))
+    limit_nm = limit_off_the_round_trip(load_preset(name).scales.torque_nm)
+    data["top_drive"]["max_torque_nm"] = limit_nm
+    preset = preset_from_dict(name, data)
+    assert preset.drive.max_torque_nm == limit_nm            # as the file gives it
+    scaled = limit_nm / preset.scales.torque_nm
+    values = {**yaml_defaults(preset), "top_drive.mode": "torque",
+              "top_drive.motor_lag_s": 0.0, "top_drive.max_torque_rate_nm_s": 0.0}
+    assert values["top_drive.max_torque_nm"] == limit_nm
+    roads = {"preset": SimSession(SessionConfig(preset=preset)),
+             "parameter": SimSession(SessionConfig(preset=preset, top_drive=top_drive_of(values)))}
+    for road, session in roads.items():
+        assert session.sim.top_drive.max_torque == scaled, road
+    session = roads["parameter"]                 # no lag, no rate limit: the clip alone
+    session.set_motor_torque_nm(3.0 * limit_nm)
+    motor_nm = session.run(2).rows[1:, TELEMETRY_INDEX["motor_torque_nm"]]
+    assert np.all(motor_nm == scaled * preset.scales.torque_nm)    # the limit, once clipped
