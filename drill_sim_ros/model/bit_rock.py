@@ -259,23 +259,29 @@ def sector(n_blades: float) -> float:
 APPLIES_TO = ("friction", "bit")       # friction_weakening.applies_to -> LAW_WEAKENING_*
 WEAKENING = "physical.friction_weakening"
 WEAKENING_RANGES = {"floor_ratio": (0.0, 1.0),      # (0, 1]; 1: RGD07's torque
-                    "speed_rad_s": (0.0, 1.0e4)}    # (0, 1e4] rad/s
+                    "speed_rad_s": (0.0, 1.0e4),    # (0, 1e4] rad/s
+                    "response_s": (0.0, 100.0)}     # [0, 100] s; 0: the bit's own speed
 
 
 def _weakening_number(key: str, value: object) -> float:
     """``physical.friction_weakening.<key>`` as a float in its range (open below), or one
     ParameterError line naming it and the range."""
-    return number_in(f"'{WEAKENING}.{key}'", value, *WEAKENING_RANGES[key], low_open=True)
+    return number_in(f"'{WEAKENING}.{key}'", value, *WEAKENING_RANGES[key],
+                     low_open=key != "response_s")
+
 
 @dataclass(frozen=True)
 class BitLaw:
     """The bit law in kernel units, what the simulator takes: ``law`` (``LAW_*``) and its
     parameters ``a``, ``b`` (module doc: for the weakening laws the floor ratio and the
-    e-folding speed, scaled omega t*). The default is RGD07's law."""
+    e-folding speed, scaled omega t*), and ``response``, the time constant (scaled, tau)
+    with which the speed the law reads follows the bit's (0: the bit's speed itself). The
+    default is RGD07's law."""
 
     law: int = LAW_RGD07
     a: float = 1.0
     b: float = 1.0
+    response: float = 0.0
 
     def __post_init__(self) -> None:
         if self.law not in range(len(LAWS)):
@@ -284,6 +290,15 @@ class BitLaw:
         if not (math.isfinite(self.a) and math.isfinite(self.b) and self.b > 0.0):
             raise ParameterError(f"bit law parameters a = {self.a!r}, b = {self.b!r} must "
                                  "be finite, b > 0")
+        if not (math.isfinite(self.response) and self.response >= 0.0):
+            raise ParameterError(f"bit law response = {self.response!r} must be finite, "
+                                 ">= 0")
+
+    def alpha(self, dtau: float) -> float:
+        """The share by which the speed the law reads follows the bit's over a step
+        ``dtau``: the exact step of a first-order lag of time constant ``response`` for a
+        speed held over the step, 1 - exp(-dtau / response); 1 without a lag."""
+        return 1.0 if self.response == 0.0 else -math.expm1(-dtau / self.response)
 
     def torque(self, doc: float, w_f: float, beta: float, omega: float) -> float:
         """The law's sliding torque (:func:`sliding_torque`), kernel units."""
@@ -300,11 +315,16 @@ class FrictionWeakening:
     docs/model.md#the-bit-law-one-seam-and-a-bit-friction-that-falls-with-speed):
     f(omega) = floor_ratio + (1 - floor_ratio) exp(-omega / speed_rad_s) times the wearflat
     friction (``applies_to: friction``, NORCE Simulator4nDOF's form) or the whole bit torque
-    (``bit``, the COPPE/UFRJ form). floor_ratio = 1 is RGD07's law."""
+    (``bit``, the COPPE/UFRJ form). floor_ratio = 1 is RGD07's law. ``response_s``: the
+    law reads the bit's speed through a first-order lag of this time constant (0: the bit's
+    speed itself). The published laws are steady-state curves, torque against a held
+    rotary speed; a lag keeps them out of the band above it, where the bit meets RGD07's
+    rate-independent law (docs/model.md)."""
 
     floor_ratio: float = 1.0
     speed_rad_s: float = 7.0
     applies_to: str = "friction"
+    response_s: float = 0.0
 
     def __post_init__(self) -> None:
         for key in WEAKENING_RANGES:
@@ -314,9 +334,11 @@ class FrictionWeakening:
                                  f"one of {', '.join(APPLIES_TO)}")
 
     def scaled(self, time_s: float) -> BitLaw:
-        """The law in kernel units: the e-folding speed times t* (eqs. 19-20)."""
+        """The law in kernel units: the e-folding speed times t*, the response over t*
+        (eqs. 19-20)."""
         law = LAW_WEAKENING_FRICTION if self.applies_to == "friction" else LAW_WEAKENING_BIT
-        return BitLaw(law, self.floor_ratio, self.speed_rad_s * time_s)
+        return BitLaw(law, self.floor_ratio, self.speed_rad_s * time_s,
+                      self.response_s / time_s)
 
 
 def friction_weakening_from_dict(values: object) -> FrictionWeakening | None:

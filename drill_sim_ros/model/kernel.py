@@ -97,7 +97,9 @@ P_BIT_LAW = 27      # the bit law: bit_rock.LAW_RGD07 | LAW_WEAKENING_FRICTION |
 P_BIT_LAW_A = 28    # its parameters (bit_rock.BitLaw): for the weakening laws the floor
 P_BIT_LAW_B = 29    # ratio and the e-folding speed (omega t*)
 P_TD_TORQUE_RATE = 30  # motor torque rate limit, scaled rate_SI t* / C (inf: none)
-N_PARAMS = 31
+P_BIT_LAW_ALPHA = 31  # the speed the bit law reads follows the bit's per step by this share,
+                      # 1 - exp(-dtau / response) (1: the bit's speed itself; BitLaw.response)
+N_PARAMS = 32
 OFF_BOTTOM_LIFTED = 3.0
 
 # ---- surface targets (float64) ----------------------------------------------------------
@@ -130,7 +132,8 @@ S_SUB_OMEGA_TOP = 19  # and the sums of the end speeds over them: the drive's,
 S_SUB_V_TOP = 20    # the hook's,
 S_SUB_OMEGA_BIT = 21  # the bit's angular
 S_SUB_V_BIT = 22    # and axial
-N_STATE = 23
+S_LAW_OMEGA = 23    # the bit speed the bit law reads (P_BIT_LAW_ALPHA: lagged, or the bit's)
+N_STATE = 24
 
 # ---- sample columns ---------------------------------------------------------------------
 C_TAU = 0
@@ -172,21 +175,21 @@ N_ACC = 13
 # ---- what a step carries (named tuples: compiled as plain locals) ----------------------
 Loop = namedtuple("Loop", (
     "u", "v", "phi", "omega", "phi_s", "omega_s", "w_app", "stuck", "node", "frac", "h_old",
-    "step", "omega_ref", "integral", "motor", "v_hook", "hook_int", "head", "count",
-    "cursor"))
+    "step", "omega_ref", "integral", "motor", "v_hook", "hook_int", "law_omega", "head",
+    "count", "cursor"))
 Loop.__doc__ = """The loop-carried state of a run (the ``S_*`` slots and the history's bookkeeping
 ``meta``: head, count, cursor)."""
 Law = namedtuple("Law", (
     "dt", "tau_avg", "beta", "lam", "n_blades", "psi", "off_bottom", "layer_u", "cut_factor",
     "sector", "tgt_w", "w_rate", "inv_spacing", "hook_kp", "hook_ki", "pickup", "clearance",
-    "tag_speed", "substeps", "bit_law", "law_a", "law_b"))
+    "tag_speed", "substeps", "bit_law", "law_a", "law_b", "law_alpha"))
 Law.__doc__ = """A run's constants of the bit law, the rock and the hook: dtau, the statistics
 window start, beta, lambda, n, psi, off bottom, the next layer's top, the cutting factor, the
 blade sector 2 pi / n, the applied weight's target and ramp rate, the profile's nodes per
 radian, the hook's WOB loop gains, its pick-up speed (0 on bottom), the clearance it picks
 up to, its lowering speed's cap (the tag speed; inf until a tag), the steps per step of
 the wave guide (:func:`_held_means`) and the bit law with its two parameters
-(bit_rock.sliding_torque)."""
+(bit_rock.sliding_torque) and the share by which the speed it reads follows the bit's."""
 Drive = namedtuple("Drive", (
     "mode", "omega", "torque", "omega_rate", "inertia", "kp", "ki", "max_torque", "lag_alpha",
     "max_torque_rate"))
@@ -377,7 +380,7 @@ def _respond(x: Loop, law: Law, surface: float, cursor: int, ends: tuple,
     v0, kick_v, f_ext, omega0, kick_w, t_ext, t_top, f_top = ends
     v_new, omega_new, w_f, wob, tob, mode, stuck = br.bit_response(
         v0, kick_v, f_ext, omega0, kick_w, t_ext, _cutting(law.cut_factor, law.off_bottom, doc),
-        x.stuck, law.beta, law.lam, law.bit_law, x.omega, law.law_a, law.law_b)
+        x.stuck, law.beta, law.lam, law.bit_law, x.law_omega, law.law_a, law.law_b)
     v_hook, hook_int = x.v_hook, x.hook_int
     if not lumped:                # the hook's WOB loop
         v_hook, hook_int = _hook(law, x.w_app, f_top, hook_int,
@@ -424,10 +427,12 @@ def _moved(x: Loop, r: Response, d: DriveStep, law: Law, lumped_kinematic: bool,
     (eq. C.1), the drive's angle on (RGD07's kinematic drive on the lumped string turns at
     the old speed), the applied weight ramped."""
     phi_s = x.phi_s + (x.omega_s if lumped_kinematic else d.omega_s_next) * law.dt
+    law_omega = r.omega_new if law.law_alpha == 1.0 else \
+        x.law_omega + law.law_alpha * (r.omega_new - x.law_omega)
     return Loop(r.u_new, r.v_new, r.phi_new, r.omega_new, phi_s, d.omega_s_next,
                 ramp(x.w_app, law.tgt_w, law.w_rate, law.dt), r.stuck, node, frac, h_old,
-                x.step + 1, d.omega_ref, d.integral, d.motor, r.v_hook, r.hook_int, head,
-                count, cursor)
+                x.step + 1, d.omega_ref, d.integral, d.motor, r.v_hook, r.hook_int,
+                law_omega, head, count, cursor)
 
 
 @njit(cache=True, inline="always")
@@ -464,7 +469,7 @@ def _law_params(prm: np.ndarray, tgt: np.ndarray, profile: np.ndarray) -> Law:
                tgt[I_W_APP], prm[P_W_RATE], profile.shape[0] / sector, prm[P_HOOK_KP],
                prm[P_HOOK_KI], prm[P_PICKUP] if lifted else 0.0, prm[P_CLEARANCE],
                prm[P_TAG_SPEED], max(1, int(prm[P_SUBSTEPS])), int(prm[P_BIT_LAW]),
-               prm[P_BIT_LAW_A], prm[P_BIT_LAW_B])
+               prm[P_BIT_LAW_A], prm[P_BIT_LAW_B], prm[P_BIT_LAW_ALPHA])
 
 
 @njit(cache=True, inline="always")
@@ -491,7 +496,7 @@ def _unpack(st: np.ndarray, meta: np.ndarray) -> Loop:
     return Loop(st[S_U], st[S_V], st[S_PHI], st[S_OMEGA], st[S_PHI_S], st[S_OMEGA_S],
                 st[S_W_APP], st[S_STUCK] != 0.0, int(st[S_NODE]), st[S_FRAC], st[S_H_OLD],
                 int(st[S_STEP]), st[S_OMEGA_REF], st[S_TD_INTEGRAL], st[S_MOTOR_TORQUE],
-                st[S_V_HOOK], st[S_HOOK_INTEGRAL], meta[0], meta[1], meta[2])
+                st[S_V_HOOK], st[S_HOOK_INTEGRAL], st[S_LAW_OMEGA], meta[0], meta[1], meta[2])
 
 
 @njit(cache=True, inline="always")
@@ -504,7 +509,7 @@ def _pack(st: np.ndarray, meta: np.ndarray, x: Loop, dt: float) -> None:
     st[S_NODE], st[S_FRAC], st[S_H_OLD] = x.node, x.frac, x.h_old
     st[S_STEP], st[S_TAU] = x.step, x.step * dt
     st[S_OMEGA_REF], st[S_TD_INTEGRAL], st[S_MOTOR_TORQUE] = x.omega_ref, x.integral, x.motor
-    st[S_V_HOOK], st[S_HOOK_INTEGRAL] = x.v_hook, x.hook_int
+    st[S_V_HOOK], st[S_HOOK_INTEGRAL], st[S_LAW_OMEGA] = x.v_hook, x.hook_int, x.law_omega
 
 
 @njit(cache=True)

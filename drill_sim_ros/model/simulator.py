@@ -61,6 +61,7 @@ PARAMETERS: tuple[tuple[str, int, str], ...] = (
     ("bit_law", k.P_BIT_LAW, "bit_law.law"),
     ("bit_law_a", k.P_BIT_LAW_A, "bit_law.a"),
     ("bit_law_b", k.P_BIT_LAW_B, "bit_law.b"),
+    ("bit_law_alpha", k.P_BIT_LAW_ALPHA, "bit_law_alpha"),
 )
 
 
@@ -197,6 +198,12 @@ class Simulator:
         self._fill_params("top_drive")
 
     @property
+    def bit_law_alpha(self) -> float:
+        """The share by which the speed the bit law reads follows the bit's per step
+        (BitLaw.alpha)."""
+        return self.bit_law.alpha(self.config.dtau)
+
+    @property
     def top_drive_lag_alpha(self) -> float:
         """The drive's motor lag per step (TopDrive.lag_alpha)."""
         return self.top_drive.lag_alpha(self.config.dtau)
@@ -276,7 +283,7 @@ class Simulator:
         p = self.params
         st = np.zeros(k.N_STATE)
         st[k.S_V] = triv.v + self._perturb[0]
-        st[k.S_OMEGA] = p.omega0 + self._perturb[1]
+        st[k.S_OMEGA] = st[k.S_LAW_OMEGA] = p.omega0 + self._perturb[1]
         st[k.S_PHI_S] = triv.torque           # pipe twist carries the trivial torque
         st[k.S_OMEGA_S] = p.omega0
         st[k.S_W_APP] = p.w0
@@ -647,7 +654,7 @@ class Simulator:
         self._prm[k.P_OFF_BOTTOM] = 2.0 if anechoic else 1.0
         st = self._state
         st[k.S_PHI_S] = st[k.S_PHI]
-        st[k.S_OMEGA] = st[k.S_OMEGA_S]
+        st[k.S_OMEGA] = st[k.S_LAW_OMEGA] = st[k.S_OMEGA_S]
         st[k.S_TD_INTEGRAL] = st[k.S_MOTOR_TORQUE] = 0.0
         st[k.S_V] = st[k.S_V_HOOK] = st[k.S_HOOK_INTEGRAL] = 0.0
         self._targets[k.I_MOTOR_TORQUE] = 0.0

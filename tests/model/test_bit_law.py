@@ -117,6 +117,32 @@ def test_the_kernel_applies_the_law_at_the_bits_speed(applies_to: str) -> None:
     assert tob[sliding] == pytest.approx(expected[sliding], rel=1e-12)
 
 
+def test_a_lagged_law_reads_the_bits_speed_through_a_first_order_lag() -> None:
+    """With ``response_s``, the speed the law reads follows the bit's sampled speed as the
+    exact step of a first-order lag, w_k+1 = w_k + (1 - exp(-dt / response)) (omega_k+1 -
+    w_k) from w_0 = omega_0, written here in plain Python; every sliding step's torque is
+    eq. (30) times the factor at that speed."""
+    response_s = 0.05
+    preset = field(floor_ratio=0.4, speed_rad_s=2.0, applies_to="bit", response_s=response_s)
+    sc, p = preset.scales, preset.params
+    sim = Simulator(p, SimConfig(dtau=preset.dtau, n_nodes=256), perturb_omega=-0.6 * p.omega0,
+                    top_drive=preset.top_drive, scales=sc, string=preset.kernel_string,
+                    bit_law=preset.bit_law)
+    data = sim.advance(sim.steps_for(4.0 / sc.time_s), every=1).data
+    omega = data[:, k.C_OMEGA]
+    alpha = -math.expm1(-preset.dtau * sc.time_s / response_s)
+    read = np.empty_like(omega)
+    read[0] = omega[0]
+    for i in range(1, omega.size):
+        read[i] = read[i - 1] + alpha * (omega[i] - read[i - 1])
+    f = np.array([factor(w / sc.time_s, 0.4, 2.0) for w in read])
+    doc, w_f, tob, mode = data[:, k.C_DOC], data[:, k.C_WF], data[:, k.C_TOB], data[:, k.C_MODE]
+    sliding = (mode == k.MODE_CUTTING) | (mode == k.MODE_LOST_CONTACT)
+    lagless = np.array([factor(w / sc.time_s, 0.4, 2.0) for w in omega])
+    assert sliding.sum() > 1000 and np.max(np.abs(f - lagless)[sliding]) > 0.01
+    assert tob[sliding] == pytest.approx(((doc + p.beta * w_f) * f)[sliding], rel=1e-9)
+
+
 def test_the_stuck_bit_holds_rgd07s_static_torque() -> None:
     """Stuck, the bit holds a string torque just below delta + beta lambda whatever the law;
     just above it slips, and the torque it then meets is that static level (f(0) = 1): the
@@ -142,6 +168,7 @@ def test_the_option_is_checked_one_line() -> None:
              ({"speed_rad_s": -1.0}, r"speed_rad_s' = -1\.0 must be a number in \(0, 10000\]"),
              ({"speed_rad_s": "fast"}, "speed_rad_s"),
              ({"applies_to": "rock"}, "applies_to' = 'rock' must be one of friction, bit"),
+             ({"response_s": -0.1}, r"response_s' = -0\.1 must be a number in \[0, 100\]"),
              ({"floor": 0.5}, "unknown key")]
     for values, message in cases:
         with pytest.raises(ParameterError, match=message) as info:
