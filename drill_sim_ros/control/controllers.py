@@ -53,6 +53,8 @@ from drill_sim_ros.model.top_drive import speed_loop
 
 CONTROL_MODES = ("speed", "torque")
 MAX_PARAMETER = 1e9     # every parameter is a positive number at most this (SI)
+HOLD_PHASE_RAD = math.pi / 3    # the series damper's phase at a sixth of the control rate
+MAX_HOLD_PHASE_RAD = 1.2        # ... beyond which a motor's lag leaves no band to keep
 
 
 class LowPass:
@@ -229,12 +231,15 @@ class SoftDrive(TopDriveController):
               "tuned_rad_s": "where the emulated drive's reactance vanishes, rad/s (default "
                              "omega_1)",
               "hold_margin": "the series damper's admittance over the hold's deficit "
-                             "(P / 2)(1 / J_v - 1 / J) (default 2: passive up to a sixth of "
-                             "the control rate, past the collars' ring)"}
+                             "(P / 2 + motor lag)(1 / J_v - 1 / J) (default "
+                             "1 / cos(pi / 3 (1 + lag / P)), 2 without a motor lag: passive "
+                             "up to a sixth of the control rate, past the collars' ring)"}
 
     def defaults(self) -> dict[str, float]:
         return {**super().defaults(), "inertia_fraction": 1.0,
-                "tuned_rad_s": self.rig.first_mode_rad_s, "hold_margin": 2.0}
+                "tuned_rad_s": self.rig.first_mode_rad_s,
+                "hold_margin": 1.0 / math.cos(min(HOLD_PHASE_RAD * (
+                    1.0 + self.rig.motor_lag_s / self.period_s), MAX_HOLD_PHASE_RAD))}
 
     def reset(self) -> None:
         super().reset()
@@ -256,15 +261,20 @@ class SoftDrive(TopDriveController):
         hold and the period's speed ramp, a delay P: cos(wP) / b. With 1 / b = m times that
         deficit (m = hold_margin) the drive is passive while m cos(wP) > 1, up to
         arccos(1 / m) / (2 pi P): 16.7 Hz for m = 2 at 100 Hz, past the collars' ring
-        (c / L = 15.9 Hz on the field string). Above that no sampled correction helps:
+        (c / L = 15.9 Hz on the field string). A motor that follows its command with a lag
+        tau adds tau to both delays: the deficit grows to (P / 2 + tau)(...) and the
+        damper acts as cos(w (P + tau)), so the default margin
+        1 / cos(pi / 3 (1 + tau / P)) keeps the band to a sixth of the control rate (2.35
+        for the field drive's 0.8 ms at 100 Hz; the phase is capped at 1.2 rad, where a
+        lag near half a period leaves no band to keep). Above that no sampled correction helps:
         anything computed from the samples lags by more than 90 degrees near the Nyquist
         rate, and the drive's own instant damper kp adds only kp / (w J)^2 there
         (docs/closed-loop.md). It is high-passed well below the first mode (corner
         omega_1 / 10), so it yields to a torque change but not to the mean torque: no
         steady speed droop."""
         j_v, _, _ = self.virtual_gains()
-        deficit = 0.5 * self.period_s * max(1.0 / j_v - 1.0 / self.rig.drive_inertia_kg_m2,
-                                            0.0)
+        deficit = (0.5 * self.period_s + self.rig.motor_lag_s) \
+            * max(1.0 / j_v - 1.0 / self.rig.drive_inertia_kg_m2, 0.0)
         corner = 0.1 * self.params["tuned_rad_s"]
         return self.params["hold_margin"] * deficit, 1.0 / (1.0 + corner * self.period_s)
 

@@ -62,6 +62,9 @@ class RigPhysics:
     max_surface_rpm: float = quantity(
         "rev/min", "the speed setpoint's limit (sim_node's limits.max_surface_rpm)",
         MAX_SURFACE_RPM)
+    motor_lag_s: float = quantity(
+        "s", "the time constant with which the drive's motor torque follows its command "
+        "(0: at once)", 0.0)
 
     @property
     def first_mode_rad_s(self) -> float:
@@ -89,7 +92,8 @@ def rig_physics(preset: Preset) -> RigPhysics:
         stiffness_nm_rad=s.stiffness_nm_per_rad, bit_inertia_kg_m2=s.inertia_kg_m2,
         drive_inertia_kg_m2=drive.inertia_kg_m2, impedance_nm_s=impedance,
         max_torque_nm=drive.max_torque_nm, drive_kp_nm_s=drive.kp_nm_s,
-        drive_ki_nm=drive.ki_nm, bit_area_m2=math.pi * phys.bit_radius_m**2,
+        drive_ki_nm=drive.ki_nm, motor_lag_s=drive.motor_lag_s,
+        bit_area_m2=math.pi * phys.bit_radius_m**2,
         torsional_modes_hz=modes_hz, cutoff_hz=cutoff_of(modes_hz))
 
 

@@ -24,12 +24,16 @@ from drill_sim_ros.model.validate_input import read_preset_file
 FIG8A = DimensionlessParams(n=6, psi=50.0, beta=0.3, lam=5.0, w0=7.0, omega0=5.0)
 
 
-def field(preset: str = "field_8p5in_shale", **weakening: object) -> Preset:
-    """The field preset with ``physical.friction_weakening`` = ``weakening`` (none: as
-    the file is)."""
+def field(preset: str = "field_8p5in_shale", sigma_l: float | None = None,
+          **weakening: object) -> Preset:
+    """The field preset with ``physical.friction_weakening`` = ``weakening`` (none: RGD07's
+    law, the option removed) and, if given, the bit's sigma l (N/m)."""
     data = read_preset_file(preset_path(preset))
+    data["physical"].pop("friction_weakening", None)
     if weakening:
         data["physical"]["friction_weakening"] = dict(weakening)
+    if sigma_l is not None:
+        data["physical"]["contact_stress_times_wearflat_n_per_m"] = sigma_l
     return preset_from_dict(preset, data)
 
 
@@ -66,10 +70,11 @@ def test_steady_torque_is_the_papers_times_the_factor(applies_to: str) -> None:
 
 
 def test_the_slope_at_rest_is_the_friction_torque_over_the_speed() -> None:
-    """-dT/domega at omega = 0 of the wearflat weakening on the default sharp bit: T_f (1 -
-    floor) / speed, about 20 N m s (issue 49's estimate), from the compiled law by a
-    central difference in kernel units, converted to N m s."""
-    preset = field(floor_ratio=0.5, speed_rad_s=7.0)
+    """-dT/domega at omega = 0 of the wearflat weakening on the sharp bit (sigma l = 1e5
+    N/m, the default until 2026-12-06): T_f (1 - floor) / speed, about 20 N m s (issue
+    49's estimate), from the compiled law by a central difference in kernel units,
+    converted to N m s."""
+    preset = field(sigma_l=1.0e5, floor_ratio=0.5, speed_rad_s=7.0)
     law, p, sc = preset.bit_law, preset.params, preset.scales
     doc = max(p.w0 - p.lam, 0.0)
     _, t_f = si_torques(preset)
