@@ -56,7 +56,9 @@ LABELS = {"ssi_before_mean": "SSI before switch-on (mean)", "ssi_mean": "SSI aft
           "saturation_count": "saturated samples",
           "saturation_fraction": "at the torque limit", "period_s": "stick-slip period [s]",
           "ring_rms_rpm": "collar ring RMS [rpm]", "ring_hz": "collar ring freq. [Hz]",
-          "cutoff_hz": "cut-off [Hz]", "status": "status", "stall_time_s": "stalled at [s]"}
+          "cutoff_hz": "cut-off [Hz]", "off_bottom_fraction": "bit off the rock",
+          "wob_rms_n": "WOB at the bit, RMS about mean [N]", "status": "status",
+          "stall_time_s": "stalled at [s]"}
 
 
 def add_parser(sub: Any) -> None:

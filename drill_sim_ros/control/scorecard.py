@@ -26,6 +26,8 @@ ROS-free; from telemetry rows (``TELEMETRY_FIELDS``, SI) of a run, after the swi
   ``PERIOD_MIN_HZ``; None when it is flat: no spectral line of ``MIN_OSCILLATION_RMS_RPM``);
 * ring: the RMS of the bit speed above the cut-off (raw minus low-passed), its dominant
   frequency (None below ``MIN_OSCILLATION_RMS_RPM``), and the cut-off used;
+* the bit's axial state: the share of samples with the bit above the rock (bounce) and the
+  WOB at the bit's RMS about its mean (N);
 * mean ROP (m/h); mechanical specific energy at the bit (Teale 1965: <WOB>/A +
   <TOB omega_bit>/(A <ROP>), MPa);
 * peak and RMS string torque at the quill (N m);
@@ -64,9 +66,10 @@ from drill_sim_ros.control.schedule import Schedule
 from drill_sim_ros.model import analysis, defaults
 from drill_sim_ros.model.errors import ParameterError
 from drill_sim_ros.model.params import RPM_PER_RAD_S
-from drill_sim_ros.model.telemetry import TELEMETRY_INDEX
+from drill_sim_ros.model.telemetry import MODE_NAMES, TELEMETRY_INDEX
 
 F = TELEMETRY_INDEX
+OFF_BOTTOM_MODE = MODE_NAMES.index("off_bottom")   # the telemetry's mode of a bit above rock
 STUCK_RPM = 1.0           # low-passed bit speed below this: stuck (on the lumped twin the
                           # raw stuck share 0.208 reads 0.211 by this rule)
 MIN_OSCILLATION_RMS_RPM = 0.1   # below this RMS a component has no frequency (flat)
@@ -92,7 +95,8 @@ SCORE_FIELDS = ("ssi_before_mean", "ssi_mean", "ssi_max", "ssi_last", "stick_fra
                 "mse_mpa", "quill_torque_peak_nm", "quill_torque_rms_nm",
                 "motor_torque_std_nm", "motor_torque_rate_mean_knm_s", "motor_energy_mj",
                 "motor_energy_in_mj", "saturation_count", "saturation_fraction", "period_s",
-                "ring_rms_rpm", "ring_hz", "cutoff_hz", "status", "stall_time_s")
+                "ring_rms_rpm", "ring_hz", "cutoff_hz", "off_bottom_fraction", "wob_rms_n",
+                "status", "stall_time_s")
 STATUSES = ("ok", "stick-slip", "stalled", "fault")
 
 
@@ -151,6 +155,7 @@ def score(rows: np.ndarray, enable_at_s: float, schedule: Schedule, rig: RigPhys
         **_costs(after, rig, period_s),
         "period_s": _period_s(slow, sample_period_s(rows)),
         **_ring(bit - slow, sample_period_s(rows), rig.cutoff_hz),
+        **axial_state(after),
     }
     stall_s = stall_time_s(t, slow_all < STUCK_RPM, enable_at_s)
     return {**card, "status": status_of(card, stall_s), "stall_time_s": stall_s}
@@ -184,6 +189,15 @@ def _costs(after: np.ndarray, rig: RigPhysics, period_s: float) -> dict[str, Any
         "saturation_count": int(saturated(after, rig).sum()),
         "saturation_fraction": float(at_torque_limit(after, rig).mean()),
     }
+
+
+def axial_state(rows: np.ndarray) -> dict[str, float]:
+    """The bit's axial state over ``rows``: the share of samples with the bit above the rock
+    (mode ``off_bottom``: bit bounce, or the bit picked up) and the RMS of the WOB at the
+    bit about its mean (N)."""
+    wob = rows[:, F["wob_n"]]
+    return {"off_bottom_fraction": float(np.mean(rows[:, F["mode"]] == OFF_BOTTOM_MODE)),
+            "wob_rms_n": float(np.std(wob))}
 
 
 def motor_effort(rows: np.ndarray, period_s: float) -> dict[str, float]:

@@ -23,6 +23,7 @@ from drill_sim_ros.study.suite import Entry, EntryResult
 # (card key, column head, format) of the table
 COLUMNS = (("ssi_mean", "SSI after", ".3f"), ("stick_fraction", "stick frac", ".3f"),
            ("period_s", "period s", ".2f"), ("ring_rms_rpm", "ring rpm", ".1f"),
+           ("off_bottom_fraction", "off rock", ".1%"),
            ("rop_m_h", "ROP m/h", ".2f"), ("mse_mpa", "MSE MPa", ".0f"),
            ("time_to_suppress_s", "suppress s", ".1f"),
            ("saturation_fraction", "at limit", ".1%"),
@@ -34,13 +35,14 @@ NUMERIC = ("ssi_before_mean", "ssi_mean", "ssi_max", "ssi_last", "stick_fraction
            "quill_torque_peak_nm", "quill_torque_rms_nm", "motor_torque_std_nm",
            "motor_torque_rate_mean_knm_s", "motor_energy_mj", "motor_energy_in_mj",
            "saturation_count", "saturation_fraction", "period_s", "ring_rms_rpm", "ring_hz",
-           "cutoff_hz", "stall_time_s", "wall_s")
+           "cutoff_hz", "off_bottom_fraction", "wob_rms_n", "stall_time_s", "wall_s")
 UNITS = {"rop_m_h": "m/h", "mse_mpa": "MPa", "time_to_suppress_s": "s", "stall_time_s": "s",
          "stick_longest_s": "s", "bit_rpm_max": "rev/min",
          "quill_torque_peak_nm": "N m", "quill_torque_rms_nm": "N m",
          "motor_torque_std_nm": "N m", "motor_torque_rate_mean_knm_s": "kN m/s",
          "motor_energy_mj": "MJ", "motor_energy_in_mj": "MJ",
          "period_s": "s", "ring_rms_rpm": "rev/min", "ring_hz": "Hz", "cutoff_hz": "Hz",
+         "wob_rms_n": "N",
          "wall_s": "s"}
 
 

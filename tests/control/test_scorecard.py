@@ -356,3 +356,19 @@ def test_the_rule_at_its_edges() -> None:
     assert status_of({**settled, "ssi_last": SSI_OK}, None) == "stick-slip"
     assert status_of({**settled, "time_to_suppress_s": None}, None) == "stick-slip"
     assert status_of(settled, 150.0) == "stalled"
+
+
+def test_the_axial_state_by_its_definitions() -> None:
+    """A bit above the rock (mode off_bottom, WOB 0) for 2 s in every 10 s after the
+    switch-on at 20 s, else 60 kN: off the rock 0.2 of the time; the WOB's RMS about its
+    mean 60 kN sqrt(0.2 x 0.8) (a two-level signal)."""
+    rows = synthetic(100.0)
+    t = rows[:, F["sim_time_s"]]
+    bounce = (t % 10.0) >= 8.0
+    rows[bounce, F["mode"]] = 3
+    rows[bounce, F["wob_n"]] = 0.0
+    card = score(rows, 20.0, SCHEDULE, RIG, PERIOD_S)
+    share = float(np.mean(bounce[t > 20.0]))
+    assert share == pytest.approx(0.2, abs=1e-3)
+    assert card["off_bottom_fraction"] == pytest.approx(share, rel=1e-12)
+    assert card["wob_rms_n"] == pytest.approx(60e3 * math.sqrt(share * (1 - share)), rel=1e-9)
