@@ -67,7 +67,6 @@ from drill_sim_ros.control.bench import Bench
 from drill_sim_ros.control.command import Command
 from drill_sim_ros.control.scenario import Scenario, load_scenario, scenario_path
 from drill_sim_ros.control.scorecard import score
-from drill_sim_ros.model import analysis
 from drill_sim_ros.model.errors import NumericalFault, ParameterError
 from drill_sim_ros.model.params import RPM_PER_RAD_S
 from drill_sim_ros.model.telemetry import TELEMETRY_INDEX as F
@@ -103,7 +102,7 @@ def scales_of(bench: Bench) -> Scales:
     rig, preset, schedule = bench.rig, bench.preset, bench.schedule
     top_rad_s = rig.max_surface_rpm / RPM_PER_RAD_S
     speed = schedule.rpm_at(0.0) / RPM_PER_RAD_S
-    steady_nm = preset.scales.tob_nm(analysis.trivial_solution(preset.params).torque)
+    steady_nm = preset.scales.tob_nm(bench.session.sim.trivial.torque)   # the bit law's
     torque_ref = rig.max_torque_nm if math.isfinite(rig.max_torque_nm) else 10.0 * steady_nm
     weight_n, wob_n = bench.session.submerged_weight_n, schedule.wob_at(0.0)
     wob_scale = wob_n if wob_n > 0 else weight_n
