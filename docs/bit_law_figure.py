@@ -1,10 +1,11 @@
 """The bit torque against the bit's speed at the field point (docs/model.md): draws the PNG.
 
-The default field preset's bit (8.5 in, sigma l = 1e5 N/m, 60 kN applied, steady drilling:
+The default field preset's bit (8.5 in, its sigma l, 60 kN applied, steady drilling:
 W_f = lambda, the depth of cut of eq. 34) through the model's own law
 (``Preset.bit_law``, ``bit_rock.BitLaw.torque``), in SI: RGD07's flat line, and
 ``physical.friction_weakening`` with floor 0.5 and 7 rad/s on the wearflat friction only and
-on the whole bit torque; beside them the COPPE/UFRJ field fit (Castello & Ritto, arXiv
+on the whole bit torque (the preset's own law, drawn at a held speed: its lag does not
+show); beside them the COPPE/UFRJ field fit (Castello & Ritto, arXiv
 2206.14609) T = WOB x 0.0239 m x [tanh(1.91 w) + 8.5 w / (1 + 5.47 w^2)], w in rad/s.
 
 Usage: .venv/bin/python docs/bit_law_figure.py [--out docs/img/bit_law_field.png]
@@ -27,9 +28,10 @@ WEAKENING = {"floor_ratio": 0.5, "speed_rad_s": 7.0}
 
 
 def preset_with(applies_to: str | None) -> Preset:
-    """The default field preset, with ``friction_weakening`` on ``applies_to`` (None: as
-    the file is, RGD07's law)."""
+    """The default field preset, with ``friction_weakening`` on ``applies_to`` (None:
+    RGD07's law, the option removed)."""
     data = read_preset_file(preset_path(PRESET))
+    data["physical"].pop("friction_weakening", None)
     if applies_to is not None:
         data["physical"]["friction_weakening"] = {**WEAKENING, "applies_to": applies_to}
     return preset_from_dict(PRESET, data)
@@ -63,7 +65,7 @@ def draw(path: Path) -> None:
     ax.plot(omega, law_torque_nm(preset_with("friction"), omega) / 1e3, "C0-", lw=2,
             label="weakening on the wearflat friction (floor 0.5, 7 rad/s)")
     ax.plot(omega, law_torque_nm(preset_with("bit"), omega) / 1e3, "C3-", lw=2,
-            label="weakening on the whole bit torque (floor 0.5, 7 rad/s)")
+            label="weakening on the whole bit torque (floor 0.5, 7 rad/s): the default")
     ax.plot(omega, coppe_torque_nm(wob_n, omega) / 1e3, "C2--", lw=1.8,
             label="COPPE/UFRJ field fit, Castello & Ritto (2022)")
     for rpm in (35.0, 60.0):
@@ -72,12 +74,13 @@ def draw(path: Path) -> None:
                 fontsize=8)
     ax.set_xlabel("bit speed ω (rad/s)")
     ax.set_ylabel("torque on bit (kN m)")
+    sigma_l = base.physical.contact_stress_times_wearflat_n_per_m
     ax.set_title(f"Bit torque at the field point: 8.5-in bit, {wob_n / 1e3:.0f} kN, "
-                 "σℓ = 1e5 N/m", fontsize=10)
+                 f"σℓ = {sigma_l:.0e} N/m", fontsize=10)
     ax.set_xlim(0.0, 20.0)
     ax.set_ylim(0.0, 4.5)
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=8, loc="lower right")
+    ax.legend(fontsize=8, loc="upper right")
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
