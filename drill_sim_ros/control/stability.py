@@ -1,0 +1,143 @@
+"""Predict whether the first torsional mode grows, per controller (``drill_sim stability``).
+
+ROS-free. The loop of the pipe's first mode (docs/string.md, "Predicting the first mode's
+growth"): a torque wave goes down the pipe, the BHA and bit reflect it with r_bit, it comes
+back up, the top reflects it with r_top. It grows when the loop gain
+
+    G = |r_bit(f1)| |r_top(f1)| |exp(-2 gamma L_pipe)|
+
+exceeds 1 at the first mode's frequency f1, where the loop's phase is a whole turn.
+
+* r_bit: ANALYTIC, not measured (:mod:`drill_sim_ros.model.bit_reflection`): the collars as
+  lossy lines ending in the bit's inertia and the bit law's small-signal slope
+  b = -dT/dw at the operating point with the law's lag, b / (1 + s tau). The slope is a
+  central difference of the law's own torque at the steady drilling state
+  (:func:`analysis.trivial_solution` at the point's rpm and WOB).
+* r_top: MEASURED in the time domain with the controller in the loop
+  (:func:`reflection.measure_reflection_with`), once per controller on a band about the
+  string's first mode, interpolated at f1.
+* f1: the phase condition with a clamped top (r_top = +1) and the bit law's termination
+  (:func:`bit_reflection.first_mode_hz`). The phase of r_top is not measured: a soft top
+  shifts the mode, and the loop gain there is read at the clamped-top mode.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from drill_sim_ros.control.reflection import measure_reflection_with
+from drill_sim_ros.model import analysis
+from drill_sim_ros.model import bit_reflection as br
+from drill_sim_ros.model import string as sg
+from drill_sim_ros.model import string_instruments as si
+from drill_sim_ros.model.errors import ParameterError
+from drill_sim_ros.model.presets import Preset, load_preset
+
+CONTROLLERS = ("stiff", "soft_torque", "z_torque")
+RPM_RANGE = (1.0, 400.0)          # surface rpm a prediction accepts
+WOB_RANGE_N = (1.0e3, 1.0e6)      # applied WOB, N
+BAND = (0.5, 2.0)                 # r_top is measured over this band x the first mode
+BAND_POINTS = 61
+MODE_SEARCH = 3.0                 # f1 is searched below this x the clamped-top first mode
+
+
+@dataclass(frozen=True)
+class Prediction:
+    """The first mode's loop at one operating point under one controller."""
+
+    controller: str
+    rpm: float
+    wob_n: float
+    slope_nm_s: float          # b = -dT/dw of the bit law at the point
+    mode_hz: float             # f1 with a clamped top and the bit's termination
+    r_bit: float               # |r_bit(f1)|
+    r_top: float               # |r_top(f1)|, measured with the controller
+    pipe: float                # |exp(-2 gamma L_pipe)| at f1: the pipe's round trip
+    loop_gain: float
+
+    @property
+    def grows(self) -> bool:
+        return self.loop_gain > 1.0
+
+    def as_dict(self) -> dict[str, object]:
+        return {"controller": self.controller, "rpm": self.rpm, "wob_n": self.wob_n,
+                "slope_nm_s": round(self.slope_nm_s, 3), "mode_hz": round(self.mode_hz, 5),
+                "r_bit": round(self.r_bit, 4), "r_top": round(self.r_top, 4),
+                "pipe_round_trip": round(self.pipe, 4),
+                "loop_gain": round(self.loop_gain, 4), "grows": self.grows}
+
+
+def check_point(rpm: float, wob_n: float) -> None:
+    """One-line errors for an operating point out of range."""
+    if not (math.isfinite(rpm) and RPM_RANGE[0] <= rpm <= RPM_RANGE[1]):
+        raise ParameterError(f"--rpm = {rpm!r} must be in [{RPM_RANGE[0]:g}, "
+                             f"{RPM_RANGE[1]:g}]")
+    if not (math.isfinite(wob_n) and WOB_RANGE_N[0] <= wob_n <= WOB_RANGE_N[1]):
+        raise ParameterError(f"--wob-n = {wob_n!r} must be in [{WOB_RANGE_N[0]:g}, "
+                             f"{WOB_RANGE_N[1]:g}] N")
+
+
+def checked_preset(name: str) -> Preset:
+    preset = load_preset(name)
+    if not preset.is_physical:
+        raise ParameterError(f"preset '{preset.name}' is dimensionless; stability needs a "
+                             "physical preset with a distributed string")
+    si.require_distributed(preset)
+    return preset
+
+
+def operating_point(preset: Preset) -> tuple[float, float]:
+    """The preset's own (surface rpm, applied WOB N)."""
+    p, sc = preset.params, preset.scales
+    return sc.rpm(p.omega0), sc.wob_n(p.w0)
+
+
+def bit_slope_nm_s(preset: Preset, rpm: float, wob_n: float) -> float:
+    """b = -dT/dw of the preset's bit law in steady drilling at ``rpm`` and ``wob_n``."""
+    sc = preset.scales
+    p = preset.params.with_(omega0=sc.omega_from_rpm(rpm), w0=sc.w_from_newton(wob_n))
+    steady = analysis.trivial_solution(p)
+    return br.law_slope_nm_s(preset.bit_law, steady.depth_of_cut, min(p.w0, p.lam), p.beta,
+                             p.omega0, sc.torque_nm, sc.time_s)
+
+
+def response_s(preset: Preset) -> float:
+    return preset.bit_law.response * preset.scales.time_s
+
+
+def top_band_hz(preset: Preset) -> np.ndarray:
+    f1 = sg.analytic_modes_hz(preset.string, 1)[0]
+    return np.linspace(BAND[0] * f1, BAND[1] * f1, BAND_POINTS)
+
+
+def measure_tops(preset_name: str, controllers: list[str]) -> dict[str, np.ndarray]:
+    """|r_top| over :func:`top_band_hz` for each controller, measured in the time domain."""
+    f_hz = top_band_hz(load_preset(preset_name))
+    return {c: np.array(measure_reflection_with(preset_name, c, f_hz=f_hz).r_measured)
+            for c in controllers}
+
+
+def predict(preset: Preset, tops: dict[str, np.ndarray], rpm: float,
+            wob_n: float) -> list[Prediction]:
+    """The first mode's loop gain at ``rpm`` and ``wob_n`` for each controller of ``tops``
+    (|r_top| on :func:`top_band_hz`)."""
+    check_point(rpm, wob_n)
+    slope, lag = bit_slope_nm_s(preset, rpm, wob_n), response_s(preset)
+    f_max = MODE_SEARCH * sg.analytic_modes_hz(preset.string, 1)[0]
+    mode = br.first_mode_hz(preset.string, slope, lag, f_max)
+    if mode is None:
+        raise ParameterError(f"no first mode below {f_max:.3g} Hz at {rpm:g} rpm and "
+                             f"{wob_n:g} N (bit slope {slope:.4g} N m s)")
+    f = np.array([mode])
+    r_bit = float(abs(br.bit_reflection(preset.string, slope, lag, f))[0])
+    pipe = float(abs(br.pipe_round_trip(preset.string, f))[0])
+    band = top_band_hz(preset)
+    out = []
+    for name, r_top in tops.items():
+        top = float(np.interp(mode, band, r_top))
+        out.append(Prediction(name, rpm, wob_n, slope, mode, r_bit, top, pipe,
+                              r_bit * top * pipe))
+    return out

@@ -1,0 +1,119 @@
+"""The bit and BHA as a termination of the drill pipe, small-signal, in the frequency domain.
+
+ROS-free, numpy only. Used by ``drill_sim stability`` (control/stability.py) to predict
+whether the first torsional mode grows about a steady drilling state (docs/string.md,
+"Predicting the first mode's growth").
+
+About a steady sliding state at the bit speed w0 the bit law's torque changes by
+dT = -b dw_bar, with b = -dT/dw the law's slope at w0 (:func:`law_slope_nm_s`, by a
+central difference of the law's own torque function) and w_bar the speed the law reads, the
+bit's speed through a first-order lag of time constant tau (the law's ``response``). The
+bit end then needs the torque
+
+    Z_end(s) w = (I_b s - b / (1 + s tau)) w
+
+from the string (I_b the bit's inertia beyond the collars): a negative damper, a source of
+wave energy where b > 0. RGD07's own law adds nothing here: at a held WOB its steady torque
+does not depend on the speed (b = 0); its axial-torsional coupling through the depth of cut
+is not part of this termination.
+
+Each section is a lossy transmission line. With the string's loss form (a viscous force per
+unit length ``rate x inertia per metre x speed``, so d w/dt = -rate w for a rigid piece) a
+section of inertia per metre m, stiffness S = G J and rate g has, in Laplace variable s,
+
+    gamma(s) = sqrt(s (s + g)) / c,    Z(s) = Z0 sqrt((s + g) / s)
+
+(c = sqrt(G / rho), Z0 = J sqrt(G rho)). A load Z_L seen through a section of length L is
+Z_in = Z (Z_L + Z tanh(gamma L)) / (Z + Z_L tanh(gamma L)). For g << w a travelling wave
+keeps |exp(-gamma x)| = exp(-g x / 2c) = exp(-g t / 2): over the pipe's round trip
+(t = 2 L / c) it keeps exp(-g L / c).
+
+Reflections are of torque waves, looking out of the pipe: r = (Z_L - Z) / (Z_L + Z), +1 at a
+clamped end, -1 at a free one, |r| > 1 where the load's real part is negative (it feeds the
+wave). The pipe's first mode then needs r_top r_bit exp(-2 gamma L_pipe) = 1.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from drill_sim_ros.model.bit_rock import BitLaw
+from drill_sim_ros.model.string import Section, StringSpec, line_properties
+
+SLOPE_STEP = 1e-4        # central difference of the law, share of the speed
+
+
+def law_slope_nm_s(law: BitLaw, doc: float, w_f: float, beta: float, omega: float,
+                   torque_nm: float, time_s: float) -> float:
+    """b = -dT/dw of ``law`` at the bit speed ``omega`` (kernel units, like ``doc`` and
+    ``w_f``) in N m s: a central difference of the law's torque, in kernel units times
+    C t* (T = C T_k, w = w_k / t*)."""
+    h = SLOPE_STEP * max(abs(omega), 1e-3)
+    rise = law.torque(doc, w_f, beta, omega + h) - law.torque(doc, w_f, beta, omega - h)
+    return -rise / (2.0 * h) * torque_nm * time_s
+
+
+def _s(f_hz: np.ndarray) -> np.ndarray:
+    return 2j * np.pi * np.asarray(f_hz, dtype=float)
+
+
+def line_of(section: Section, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(gamma L, Z(s)) of ``section``'s torsional line at Laplace values ``s``."""
+    line = line_properties(section, False)
+    root = np.sqrt((s + line.damping_per_s) / s)
+    return s * root * section.length_m / line.speed_m_s, line.impedance * root
+
+
+def through(section: Section, load: np.ndarray, s: np.ndarray) -> np.ndarray:
+    """The impedance ``load`` at the bottom of ``section`` as seen at its top."""
+    gl, z = line_of(section, s)
+    t = np.tanh(gl)
+    return z * (load + z * t) / (z + load * t)
+
+
+def end_impedance(bit_inertia_kg_m2: float, slope_nm_s: float, response_s: float,
+                  f_hz: np.ndarray) -> np.ndarray:
+    """Z_end = I_b s - b / (1 + s tau), N m s (module doc)."""
+    s = _s(f_hz)
+    return bit_inertia_kg_m2 * s - slope_nm_s / (1.0 + s * response_s)
+
+
+def bha_impedance(spec: StringSpec, slope_nm_s: float, response_s: float,
+                  f_hz: np.ndarray) -> np.ndarray:
+    """What the pipe (the top section) sees below it: the bit end through every lower
+    section, bottom up."""
+    s = _s(f_hz)
+    z = end_impedance(spec.bit_inertia_kg_m2, slope_nm_s, response_s, f_hz)
+    for section in reversed(spec.sections[1:]):
+        z = through(section, z, s)
+    return z
+
+
+def bit_reflection(spec: StringSpec, slope_nm_s: float, response_s: float,
+                   f_hz: np.ndarray) -> np.ndarray:
+    """r_bit(f), complex: the torque wave's reflection by the BHA and bit, in the pipe just
+    above the collars (module doc)."""
+    z_load = bha_impedance(spec, slope_nm_s, response_s, f_hz)
+    z_pipe = line_of(spec.sections[0], _s(f_hz))[1]
+    return (z_load - z_pipe) / (z_load + z_pipe)
+
+
+def pipe_round_trip(spec: StringSpec, f_hz: np.ndarray) -> np.ndarray:
+    """exp(-2 gamma L) of the pipe (the top section), complex: its round trip's phase and
+    attenuation."""
+    return np.exp(-2.0 * line_of(spec.sections[0], _s(f_hz))[0])
+
+
+def first_mode_hz(spec: StringSpec, slope_nm_s: float, response_s: float,
+                  f_max_hz: float, points: int = 4000) -> float | None:
+    """The first frequency below ``f_max_hz`` at which the loop r_top r_bit exp(-2 gamma L)
+    is real and positive with a clamped top (r_top = 1): the phase condition of the first
+    mode of a string held at the top, with the bit law's termination. Linear interpolation
+    on a fine grid; None if there is none."""
+    f = np.linspace(f_max_hz / points, f_max_hz, points)
+    loop = bit_reflection(spec, slope_nm_s, response_s, f) * pipe_round_trip(spec, f)
+    im, re = loop.imag, loop.real
+    for i in range(f.size - 1):
+        if im[i] * im[i + 1] <= 0.0 and im[i] != im[i + 1] and re[i] + re[i + 1] > 0.0:
+            return float(f[i] + (f[i + 1] - f[i]) * im[i] / (im[i] - im[i + 1]))
+    return None
