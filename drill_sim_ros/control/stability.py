@@ -16,6 +16,9 @@ exceeds 1 at the first mode's frequency f1, where the loop's phase is a whole tu
 * r_top: MEASURED in the time domain with the controller in the loop
   (:func:`reflection.measure_reflection_with`), once per controller on a band about the
   string's first mode, interpolated at f1.
+* Where the slope beats what the pipe and the collars absorb (b > about Z of the pipe),
+  the bit is unstable by itself on an endless pipe, whatever comes back from the top
+  (:func:`bit_reflection.runs_away`): then G is infinite, growth under every controller.
 * f1: the phase condition with a clamped top (r_top = +1) and the bit law's termination
   (:func:`bit_reflection.first_mode_hz`). The phase of r_top is not measured: a soft top
   shifts the mode, and the loop gain there is read at the clamped-top mode.
@@ -57,17 +60,22 @@ class Prediction:
     r_top: float               # |r_top(f1)|, measured with the controller
     pipe: float                # |exp(-2 gamma L_pipe)| at f1: the pipe's round trip
     loop_gain: float
+    runs_away: bool = False    # the bit unstable by itself (G infinite, mode undefined)
 
     @property
     def grows(self) -> bool:
         return self.loop_gain > 1.0
 
     def as_dict(self) -> dict[str, object]:
+        """JSON-ready; a figure that is not finite (a bit that runs away) is null."""
+        def num(value: float, digits: int) -> float | None:
+            return round(value, digits) if math.isfinite(value) else None
+
         return {"controller": self.controller, "rpm": self.rpm, "wob_n": self.wob_n,
-                "slope_nm_s": round(self.slope_nm_s, 3), "mode_hz": round(self.mode_hz, 5),
-                "r_bit": round(self.r_bit, 4), "r_top": round(self.r_top, 4),
-                "pipe_round_trip": round(self.pipe, 4),
-                "loop_gain": round(self.loop_gain, 4), "grows": self.grows}
+                "slope_nm_s": num(self.slope_nm_s, 3), "mode_hz": num(self.mode_hz, 5),
+                "r_bit": num(self.r_bit, 4), "r_top": num(self.r_top, 4),
+                "pipe_round_trip": num(self.pipe, 4), "loop_gain": num(self.loop_gain, 4),
+                "runs_away": self.runs_away, "grows": self.grows}
 
 
 def check_point(rpm: float, wob_n: float) -> None:
@@ -127,6 +135,9 @@ def predict(preset: Preset, tops: dict[str, np.ndarray], rpm: float,
     check_point(rpm, wob_n)
     slope, lag = bit_slope_nm_s(preset, rpm, wob_n), response_s(preset)
     f_max = MODE_SEARCH * sg.analytic_modes_hz(preset.string, 1)[0]
+    if br.runs_away(preset.string, slope, lag, f_max):
+        return [Prediction(name, rpm, wob_n, slope, math.nan, math.inf, math.nan, math.nan,
+                           math.inf, runs_away=True) for name in tops]
     mode = br.first_mode_hz(preset.string, slope, lag, f_max)
     if mode is None:
         raise ParameterError(f"no first mode below {f_max:.3g} Hz at {rpm:g} rpm and "

@@ -35,6 +35,8 @@ wave). The pipe's first mode then needs r_top r_bit exp(-2 gamma L_pipe) = 1.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from drill_sim_ros.model.bit_rock import BitLaw
@@ -72,29 +74,48 @@ def through(section: Section, load: np.ndarray, s: np.ndarray) -> np.ndarray:
 
 
 def end_impedance(bit_inertia_kg_m2: float, slope_nm_s: float, response_s: float,
-                  f_hz: np.ndarray) -> np.ndarray:
-    """Z_end = I_b s - b / (1 + s tau), N m s (module doc)."""
-    s = _s(f_hz)
+                  s: np.ndarray) -> np.ndarray:
+    """Z_end = I_b s - b / (1 + s tau), N m s (module doc), at Laplace values ``s``."""
     return bit_inertia_kg_m2 * s - slope_nm_s / (1.0 + s * response_s)
 
 
 def bha_impedance(spec: StringSpec, slope_nm_s: float, response_s: float,
-                  f_hz: np.ndarray) -> np.ndarray:
-    """What the pipe (the top section) sees below it: the bit end through every lower
-    section, bottom up."""
-    s = _s(f_hz)
-    z = end_impedance(spec.bit_inertia_kg_m2, slope_nm_s, response_s, f_hz)
+                  s: np.ndarray) -> np.ndarray:
+    """What the pipe (the top section) sees below it at Laplace values ``s``: the bit end
+    through every lower section, bottom up."""
+    z = end_impedance(spec.bit_inertia_kg_m2, slope_nm_s, response_s, s)
     for section in reversed(spec.sections[1:]):
         z = through(section, z, s)
     return z
+
+
+def runs_away(spec: StringSpec, slope_nm_s: float, response_s: float,
+              band_hz: float, points: int = 4000) -> bool:
+    """True when the bit and BHA on an endless pipe (no wave ever comes back) are unstable
+    by themselves below ``band_hz``: Z_BHA(s) + Z_pipe(s) has a zero with Re s > 0 there
+    (then r_bit has a pole in the right half plane, and no loop gain at a mode describes the
+    growth: it grows under any top). Counted by the argument principle on the rectangle
+    1e-4 <= Re s <= 20 1/s, 0 <= Im s <= 2 pi band_hz (zeros come in conjugate pairs or on
+    the real axis; the BHA's own poles, its clamped-top modes, lie above a low band)."""
+    re_lo, re_hi, im_hi = 1e-4, 20.0, 2.0 * math.pi * band_hz
+    edge = np.linspace(0.0, 1.0, points)
+    path = np.concatenate((re_lo + (re_hi - re_lo) * edge + 0j,          # bottom, real axis
+                           re_hi + 1j * im_hi * edge,                     # right
+                           re_hi - (re_hi - re_lo) * edge + 1j * im_hi,   # top
+                           re_lo + 1j * im_hi * (1.0 - edge)))            # left
+    total = bha_impedance(spec, slope_nm_s, response_s, path) + line_of(spec.sections[0],
+                                                                        path)[1]
+    turns = np.sum(np.diff(np.unwrap(np.angle(total)))) / (2.0 * math.pi)
+    return bool(round(turns) != 0)
 
 
 def bit_reflection(spec: StringSpec, slope_nm_s: float, response_s: float,
                    f_hz: np.ndarray) -> np.ndarray:
     """r_bit(f), complex: the torque wave's reflection by the BHA and bit, in the pipe just
     above the collars (module doc)."""
-    z_load = bha_impedance(spec, slope_nm_s, response_s, f_hz)
-    z_pipe = line_of(spec.sections[0], _s(f_hz))[1]
+    s = _s(f_hz)
+    z_load = bha_impedance(spec, slope_nm_s, response_s, s)
+    z_pipe = line_of(spec.sections[0], s)[1]
     return (z_load - z_pipe) / (z_load + z_pipe)
 
 
