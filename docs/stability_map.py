@@ -7,7 +7,9 @@ default, the second half of the run, 90-180 s), and on the same grid the predict
 G = |r_bit| |r_top| |exp(-2 gamma L_pipe)|, grows when G > 1). A simulated point counts as
 stick-slip by the scorecard's rule as far as the map records it: stuck 10 % of the window
 or more, or a mean SSI of 1 or more. Printed: per controller the agreement share, and the
-points that disagree with their G, stick fraction and SSI.
+points that disagree with their G, stick fraction and SSI, each run again through the
+bench for the scorecard's status (a stall, the bit held while the drive sits at its torque
+limit, is not the first mode's growth) and its shares at the torque limit and off bottom.
 
 The maps are run (by the command printed) into --maps unless their files are there already
 (a re-run resumes them).
@@ -62,18 +64,39 @@ def predicted(tops: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
     return out
 
 
+def rerun(controller: str, rpm: float, wob_n: float) -> dict[str, object]:
+    """The map's point again through the bench, scored over the map's window (90-180 s):
+    the scorecard's status (which tells a stall from stick-slip) and what the map lacks."""
+    from drill_sim_ros.control.bench import run_in_process
+    from drill_sim_ros.control.scenario import Scenario
+    scenario = Scenario(preset=PRESET, duration_s=180.0, control_rate_hz=100.0,
+                        controller=controller, enable_at_s=60.0,
+                        schedule=({"t_s": 0.0, "rpm": rpm, "wob_n": wob_n},))
+    return run_in_process(scenario).score(90.0)
+
+
 def report(controller: str, gain: np.ndarray, sim: tuple[np.ndarray, ...]) -> None:
+    """Agreement, then every disagreeing point with its re-run's status."""
     sticks, stuck, ssi = sim
     agree = (gain > 1.0) == sticks
     print(f"\n{controller}: agreement {agree.sum()} of {agree.size} "
           f"({agree.mean():.0%}); simulated stick-slip at {sticks.sum()}, "
           f"predicted growth at {(gain > 1.0).sum()}")
-    print("| rpm | WOB kN | G | predicted | stuck | SSI | simulated |")
-    print("|---|---|---|---|---|---|---|")
+    print("| rpm | WOB kN | G | predicted | stuck | SSI | simulated | re-run: status, "
+          "at the torque limit, off bottom |")
+    print("|---|---|---|---|---|---|---|---|")
+    stalls = 0
     for i, j in zip(*np.nonzero(~agree), strict=True):
+        card = rerun(controller, float(RPM[i]), float(WOB_N[j]))
+        stalls += card["status"] == "stalled"
         print(f"| {RPM[i]} | {WOB_N[j] / 1e3:.0f} | {gain[i, j]:.2f} | "
               f"{'grows' if gain[i, j] > 1 else 'decays'} | {stuck[i, j]:.2f} | "
-              f"{ssi[i, j]:.2f} | {'stick-slip' if sticks[i, j] else 'ok'} |")
+              f"{ssi[i, j]:.2f} | {'stick-slip' if sticks[i, j] else 'ok'} | "
+              f"{card['status']}, {card['saturation_fraction']:.2f}, "
+              f"{card['off_bottom_fraction']:.2f} |")
+    kept = agree.size - stalls
+    print(f"{controller}: without the {stalls} stalled points: {agree.sum()} of {kept} "
+          f"({agree.sum() / kept:.0%})")
 
 
 def plot(path: Path, gains: dict[str, np.ndarray],
@@ -94,7 +117,8 @@ def plot(path: Path, gains: dict[str, np.ndarray],
         wrong = (gain > 1.0) != sticks
         ax.scatter(xx[wrong], yy[wrong], marker="x", s=60, c="tab:blue",
                    label="prediction disagrees")
-        levels = ax.contour(x, y, gain.T, levels=[1.0], colors="tab:blue", linewidths=2)
+        finite = np.minimum(gain, 10.0)       # a bit unstable by itself: G infinite
+        levels = ax.contour(x, y, finite.T, levels=[1.0], colors="tab:blue", linewidths=2)
         ax.clabel(levels, fmt="G = 1", fontsize=8)
         agree = 1.0 - wrong.mean()
         ax.set_title(f"{name}: agreement {agree:.0%}", fontsize=10)
@@ -129,10 +153,13 @@ def main() -> int:
     tops = st.measure_tops(PRESET, list(st.CONTROLLERS))
     band = st.top_band_hz(st.checked_preset(PRESET))
     for c, r in tops.items():
-        k = int(np.argmin(r))
-        print(f"|r_top| {c}: {r.min():.3f} at its least ({band[k]:.3f} Hz), "
-              f"{np.interp(0.2115, band, r):.3f} at 0.2115 Hz")
+        k = int(np.argmin(np.abs(r)))
+        print(f"|r_top| {c}: {abs(r[k]):.3f} at its least ({band[k]:.3f} Hz)")
     gains = predicted(tops)
+    alone = np.isinf(gains[st.CONTROLLERS[0]])
+    print(f"the bit unstable by itself (G infinite): {alone.sum()} points, at "
+          + ", ".join(f"{RPM[i]} rpm {WOB_N[j] / 1e3:.0f} kN" for i, j in zip(*np.nonzero(alone),
+                                                                     strict=True)))
     for c in st.CONTROLLERS:
         report(c, gains[c], sims[c])
     if args.plot is not None:

@@ -43,16 +43,16 @@ def cmd_stability(args: Any) -> int:
         first = rows[0]
         if first.runs_away:
             print(f"{preset.name} at {rpm:g} rpm, {wob_n / 1e3:g} kN: bit slope b = "
-                  f"{first.slope_nm_s:.1f} N m s: the bit runs away by itself (no "
-                  "oscillation needed): it grows under every controller")
+                  f"{first.slope_nm_s:.1f} N m s: the bit and BHA are unstable by "
+                  "themselves on an endless pipe: growth under every controller")
         else:
             print(f"{preset.name} at {rpm:g} rpm, {wob_n / 1e3:g} kN: bit slope b = "
-                  f"{first.slope_nm_s:.1f} N m s, first mode {first.mode_hz:.4f} Hz, "
-                  f"|r_bit| = {first.r_bit:.3f} (analytic), pipe round trip "
-                  f"{first.pipe:.3f}")
-            print("controller      |r_top| (measured)  loop gain  first mode")
+                  f"{first.slope_nm_s:.1f} N m s; r_bit analytic, r_top measured")
+            print("controller      mode Hz  |r_bit|  |r_top|  pipe round trip  loop gain  "
+                  "first mode")
             for r in rows:
-                print(f"{r.controller:14s}  {r.r_top:18.3f}  {r.loop_gain:9.3f}  "
+                print(f"{r.controller:14s}  {r.mode_hz:7.4f}  {r.r_bit:7.3f}  {r.r_top:7.3f}"
+                      f"  {r.pipe:15.3f}  {r.loop_gain:9.3f}  "
                       f"{'grows' if r.grows else 'decays'}")
     print(json.dumps({"params": preset.name, "rpm": rpm, "wob_n": wob_n,
                       "predictions": [r.as_dict() for r in rows]}))

@@ -13,15 +13,15 @@ exceeds 1 at the first mode's frequency f1, where the loop's phase is a whole tu
   b = -dT/dw at the operating point with the law's lag, b / (1 + s tau). The slope is a
   central difference of the law's own torque at the steady drilling state
   (:func:`analysis.trivial_solution` at the point's rpm and WOB).
-* r_top: MEASURED in the time domain with the controller in the loop
-  (:func:`reflection.measure_reflection_with`), once per controller on a band about the
-  string's first mode, interpolated at f1.
+* r_top: MEASURED in the time domain with the controller in the loop, complex
+  (:func:`reflection.complex_reflection_with`, A / B at the top: +1 for a clamped top),
+  once per controller on a band up to three times the string's first mode, interpolated.
 * Where the slope beats what the pipe and the collars absorb (b > about Z of the pipe),
   the bit is unstable by itself on an endless pipe, whatever comes back from the top
   (:func:`bit_reflection.runs_away`): then G is infinite, growth under every controller.
-* f1: the phase condition with a clamped top (r_top = +1) and the bit law's termination
-  (:func:`bit_reflection.first_mode_hz`). The phase of r_top is not measured: a soft top
-  shifts the mode, and the loop gain there is read at the clamped-top mode.
+* f1: the lowest frequency at which the loop r_top r_bit exp(-2 gamma L_pipe) is real and
+  positive (:func:`bit_reflection.first_crossing_hz`) with that controller's top: a soft
+  top moves the mode (down, where it reflects more), and G is read there.
 """
 
 from __future__ import annotations
@@ -31,7 +31,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from drill_sim_ros.control.reflection import measure_reflection_with
+from drill_sim_ros.control.reflection import complex_reflection_with
 from drill_sim_ros.model import analysis
 from drill_sim_ros.model import bit_reflection as br
 from drill_sim_ros.model import string as sg
@@ -42,9 +42,9 @@ from drill_sim_ros.model.presets import Preset, load_preset
 CONTROLLERS = ("stiff", "soft_torque", "z_torque")
 RPM_RANGE = (1.0, 400.0)          # surface rpm a prediction accepts
 WOB_RANGE_N = (1.0e3, 1.0e6)      # applied WOB, N
-BAND = (0.5, 2.0)                 # r_top is measured over this band x the first mode
-BAND_POINTS = 61
-MODE_SEARCH = 3.0                 # f1 is searched below this x the clamped-top first mode
+BAND_LOW_HZ = 0.01                # r_top is measured from here
+MODE_SEARCH = 3.0                 # to this x the clamped-top first mode (f1 searched there)
+BAND_POINTS = 240
 
 
 @dataclass(frozen=True)
@@ -55,7 +55,7 @@ class Prediction:
     rpm: float
     wob_n: float
     slope_nm_s: float          # b = -dT/dw of the bit law at the point
-    mode_hz: float             # f1 with a clamped top and the bit's termination
+    mode_hz: float             # f1 with the controller's top and the bit's termination
     r_bit: float               # |r_bit(f1)|
     r_top: float               # |r_top(f1)|, measured with the controller
     pipe: float                # |exp(-2 gamma L_pipe)| at f1: the pipe's round trip
@@ -117,38 +117,42 @@ def response_s(preset: Preset) -> float:
 
 
 def top_band_hz(preset: Preset) -> np.ndarray:
+    """The frequencies on which r_top is measured and the first mode searched."""
     f1 = sg.analytic_modes_hz(preset.string, 1)[0]
-    return np.linspace(BAND[0] * f1, BAND[1] * f1, BAND_POINTS)
+    return np.linspace(BAND_LOW_HZ, MODE_SEARCH * f1, BAND_POINTS)
 
 
 def measure_tops(preset_name: str, controllers: list[str]) -> dict[str, np.ndarray]:
-    """|r_top| over :func:`top_band_hz` for each controller, measured in the time domain."""
+    """r_top (complex) on :func:`top_band_hz` for each controller, measured in the time
+    domain with the controller in the loop."""
     f_hz = top_band_hz(load_preset(preset_name))
-    return {c: np.array(measure_reflection_with(preset_name, c, f_hz=f_hz).r_measured)
-            for c in controllers}
+    return {c: complex_reflection_with(preset_name, c, f_hz) for c in controllers}
 
 
 def predict(preset: Preset, tops: dict[str, np.ndarray], rpm: float,
             wob_n: float) -> list[Prediction]:
     """The first mode's loop gain at ``rpm`` and ``wob_n`` for each controller of ``tops``
-    (|r_top| on :func:`top_band_hz`)."""
+    (r_top on :func:`top_band_hz`): at the lowest frequency where the loop's phase is a
+    whole turn with that top."""
     check_point(rpm, wob_n)
     slope, lag = bit_slope_nm_s(preset, rpm, wob_n), response_s(preset)
-    f_max = MODE_SEARCH * sg.analytic_modes_hz(preset.string, 1)[0]
-    if br.runs_away(preset.string, slope, lag, f_max):
+    band = top_band_hz(preset)
+    if br.runs_away(preset.string, slope, lag, float(band[-1])):
         return [Prediction(name, rpm, wob_n, slope, math.nan, math.inf, math.nan, math.nan,
                            math.inf, runs_away=True) for name in tops]
-    mode = br.first_mode_hz(preset.string, slope, lag, f_max)
-    if mode is None:
-        raise ParameterError(f"no first mode below {f_max:.3g} Hz at {rpm:g} rpm and "
-                             f"{wob_n:g} N (bit slope {slope:.4g} N m s)")
-    f = np.array([mode])
-    r_bit = float(abs(br.bit_reflection(preset.string, slope, lag, f))[0])
-    pipe = float(abs(br.pipe_round_trip(preset.string, f))[0])
-    band = top_band_hz(preset)
+    r_bit = br.bit_reflection(preset.string, slope, lag, band)
+    pipe = br.pipe_round_trip(preset.string, band)
     out = []
     for name, r_top in tops.items():
-        top = float(np.interp(mode, band, r_top))
-        out.append(Prediction(name, rpm, wob_n, slope, mode, r_bit, top, pipe,
-                              r_bit * top * pipe))
+        mode = br.first_crossing_hz(band, r_top * r_bit * pipe)
+        if mode is None:
+            raise ParameterError(f"no first mode below {band[-1]:.3g} Hz at {rpm:g} rpm and "
+                                 f"{wob_n:g} N under {name} (bit slope {slope:.4g} N m s)")
+        f = np.array([mode])
+        bit = float(abs(br.bit_reflection(preset.string, slope, lag, f))[0])
+        trip = float(abs(br.pipe_round_trip(preset.string, f))[0])
+        top = float(abs(np.interp(mode, band, r_top.real)
+                        + 1j * np.interp(mode, band, r_top.imag)))
+        out.append(Prediction(name, rpm, wob_n, slope, mode, bit, top, trip,
+                              bit * top * trip))
     return out

@@ -94,15 +94,15 @@ def runs_away(spec: StringSpec, slope_nm_s: float, response_s: float,
     """True when the bit and BHA on an endless pipe (no wave ever comes back) are unstable
     by themselves below ``band_hz``: Z_BHA(s) + Z_pipe(s) has a zero with Re s > 0 there
     (then r_bit has a pole in the right half plane, and no loop gain at a mode describes the
-    growth: it grows under any top). Counted by the argument principle on the rectangle
-    1e-4 <= Re s <= 20 1/s, 0 <= Im s <= 2 pi band_hz (zeros come in conjugate pairs or on
-    the real axis; the BHA's own poles, its clamped-top modes, lie above a low band)."""
+    growth: it grows under any top). Counted by the argument principle around the rectangle
+    1e-4 <= Re s <= 20 1/s, |Im s| <= 2 pi band_hz (the BHA's own poles, its clamped-top
+    modes, lie above a low band)."""
     re_lo, re_hi, im_hi = 1e-4, 20.0, 2.0 * math.pi * band_hz
     edge = np.linspace(0.0, 1.0, points)
-    path = np.concatenate((re_lo + (re_hi - re_lo) * edge + 0j,          # bottom, real axis
-                           re_hi + 1j * im_hi * edge,                     # right
-                           re_hi - (re_hi - re_lo) * edge + 1j * im_hi,   # top
-                           re_lo + 1j * im_hi * (1.0 - edge)))            # left
+    path = np.concatenate((re_lo + (re_hi - re_lo) * edge - 1j * im_hi,      # bottom
+                           re_hi + 1j * im_hi * (2.0 * edge - 1.0),           # right
+                           re_hi - (re_hi - re_lo) * edge + 1j * im_hi,       # top
+                           re_lo + 1j * im_hi * (1.0 - 2.0 * edge)))          # left
     total = bha_impedance(spec, slope_nm_s, response_s, path) + line_of(spec.sections[0],
                                                                         path)[1]
     turns = np.sum(np.diff(np.unwrap(np.angle(total)))) / (2.0 * math.pi)
@@ -125,16 +125,23 @@ def pipe_round_trip(spec: StringSpec, f_hz: np.ndarray) -> np.ndarray:
     return np.exp(-2.0 * line_of(spec.sections[0], _s(f_hz))[0])
 
 
-def first_mode_hz(spec: StringSpec, slope_nm_s: float, response_s: float,
-                  f_max_hz: float, points: int = 4000) -> float | None:
-    """The first frequency below ``f_max_hz`` at which the loop r_top r_bit exp(-2 gamma L)
-    is real and positive with a clamped top (r_top = 1): the phase condition of the first
-    mode of a string held at the top, with the bit law's termination. Linear interpolation
-    on a fine grid; None if there is none."""
-    f = np.linspace(f_max_hz / points, f_max_hz, points)
-    loop = bit_reflection(spec, slope_nm_s, response_s, f) * pipe_round_trip(spec, f)
+def first_crossing_hz(f_hz: np.ndarray, loop: np.ndarray) -> float | None:
+    """The lowest frequency of ``f_hz`` (ascending) at which ``loop`` crosses the positive
+    real axis (its phase a whole turn: a mode), linearly interpolated; None if none."""
     im, re = loop.imag, loop.real
-    for i in range(f.size - 1):
+    for i in range(f_hz.size - 1):
         if im[i] * im[i + 1] <= 0.0 and im[i] != im[i + 1] and re[i] + re[i + 1] > 0.0:
-            return float(f[i] + (f[i + 1] - f[i]) * im[i] / (im[i] - im[i + 1]))
+            return float(f_hz[i] + (f_hz[i + 1] - f_hz[i]) * im[i] / (im[i] - im[i + 1]))
     return None
+
+
+def first_mode_hz(spec: StringSpec, slope_nm_s: float, response_s: float,
+                  f_max_hz: float, points: int = 4000,
+                  r_top: np.ndarray | float = 1.0) -> float | None:
+    """The first frequency below ``f_max_hz`` at which the loop r_top r_bit exp(-2 gamma L)
+    is real and positive: the phase condition of the first mode, with the bit law's
+    termination and the top's reflection ``r_top`` (complex, on ``points`` frequencies
+    evenly spaced up to ``f_max_hz``; default 1: a clamped top)."""
+    f = np.linspace(f_max_hz / points, f_max_hz, points)
+    loop = r_top * bit_reflection(spec, slope_nm_s, response_s, f) * pipe_round_trip(spec, f)
+    return first_crossing_hz(f, loop)

@@ -333,13 +333,19 @@ def top_waves(rows: np.ndarray, z_top: float) -> tuple[np.ndarray, np.ndarray]:
 
 def spectral_ratio(a: np.ndarray, b: np.ndarray, sample_hz: float,
                    f_hz: np.ndarray) -> np.ndarray:
-    """|A(f) / B(f)| at ``f_hz`` by direct Fourier sums of the whole records (both decay to
+    """|A(f) / B(f)| at ``f_hz`` (:func:`complex_spectral_ratio`)."""
+    return np.abs(complex_spectral_ratio(a, b, sample_hz, f_hz))
+
+
+def complex_spectral_ratio(a: np.ndarray, b: np.ndarray, sample_hz: float,
+                           f_hz: np.ndarray) -> np.ndarray:
+    """A(f) / B(f) at ``f_hz`` by direct Fourier sums of the whole records (both decay to
     nothing at the end, so no window is needed)."""
     t = np.arange(a.size) / sample_hz
     out = []
     for f in f_hz:
         e = np.exp(-2j * np.pi * f * t)
-        out.append(abs(np.dot(a, e)) / abs(np.dot(b, e)))
+        out.append(np.dot(a, e) / np.dot(b, e))
     return np.array(out)
 
 
@@ -364,14 +370,15 @@ def _top_records(sim: Simulator, z_top: float, seconds: float, block: int = 32
 
 
 def reflection_of(run: Callable[[bool], tuple[np.ndarray, np.ndarray]], sample_hz: float,
-                  f_hz: np.ndarray) -> np.ndarray:
-    """|r(f)| from two identical runs ``run(pulse)`` -> (a, b), with and without the pulse
-    from the bit: their difference is the pulse's own waves at the top (the loop is linear
-    off bottom), so a drive or controller that is not at rest when the pulse comes does not
-    count."""
+                  f_hz: np.ndarray, with_phase: bool = False) -> np.ndarray:
+    """|r(f)| (``with_phase``: r(f) = A / B, complex) from two identical runs ``run(pulse)``
+    -> (a, b), with and without the pulse from the bit: their difference is the pulse's own
+    waves at the top (the loop is linear off bottom), so a drive or controller that is not
+    at rest when the pulse comes does not count."""
     a1, b1 = run(True)
     a0, b0 = run(False)
-    return spectral_ratio(a1 - a0, b1 - b0, sample_hz, f_hz)
+    ratio = complex_spectral_ratio(a1 - a0, b1 - b0, sample_hz, f_hz)
+    return ratio if with_phase else np.abs(ratio)
 
 
 def measure_reflection(preset: Preset, seconds: float = 120.0,

@@ -54,3 +54,20 @@ def test_cli_smoke(capsys: pytest.CaptureFixture[str]) -> None:
     assert p["loop_gain"] == pytest.approx(p["r_bit"] * p["r_top"] * p["pipe_round_trip"],
                                            rel=1e-3)
     assert p["grows"] == (p["loop_gain"] > 1.0)
+
+
+def test_complex_top_reflection_of_the_speed_loop_is_the_formula() -> None:
+    """The phase too: the drive's own speed loop through the bench reflects the torque wave
+    as (Z_TD - Z) / (Z_TD + Z), Z_TD(s) = J s + kp + ki / s (+1 for a clamped top, the
+    convention of model/bit_reflection.py)."""
+    import numpy as np
+
+    from drill_sim_ros.control.reflection import complex_reflection_with
+    preset = st.checked_preset(FIELD)
+    drive = preset.top_drive.physical(preset.scales)
+    z = preset.string.sections[0].torsional_impedance_nm_s
+    f = np.array([0.05, 0.2, 1.0, 3.0])
+    s = 2j * np.pi * f
+    z_td = drive.inertia_kg_m2 * s + drive.kp_nm_s + drive.ki_nm / s
+    measured = complex_reflection_with(FIELD, "none", f, seconds=60.0)
+    assert np.max(np.abs(measured - (z_td - z) / (z_td + z))) < 0.03

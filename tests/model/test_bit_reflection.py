@@ -6,6 +6,7 @@ with a point damper at the bit, and the bit law's slope by hand."""
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 
@@ -82,3 +83,15 @@ def test_law_slope_by_hand() -> None:
     expected = t0 * (1 - floor) / (speed / time_s) * math.exp(-omega / speed)
     got = br.law_slope_nm_s(law, doc, w_f, beta, omega, torque_nm, time_s)
     assert abs(got - expected) < 1e-6 * expected
+
+
+def test_a_bit_on_an_endless_pipe_runs_away_when_its_slope_beats_the_pipe() -> None:
+    """One lossless section and the bit's inertia I with the lagged negative damper: on an
+    endless pipe (I s + Z)(1 + s tau) - b = 0, i.e. I tau s^2 + (I + Z tau) s + Z - b = 0,
+    has a root in the right half plane exactly when b > Z (Routh-Hurwitz)."""
+    lossless = SPEC.undamped()
+    spec = replace(lossless, sections=lossless.sections[:1], bit_inertia_kg_m2=100.0)
+    z = spec.sections[0].torsional_impedance_nm_s
+    for tau in (0.0, 0.06):
+        assert not br.runs_away(spec, 0.95 * z, tau, 0.6)
+        assert br.runs_away(spec, 1.05 * z, tau, 0.6)
