@@ -135,6 +135,29 @@ def plot(path: Path, gains: dict[str, np.ndarray],
     plt.close(fig)
 
 
+def bit_check(sigma: float = 0.6) -> None:
+    """r_bit measured in the time domain (string_instruments.measure_bit_reflection) beside
+    the analytic one the prediction uses, at s = sigma + 2 pi i f (the measurement needs
+    Re s > 0: steady drilling on RGD07's law departs after some seconds)."""
+    from drill_sim_ros.model import bit_reflection as br
+    from drill_sim_ros.model import string_instruments as si
+    preset = st.checked_preset(PRESET)
+    sc = preset.scales
+    f = np.array([0.1, 0.15, 0.2, 0.3, 0.5, 1.0])
+    s = sigma + 2j * np.pi * f
+    print(f"\n|r_bit| at s = {sigma} + 2 pi i f, f = {', '.join(f'{x:g}' for x in f)} Hz: "
+          "measured / analytic, largest |difference|")
+    for rpm, wob in ((35, 60e3), (60, 100e3), (100, 60e3)):
+        slope = st.bit_slope_nm_s(preset, rpm, wob)
+        formula = br.bit_reflection_at(preset.string, slope, st.response_s(preset), s)
+        measured = si.measure_bit_reflection(preset, sc.omega_from_rpm(rpm),
+                                             sc.w_from_newton(wob), s)
+        print(f"| {rpm} rpm {wob / 1e3:.0f} kN | b = {slope:.0f} N m s | "
+              + " ".join(f"{m:.2f}/{a:.2f}" for m, a in zip(np.abs(measured),
+                                                              np.abs(formula), strict=True))
+              + f" | {np.max(np.abs(measured - formula)):.2f} |")
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--maps", type=Path, default=Path("stability_maps"),
@@ -162,6 +185,7 @@ def main() -> int:
                                                                      strict=True)))
     for c in st.CONTROLLERS:
         report(c, gains[c], sims[c])
+    bit_check()
     if args.plot is not None:
         plot(args.plot, gains, sims)
         print(f"wrote {args.plot}", file=sys.stderr)

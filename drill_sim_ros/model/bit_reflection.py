@@ -89,6 +89,20 @@ def bha_impedance(spec: StringSpec, slope_nm_s: float, response_s: float,
     return z
 
 
+def below(section: Section, impedance_on_top: np.ndarray, s: np.ndarray) -> np.ndarray:
+    """The load at the bottom of ``section`` that it shows as ``impedance_on_top`` at its
+    top (the inverse of :func:`through`)."""
+    gl, z = line_of(section, s)
+    t = np.tanh(gl)
+    return z * (impedance_on_top - z * t) / (z - impedance_on_top * t)
+
+
+def reflection_of_load(section: Section, load: np.ndarray, s: np.ndarray) -> np.ndarray:
+    """r = (Z_L - Z(s)) / (Z_L + Z(s)) of ``load`` at the bottom of ``section``."""
+    z = line_of(section, s)[1]
+    return (load - z) / (load + z)
+
+
 def runs_away(spec: StringSpec, slope_nm_s: float, response_s: float,
               band_hz: float, points: int = 4000) -> bool:
     """True when the bit and BHA on an endless pipe (no wave ever comes back) are unstable
@@ -113,16 +127,25 @@ def bit_reflection(spec: StringSpec, slope_nm_s: float, response_s: float,
                    f_hz: np.ndarray) -> np.ndarray:
     """r_bit(f), complex: the torque wave's reflection by the BHA and bit, in the pipe just
     above the collars (module doc)."""
-    s = _s(f_hz)
-    z_load = bha_impedance(spec, slope_nm_s, response_s, s)
-    z_pipe = line_of(spec.sections[0], s)[1]
-    return (z_load - z_pipe) / (z_load + z_pipe)
+    return bit_reflection_at(spec, slope_nm_s, response_s, _s(f_hz))
+
+
+def bit_reflection_at(spec: StringSpec, slope_nm_s: float, response_s: float,
+                      s: np.ndarray) -> np.ndarray:
+    """:func:`bit_reflection` at Laplace values ``s``."""
+    return reflection_of_load(spec.sections[0],
+                              bha_impedance(spec, slope_nm_s, response_s, s), s)
 
 
 def pipe_round_trip(spec: StringSpec, f_hz: np.ndarray) -> np.ndarray:
     """exp(-2 gamma L) of the pipe (the top section), complex: its round trip's phase and
     attenuation."""
-    return np.exp(-2.0 * line_of(spec.sections[0], _s(f_hz))[0])
+    return pipe_round_trip_at(spec, _s(f_hz))
+
+
+def pipe_round_trip_at(spec: StringSpec, s: np.ndarray) -> np.ndarray:
+    """:func:`pipe_round_trip` at Laplace values ``s``."""
+    return np.exp(-2.0 * line_of(spec.sections[0], s)[0])
 
 
 def first_crossing_hz(f_hz: np.ndarray, loop: np.ndarray) -> float | None:

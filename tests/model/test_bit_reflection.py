@@ -12,6 +12,7 @@ import numpy as np
 
 from drill_sim_ros.model import bit_reflection as br
 from drill_sim_ros.model import string as sg
+from drill_sim_ros.model import string_instruments as si
 from drill_sim_ros.model.bit_rock import LAW_WEAKENING_BIT, RGD07_LAW, BitLaw
 from drill_sim_ros.model.presets import load_preset
 
@@ -95,3 +96,36 @@ def test_a_bit_on_an_endless_pipe_runs_away_when_its_slope_beats_the_pipe() -> N
     for tau in (0.0, 0.06):
         assert not br.runs_away(spec, 0.95 * z, tau, 0.6)
         assert br.runs_away(spec, 1.05 * z, tau, 0.6)
+
+
+def test_the_time_domain_measurement_of_a_free_bha_is_the_formula() -> None:
+    """The instrument (string_instruments.measure_bit_reflection) on the bit hanging free:
+    the BHA's reflection, measured through the simulator's delay lines, is the lossy-line
+    formula at s = 0.6 + 2 pi i f, within 0.02 up to 0.5 Hz and 0.1 to 2 Hz (the kernel's
+    stepped losses depart from the continuous line's at the higher frequencies)."""
+    preset = load_preset("field_8p5in_shale")
+    sc = preset.scales
+    f = np.array([0.1, 0.2, 0.3, 0.5, 1.0, 2.0])
+    s = 0.6 + 2j * np.pi * f
+    measured = si.measure_bit_reflection(preset, sc.omega_from_rpm(35.0),
+                                         sc.w_from_newton(60e3), s, on_bottom=False)
+    formula = br.bit_reflection_at(preset.string, 0.0, 0.0, s)
+    error = np.abs(measured - formula)
+    assert np.all(error[:4] < 0.02) and np.all(error < 0.1), error
+
+
+def test_the_measured_reflection_of_a_drilling_bit_is_near_the_small_signal_one() -> None:
+    """On bottom at 100 rpm and 60 kN (b = 46 N m s, a steady state that holds over the
+    record) the measured r_bit is the small-signal termination's within 0.06 from 0.1 to
+    1 Hz at Re s = 0.6 1/s; what is left is RGD07's depth-of-cut coupling, not in the
+    formula."""
+    from drill_sim_ros.control import stability as st
+    preset = load_preset("field_8p5in_shale")
+    sc = preset.scales
+    f = np.array([0.1, 0.2, 0.3, 0.5, 1.0])
+    s = 0.6 + 2j * np.pi * f
+    measured = si.measure_bit_reflection(preset, sc.omega_from_rpm(100.0),
+                                         sc.w_from_newton(60e3), s)
+    slope = st.bit_slope_nm_s(preset, 100.0, 60e3)
+    formula = br.bit_reflection_at(preset.string, slope, st.response_s(preset), s)
+    assert np.max(np.abs(measured - formula)) < 0.06
