@@ -75,13 +75,24 @@ def measure_reflection_with(preset_name: str, controller: str, mode: str = "spee
     loop (``mode``: speed or torque), after ``settle_s`` off bottom for the controller to
     come to rest; no analytic curve (the controller is a sampled, filtered law)."""
     f_hz = si.reflection_frequencies() if f_hz is None else f_hz
+    ratio = complex_reflection_with(preset_name, controller, f_hz, mode, seconds,
+                                    control_rate_hz, settle_s, params)
+    return si.Reflection([float(f) for f in f_hz], [float(r) for r in np.abs(ratio)], None)
+
+
+def complex_reflection_with(preset_name: str, controller: str, f_hz: np.ndarray,
+                            mode: str = "speed", seconds: float = 120.0,
+                            control_rate_hz: float = CONTROL_RATE_HZ,
+                            settle_s: float = 30.0,
+                            params: dict[str, float] | None = None) -> np.ndarray:
+    """A(f) / B(f) at the top with ``controller`` in the loop (as
+    :func:`measure_reflection_with`), complex: a = T + Z w leaving, b = T - Z w arriving."""
     preset = load_preset(preset_name)
     si.require_distributed(preset)
     scenario = Scenario(preset=preset_name, controller=controller, mode=mode,
                         duration_s=settle_s + seconds, enable_at_s=0.0,
                         control_rate_hz=control_rate_hz, params=dict(params or {}))
     settle = round(settle_s * control_rate_hz)
-    ratio = si.reflection_of(
+    return si.reflection_of(
         lambda pulse: _top_waves_through_bench(scenario, preset, pulse, settle),
-        control_rate_hz, f_hz)
-    return si.Reflection([float(f) for f in f_hz], [float(r) for r in ratio], None)
+        control_rate_hz, np.asarray(f_hz, dtype=float), with_phase=True)

@@ -29,10 +29,11 @@ import numpy as np
 from drill_sim_ros.model import kernel as k
 from drill_sim_ros.model import poles
 from drill_sim_ros.model import string as sg
+from drill_sim_ros.model.bit_reflection import below, reflection_of_load
 from drill_sim_ros.model.errors import ParameterError
 from drill_sim_ros.model.presets import Preset
 from drill_sim_ros.model.simulator import SimConfig, Simulator
-from drill_sim_ros.model.top_drive import TopDrive
+from drill_sim_ros.model.top_drive import TopDrive, TopDrivePhysical
 
 PULSE_WIDTH_S = 0.05       # standard deviation of the Gaussian pulse sent from the bit
 SAMPLE_HZ = 200.0          # the ring-down is recorded at this rate (modes < 20 Hz)
@@ -326,20 +327,32 @@ def top_waves(rows: np.ndarray, z_top: float) -> tuple[np.ndarray, np.ndarray]:
     """From kernel rows (every step): the wave arriving at the top, b = T - Z w_s, and the
     wave leaving it, a = b + 2 Z w_s(next step) (module string), over all rows but the
     last."""
-    b = rows[:-1, k.C_T_PIPE] - z_top * rows[:-1, k.C_OMEGA_S]
-    a = b + 2.0 * z_top * rows[1:, k.C_OMEGA_S]
-    return a, b
+    return waves_at_top(rows[:, k.C_T_PIPE], rows[:, k.C_OMEGA_S], z_top)
+
+
+def waves_at_top(torque: np.ndarray, speed: np.ndarray, z_top: float
+                 ) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`top_waves` from the string torque at the top and the drive speed, every
+    step."""
+    b = torque[:-1] - z_top * speed[:-1]
+    return b + 2.0 * z_top * speed[1:], b
 
 
 def spectral_ratio(a: np.ndarray, b: np.ndarray, sample_hz: float,
                    f_hz: np.ndarray) -> np.ndarray:
-    """|A(f) / B(f)| at ``f_hz`` by direct Fourier sums of the whole records (both decay to
+    """|A(f) / B(f)| at ``f_hz`` (:func:`complex_spectral_ratio`)."""
+    return np.abs(complex_spectral_ratio(a, b, sample_hz, f_hz))
+
+
+def complex_spectral_ratio(a: np.ndarray, b: np.ndarray, sample_hz: float,
+                           f_hz: np.ndarray) -> np.ndarray:
+    """A(f) / B(f) at ``f_hz`` by direct Fourier sums of the whole records (both decay to
     nothing at the end, so no window is needed)."""
     t = np.arange(a.size) / sample_hz
     out = []
     for f in f_hz:
         e = np.exp(-2j * np.pi * f * t)
-        out.append(abs(np.dot(a, e)) / abs(np.dot(b, e)))
+        out.append(np.dot(a, e) / np.dot(b, e))
     return np.array(out)
 
 
@@ -364,14 +377,15 @@ def _top_records(sim: Simulator, z_top: float, seconds: float, block: int = 32
 
 
 def reflection_of(run: Callable[[bool], tuple[np.ndarray, np.ndarray]], sample_hz: float,
-                  f_hz: np.ndarray) -> np.ndarray:
-    """|r(f)| from two identical runs ``run(pulse)`` -> (a, b), with and without the pulse
-    from the bit: their difference is the pulse's own waves at the top (the loop is linear
-    off bottom), so a drive or controller that is not at rest when the pulse comes does not
-    count."""
+                  f_hz: np.ndarray, with_phase: bool = False) -> np.ndarray:
+    """|r(f)| (``with_phase``: r(f) = A / B, complex) from two identical runs ``run(pulse)``
+    -> (a, b), with and without the pulse from the bit: their difference is the pulse's own
+    waves at the top (the loop is linear off bottom), so a drive or controller that is not
+    at rest when the pulse comes does not count."""
     a1, b1 = run(True)
     a0, b0 = run(False)
-    return spectral_ratio(a1 - a0, b1 - b0, sample_hz, f_hz)
+    ratio = complex_spectral_ratio(a1 - a0, b1 - b0, sample_hz, f_hz)
+    return ratio if with_phase else np.abs(ratio)
 
 
 def measure_reflection(preset: Preset, seconds: float = 120.0,
@@ -404,3 +418,111 @@ def measure_reflection(preset: Preset, seconds: float = 120.0,
 def z_top_of(sim: Simulator) -> float:
     """The impedance of the string's top part, kernel units."""
     return float(sim.string_arrays()[2][sg.W_Z, 0])
+
+
+MATCHED_DRIVE_INERTIA_KG_M2 = 5.0   # the matched top's inertia: J w << Z up to a few Hz
+MATCHED_DRIVE_KI_NM = 1.0           # and its integral gain: ki / w << Z from 0.01 Hz
+
+
+def matched_drive(preset: Preset) -> TopDrive:
+    """A speed loop that absorbs what comes up the pipe: kp = Z of the top section, a small
+    inertia and integral gain (Z_TD = J s + Z + ki / s close to Z in the first modes' band),
+    no torque limit, no motor lag; its integral holds the steady torque from the start."""
+    z = preset.string.sections[0].torsional_impedance_nm_s
+    return TopDrivePhysical(mode="speed", inertia_kg_m2=MATCHED_DRIVE_INERTIA_KG_M2,
+                            kp_nm_s=z, ki_nm=MATCHED_DRIVE_KI_NM,
+                            max_torque_nm=math.inf).scaled(preset.scales)
+
+
+def on_bottom_simulator(preset: Preset, omega0: float, w0: float) -> Simulator:
+    """``preset`` drilling steadily (RGD07's trivial state, no perturbation) at the scaled
+    speed ``omega0`` and weight ``w0`` under :func:`matched_drive`."""
+    require_distributed(preset)
+    params = preset.params.with_(omega0=omega0, w0=w0)
+    return Simulator(params, SimConfig(dtau=preset.dtau, n_nodes=64),
+                     top_drive=matched_drive(preset), scales=preset.scales,
+                     string=preset.kernel_string, bit_law=preset.bit_law,
+                     perturb_v=0.0, perturb_omega=0.0)
+
+
+def _record_top_with_pulse(sim: Simulator, omega0: float, amplitude: float,
+                           width_steps: float, seconds: float, block: int = 32
+                           ) -> tuple[np.ndarray, np.ndarray]:
+    """The string torque at the top and the drive speed (kernel units), every step
+    block-averaged by ``block``, over
+    ``seconds`` from now, while the drive's speed setpoint makes a Gaussian bump of
+    ``amplitude`` (kernel speed units; standard deviation ``width_steps`` steps, centred 4
+    widths from now, set in 200 stairs): the drive sends a torque pulse down the pipe."""
+    stair = max(1, round(8.0 * width_steps / 200))
+    torque, speed = [], []
+
+    def take(n: int) -> None:
+        rows = sim.advance(n, every=1).data
+        torque.append(rows[:, k.C_T_PIPE].copy())
+        speed.append(rows[:, k.C_OMEGA_S].copy())
+
+    for i in range(200):
+        x = (i * stair - 4.0 * width_steps) / width_steps
+        sim.set_inputs(omega_s=omega0 + amplitude * math.exp(-0.5 * x * x))
+        take(stair)
+    sim.set_inputs(omega_s=omega0)
+    left = sim.steps_for(seconds / sim.scales.time_s) - 200 * stair
+    while left > 0:
+        take(min(left, 1 << 18))
+        left -= 1 << 18
+    t, w = np.concatenate(torque), np.concatenate(speed)
+    m = t.size // block * block
+    return t[:m].reshape(-1, block).mean(axis=1), w[:m].reshape(-1, block).mean(axis=1)
+
+
+def laplace_ratio(a: np.ndarray, b: np.ndarray, sample_hz: float,
+                  s: np.ndarray) -> np.ndarray:
+    """A(s) / B(s) at Laplace values ``s`` (1/s) by direct sums over the records from
+    their first sample (t = 0): with Re s > 0 the records are weighted by exp(-Re(s) t), so
+    a record cut before it has died out still gives the transfer function there."""
+    t = np.arange(a.size) / sample_hz
+    out = []
+    for value in s:
+        e = np.exp(-value * t)
+        out.append(np.dot(a, e) / np.dot(b, e))
+    return np.array(out)
+
+
+BIT_PULSE_SHARE = 0.2      # the pulse's speed bump, share of the drilling speed
+BIT_SETTLE_S = 0.5         # steady drilling before the pulse
+BIT_RECORD_S = 8.0         # and the record after it: the drilling itself departs later
+
+
+def measure_bit_reflection(preset: Preset, omega0: float, w0: float, s: np.ndarray,
+                           settle_s: float = BIT_SETTLE_S,
+                           seconds: float = BIT_RECORD_S,
+                           on_bottom: bool = True) -> np.ndarray:
+    """r_bit(s), complex, MEASURED on bottom in steady drilling at the scaled speed
+    ``omega0`` and weight ``w0``, at Laplace values ``s`` (Re s > 0 for a record this
+    short). After ``settle_s`` a torque pulse is sent down from a matched top
+    (:func:`matched_drive`); the string torque and the speed at the top are recorded for
+    ``seconds``, and a run without the pulse is subtracted (the drilling moves by itself).
+    Their ratio is the impedance the string shows at the top; the pipe's lossy line is
+    taken off it (:func:`bit_reflection.below`: a wave split with the lossless Z0 would
+    mix the lossy line's own scattering in) to give the load below the pipe, the BHA and
+    bit, and its reflection (:func:`bit_reflection.reflection_of_load`, torque waves, -1
+    at a free end). The record is short because steady drilling on RGD07's law is itself
+    unstable (its axial mode): after some seconds the two runs part and their difference
+    is no longer the pulse's (docs/string.md). ``on_bottom`` False: the bit hanging free
+    (:meth:`Simulator.hang_off_bottom`), the BHA's own reflection."""
+    def run(pulse: bool) -> tuple[np.ndarray, np.ndarray]:
+        sim = on_bottom_simulator(preset, omega0, w0)
+        if not on_bottom:
+            sim.hang_off_bottom()
+        sim.advance(sim.steps_for(settle_s / preset.scales.time_s))
+        width = PULSE_WIDTH_S / (preset.scales.time_s * sim.config.dtau)       # steps
+        return _record_top_with_pulse(sim, omega0, BIT_PULSE_SHARE * omega0 if pulse
+                                      else 0.0, width, seconds)
+
+    sc = preset.scales
+    sample_hz = 1.0 / (32 * preset.dtau * sc.time_s)
+    t1, w1 = run(True)
+    t0, w0_ = run(False)
+    z_top = laplace_ratio(t1 - t0, w1 - w0_, sample_hz, s) * sc.torque_nm * sc.time_s
+    pipe = preset.string.sections[0]
+    return reflection_of_load(pipe, below(pipe, z_top, s), s)
