@@ -3,7 +3,7 @@
 A fenced block (``bash``, ``sh``, ``shell`` or no language) of README.md or docs/*.md
 whose first line starts with ``.venv/bin/drill_sim`` is run by ``bash -e`` (every command
 must exit 0) in a fresh temporary directory holding links to this checkout's ``.venv``
-(the venv running the tests) and ``config``: the paths the docs use resolve, and the
+(the venv running the tests), ``config`` and ``examples``: the paths the docs use resolve, and the
 files the commands write land in the temporary directory. Each file a command names after
 ``--plot``, ``-o``, ``--out``, ``--trace``, ``--save-traces`` or ``--record`` must exist
 afterwards. The selected blocks start together, two at a time (the rest of the suite keeps
@@ -99,9 +99,11 @@ def _param(block: Block) -> pytest.param:
 
 
 def _workdir(tmp_path: Path) -> Path:
-    """A directory where the docs' relative paths resolve: .venv and config linked."""
+    """A directory where the docs' relative paths resolve: .venv, config and examples
+    linked."""
     (tmp_path / ".venv").symlink_to(sys.prefix)
     (tmp_path / "config").symlink_to(ROOT / "config")
+    (tmp_path / "examples").symlink_to(ROOT / "examples")
     return tmp_path
 
 
