@@ -75,12 +75,12 @@ STUCK_RPM = 1.0           # low-passed bit speed below this: stuck (on the lumpe
 MIN_OSCILLATION_RMS_RPM = 0.1   # below this RMS a component has no frequency (flat)
 PERIOD_MIN_HZ = 0.02      # the slowest stick-slip the period looks for (50 s)
 WINDOW_S = defaults.WINDOW_S  # the severity window of sim_node's /diagnostics
-STALL_S = 10.0            # stuck this long at the end of a run: a stall candidate (a stick
-                          # of the field case's stick-slip lasts 8-17 s, so STALL_FACTOR
-                          # decides there)
+STALL_S = 10.0            # stuck this long at the end of a run: a stall candidate (the
+                          # default's first-mode sticks last about 1.2 s; the sharp bit's of
+                          # the default until 2026-12-06 8-17 s, so STALL_FACTOR decides there)
 STALL_FACTOR = 2.0        # ... and this many times the longest stick it broke out of: a
-                          # chaotic stick-slip's sticks vary by tens of percent (field_default:
-                          # 8.1-9.7 s uncontrolled, 9.6-14.6 s with z_torque), twice the
+                          # chaotic stick-slip's sticks vary by tens of percent (the sharp
+                          # bit: 8.1-9.7 s uncontrolled, 9.6-14.6 s with z_torque), twice the
                           # longest is outside that spread
 STICK_FRACTION_OK = 0.10  # stuck this share of the time after the switch-on: never ok
 SSI_OK = 1.0              # a last window's SSI this high is stick-slip: a symmetric
@@ -88,8 +88,8 @@ SSI_OK = 1.0              # a last window's SSI this high is stick-slip: a symme
 SSI_MAX = 10.0            # the SSI of a window is clipped here, and a window whose mean is
                           # below STUCK_RPM reads it: the SSI of a square-wave stick-slip
                           # stuck a share s of the time is 1 / (2 (1 - s)); 10 is s = 0.95,
-                          # over twice any window field_default's reference runs turn through
-                          # (at most 4.7)
+                          # over twice any window the sharp bit's reference runs turned
+                          # through (at most 4.7; the default's first-mode cycle: 1.2)
 SCORE_FIELDS = ("ssi_before_mean", "ssi_mean", "ssi_max", "ssi_last", "stick_fraction",
                 "stick_longest_s", "utr", "bit_rpm_max", "time_to_suppress_s", "rop_m_h",
                 "mse_mpa", "quill_torque_peak_nm", "quill_torque_rms_nm",
