@@ -28,7 +28,7 @@ from drill_sim_ros import closed_loop_cli, stability_cli, startup_cli, string_cl
 from drill_sim_ros.archive.output import open_output
 from drill_sim_ros.model import analysis, telemetry
 from drill_sim_ros.model import kernel as k
-from drill_sim_ros.model.bit_rock import LAWS
+from drill_sim_ros.model.bit_rock import LAWS, RGD07_LAW, BitLaw
 from drill_sim_ros.model.checks import check_blade_counts
 from drill_sim_ros.model.errors import DrillSimError
 from drill_sim_ros.model.params import GROUPS, UNIT_SCALES, DimensionlessParams, Scales
@@ -72,6 +72,7 @@ class RunSpec:
     n_nodes: int
     top_drive: TopDrive
     motor_torque: float | None
+    bit_law: BitLaw = RGD07_LAW          # the preset's (Preset.bit_law); RGD07's without one
 
 
 # ---- argument parsing ---------------------------------------------------------------------
@@ -172,7 +173,7 @@ def _resolve(args: argparse.Namespace) -> RunSpec:
     return RunSpec(params, scales, physical, tau_end, config.dtau, average_from,
                    args.perturb_v, args.perturb_omega, args.method, config.n_nodes,
                    _top_drive(args, preset.drive if preset else paper_drive(scales), scales),
-                   args.motor_torque)
+                   args.motor_torque, preset.bit_law if preset else RGD07_LAW)
 
 
 def _top_drive(args: argparse.Namespace, base: TopDrivePhysical, scales: Scales) -> TopDrive:
@@ -236,7 +237,7 @@ def simulate(spec: RunSpec, trace: TextIO | None = None, trace_every: int = 100,
     sim = Simulator(spec.params, SimConfig(dtau=spec.dtau, n_nodes=spec.n_nodes,
                                            method=spec.method, tau_avg=spec.average_from),
                     perturb_v=spec.perturb_v, perturb_omega=spec.perturb_omega,
-                    top_drive=spec.top_drive, scales=spec.scales)
+                    top_drive=spec.top_drive, scales=spec.scales, bit_law=spec.bit_law)
     if spec.motor_torque is not None:
         sim.set_inputs(motor_torque=spec.motor_torque)
     root = analysis.rightmost_root(spec.params)     # before the run, so it cannot lose it
@@ -263,7 +264,7 @@ def summarize(spec: RunSpec, sim: Simulator, kernel_seconds: float,
     acc = sim.accumulators
     avg = analysis.cycle_averages(p, acc)
     stick, bounce = analysis.first_event_tau(acc)
-    triv = analysis.trivial_solution(p)
+    triv = sim.trivial                   # eq. 34, its torque the bit law's
     sev = analysis.severity_of(avg.omega_min, avg.omega_max, avg.mean_omega, p.omega0)
     out: dict[str, Any] = {
         "params": {g: getattr(p, g) for g in GROUPS},
@@ -437,7 +438,7 @@ def _cmd_info(args: argparse.Namespace) -> int:
     weakening = preset.friction_weakening
     print("  bit law rgd07" if weakening is None else
           f"  bit law {LAWS[preset.bit_law.law]}: floor ratio {weakening.floor_ratio:.4g}, "
-          f"{weakening.speed_rad_s:.4g} rad/s")
+          f"{weakening.speed_rad_s:.4g} rad/s, read through a {weakening.response_s:.4g} s lag")
     root = analysis.rightmost_root(p)
     print(f"  tau_n0={analysis.trivial_delay(p):.4g}  critical delay="
           f"{analysis.critical_delay(p):.4g}  rightmost root={root.real:.4g}+{root.imag:.4g}i")

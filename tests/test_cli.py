@@ -11,6 +11,8 @@ from pathlib import Path
 
 import pytest
 
+from drill_sim_ros.model.presets import preset_path
+from drill_sim_ros.model.validate_input import read_preset_file
 from tests.model.helpers import SMALL_DEVIATED
 from tests.robust.helpers import one_error_line, run_cli
 
@@ -210,3 +212,24 @@ def test_startup_in_a_small_deviated_well(capsys: pytest.CaptureFixture[str],
     assert rc == 0, err
     assert plot.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["deviated.yaml", "startup.png"]
+
+
+def test_run_drills_with_the_presets_bit_law(tmp_path: Path) -> None:
+    """`drill_sim run --params field_8p5in_shale` runs the preset's weakening law: its
+    trivial torque is the law's at the drive's speed, eq. 34's times f(omega0) =
+    0.5 + 0.5 exp(-omega0 / 7 rad/s) (docs/model.md), and the same preset with floor ratio 1
+    (RGD07's law) reports eq. 34's own torque."""
+    data = read_preset_file(preset_path("field_8p5in_shale"))
+    weak = data["physical"]["friction_weakening"]
+    rgd07 = tmp_path / "rgd07.yaml"
+    rgd07.write_text(json.dumps({**data, "physical": {
+        **data["physical"], "friction_weakening": {**weak, "floor_ratio": 1.0}}}))
+    outs = []
+    for params in ("field_8p5in_shale", str(rgd07)):
+        done = drill_sim("run", "--params", params, "--t-end", "2", "--json")
+        assert done.returncode == 0, done.stderr
+        outs.append(json.loads(done.stdout.strip().splitlines()[-1]))
+    omega0_rad_s = 35.0 * 2.0 * math.pi / 60.0
+    factor = 0.5 + 0.5 * math.exp(-omega0_rad_s / 7.0)
+    assert outs[0]["trivial_torque"] == pytest.approx(factor * outs[1]["trivial_torque"],
+                                                      rel=1e-9)
