@@ -43,7 +43,7 @@ from drill_sim_ros.model.measurement import SIGNALS
 from drill_sim_ros.model.presets import Preset, submerged_string_weight_n
 from drill_sim_ros.model.session import SessionConfig, SimSession
 from drill_sim_ros.model.telemetry import N_FIELDS
-from drill_sim_ros.model.top_drive import TopDrivePhysical, limit_of_setting
+from drill_sim_ros.model.top_drive import TopDrivePhysical
 
 
 def command_limits(preset: Preset, rig: RigPhysics) -> CommandLimits:
@@ -76,16 +76,10 @@ class ClosedLoopRun:
 
 
 def scenario_drive(scenario: Scenario, preset: Preset) -> TopDrivePhysical:
-    """The drive sim_node runs for ``scenario`` (SI): the preset's, with the scenario's torque
-    limit (:meth:`Scenario.load_preset`), in its mode and with its ``drive.motor_lag_s`` and
-    ``drive.max_torque_rate_nm_s`` (0: none, ``limit_of_setting``, as sim_node reads it)."""
-    motor: dict[str, float] = {}
-    if "motor_lag_s" in scenario.drive:
-        motor["motor_lag_s"] = float(scenario.drive["motor_lag_s"])
-    if "max_torque_rate_nm_s" in scenario.drive:
-        motor["max_torque_rate_nm_s"] = limit_of_setting(
-            float(scenario.drive["max_torque_rate_nm_s"]))
-    return replace(preset.drive, mode=scenario.mode, **motor)
+    """The drive sim_node runs for ``scenario`` (SI): ``preset``'s, which
+    :meth:`Scenario.load_preset` gave the scenario's torque limit, motor lag and torque rate
+    limit, in the scenario's mode."""
+    return replace(preset.drive, mode=scenario.mode)
 
 
 def session_config(scenario: Scenario, preset: Preset) -> SessionConfig:

@@ -60,6 +60,7 @@ from drill_sim_ros.model.presets import (
     preset_from_dict,
     preset_path,
 )
+from drill_sim_ros.model.top_drive import limit_of_setting
 from drill_sim_ros.model.validate_input import read_preset_file
 
 SCENARIO_KEYS = ("preset", "duration_s", "control_rate_hz", "mode", "controller", "params",
@@ -67,6 +68,7 @@ SCENARIO_KEYS = ("preset", "duration_s", "control_rate_hz", "mode", "controller"
                  "formation", "needs")
 DRIVE_KEYS = ("accel_rpm_s", "wob_rate_n_s", "max_torque_nm", "command_delay_s",
               "motor_lag_s", "max_torque_rate_nm_s")
+MOTOR_KEYS = ("max_torque_nm", "motor_lag_s", "max_torque_rate_nm_s")   # the drive's own
 # what this model core can run beyond the keys above; the lead's kernel adds the others
 MODEL_FEATURES: frozenset[str] = frozenset(
     ("formation_layers", "motor_lag", "distributed_string"))
@@ -144,12 +146,16 @@ class Scenario:
 
     def load_preset(self) -> Preset:
         """The preset with the scenario's ``overrides``, its drive with the scenario's
-        ``drive.max_torque_nm`` (what sim_node's ``top_drive.max_torque_nm`` gets)."""
+        ``drive.max_torque_nm``, ``motor_lag_s`` and ``max_torque_rate_nm_s`` (0: none,
+        ``top_drive.limit_of_setting``, as sim_node reads its ``top_drive.*``): the drive
+        sim_node runs and the controllers are tuned from (``rig_physics``)."""
         preset = self._overridden_preset()
-        if "max_torque_nm" not in self.drive:
+        motor = {key: float(self.drive[key]) for key in MOTOR_KEYS if key in self.drive}
+        if "max_torque_rate_nm_s" in motor:
+            motor["max_torque_rate_nm_s"] = limit_of_setting(motor["max_torque_rate_nm_s"])
+        if not motor:
             return preset
-        limit_nm = float(self.drive["max_torque_nm"])
-        return replace(preset, drive=replace(preset.drive, max_torque_nm=limit_nm))
+        return replace(preset, drive=replace(preset.drive, **motor))
 
     def _overridden_preset(self) -> Preset:
         """The preset with the scenario's ``overrides`` of its sections."""

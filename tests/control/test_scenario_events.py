@@ -189,6 +189,10 @@ def test_a_scenario_motor_lag_reaches_the_drive() -> None:
     assert Bench(lagged).session.sim.top_drive.motor_lag == pytest.approx(
         0.05 / PRESET.scales.time_s
     )
+    # the controllers are tuned from the same drive (the soft drives' damper counts its lag)
+    assert rig_physics(lagged.load_preset()).motor_lag_s == 0.05
+    unlimited = lagged.with_(drive={"max_torque_rate_nm_s": 0.0})
+    assert unlimited.load_preset().drive.max_torque_rate_nm_s == math.inf
     with pytest.raises(ParameterError, match="command_delay_s"):
         scenario_from_dict({"drive": {"command_delay_s": -1.0}})
 
