@@ -49,6 +49,7 @@ from numba import njit
 
 from drill_sim_ros.model.checks import check_known_keys, number_in
 from drill_sim_ros.model.errors import ParameterError
+from drill_sim_ros.model.lag import lag_share
 
 # ---- interaction modes ------------------------------------------------------------------
 MODE_CUTTING = 0    # cutting with full wearflat contact
@@ -298,7 +299,7 @@ class BitLaw:
         """The share by which the speed the law reads follows the bit's over a step
         ``dtau``: the exact step of a first-order lag of time constant ``response`` for a
         speed held over the step, 1 - exp(-dtau / response); 1 without a lag."""
-        return 1.0 if self.response == 0.0 else -math.expm1(-dtau / self.response)
+        return lag_share(self.response, dtau)
 
     def torque(self, doc: float, w_f: float, beta: float, omega: float) -> float:
         """The law's sliding torque (:func:`sliding_torque`), kernel units."""

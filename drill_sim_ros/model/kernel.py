@@ -61,6 +61,7 @@ from drill_sim_ros.model.bit_rock import (  # noqa: F401  (the modes, re-exporte
     MODE_OFF_BOTTOM,
     MODE_STUCK,
 )
+from drill_sim_ros.model.lag import lag_step
 from drill_sim_ros.model.top_drive import TD_KINEMATIC, drive_step, ramp
 
 # ---- parameter vector (float64) -------------------------------------------------------
@@ -427,8 +428,7 @@ def _moved(x: Loop, r: Response, d: DriveStep, law: Law, lumped_kinematic: bool,
     (eq. C.1), the drive's angle on (RGD07's kinematic drive on the lumped string turns at
     the old speed), the applied weight ramped."""
     phi_s = x.phi_s + (x.omega_s if lumped_kinematic else d.omega_s_next) * law.dt
-    law_omega = r.omega_new if law.law_alpha == 1.0 else \
-        x.law_omega + law.law_alpha * (r.omega_new - x.law_omega)
+    law_omega = lag_step(x.law_omega, r.omega_new, law.law_alpha)
     return Loop(r.u_new, r.v_new, r.phi_new, r.omega_new, phi_s, d.omega_s_next,
                 ramp(x.w_app, law.tgt_w, law.w_rate, law.dt), r.stuck, node, frac, h_old,
                 x.step + 1, d.omega_ref, d.integral, d.motor, r.v_hook, r.hook_int,

@@ -36,6 +36,7 @@ from typing import Any
 from numba import njit
 
 from drill_sim_ros.model.errors import ParameterError
+from drill_sim_ros.model.lag import lag_share, lag_step
 from drill_sim_ros.model.params import Scales
 
 TD_KINEMATIC = 0
@@ -117,24 +118,15 @@ def drive_acceleration(motor: float, t_string: float, inertia: float) -> float:
 
 
 @njit(cache=True, inline="always")
-def motor_lag(previous: float, command: float, alpha: float) -> float:
-    """First-order motor torque lag (the drive's torque bandwidth): the torque moves by
-    ``alpha = 1 - exp(-dtau / lag)`` of the way to the command each step (1: no lag)."""
-    if alpha >= 1.0:
-        return command
-    return previous + alpha * (command - previous)
-
-
-@njit(cache=True, inline="always")
 def motor_response(previous: float, command: float, alpha: float, max_rate: float,
                    max_torque: float, dt: float) -> float:
     """The motor torque after one step: the first-order lag toward ``command`` (within the
-    limit already, :func:`motor_lag`), then at most ``max_rate * dt`` away from ``previous``
+    limit already, :func:`lag.lag_step`), then at most ``max_rate * dt`` away from ``previous``
     (the drive's torque rate limit, :func:`ramp`; inf: none, the lagged torque exactly),
     within the limit: a torque that starts beyond it (at t = 0, or the limit lowered at run
     time) is held to it at once, as a drive's current loop holds its torque limit; from
     within the limit the lag and the ramp never leave it."""
-    return within_limit(ramp(previous, motor_lag(previous, command, alpha), max_rate, dt),
+    return within_limit(ramp(previous, lag_step(previous, command, alpha), max_rate, dt),
                         max_torque)
 
 
@@ -227,7 +219,7 @@ class TopDrive:
 
     def lag_alpha(self, dtau: float) -> float:
         """The lag's share per step, 1 - exp(-dtau / lag) (1: no lag)."""
-        return 1.0 if self.motor_lag == 0.0 else -math.expm1(-dtau / self.motor_lag)
+        return lag_share(self.motor_lag, dtau)
 
 
 @dataclass(frozen=True)
