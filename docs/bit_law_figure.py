@@ -19,6 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
+from drill_sim_ros.model.analysis import trivial_solution
 from drill_sim_ros.model.presets import Preset, preset_from_dict, preset_path
 from drill_sim_ros.model.validate_input import read_preset_file
 
@@ -41,8 +42,9 @@ def law_torque_nm(preset: Preset, omega_rad_s: np.ndarray) -> np.ndarray:
     """The preset's bit torque in N m at the bit speeds ``omega_rad_s``, steady drilling at
     its applied weight (the depth of cut of eq. 34, the wearflat in full contact)."""
     p, sc, law = preset.params, preset.scales, preset.bit_law
-    doc, w_f = max(p.w0 - p.lam, 0.0), min(p.w0, p.lam)
-    return np.array([sc.tob_nm(law.torque(doc, w_f, p.beta, w * sc.time_s))
+    steady = trivial_solution(p)
+    return np.array([sc.tob_nm(law.torque(steady.depth_of_cut, steady.wearflat, p.beta,
+                                          w * sc.time_s))
                      for w in omega_rad_s])
 
 

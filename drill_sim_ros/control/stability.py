@@ -108,7 +108,7 @@ def bit_slope_nm_s(preset: Preset, rpm: float, wob_n: float) -> float:
     sc = preset.scales
     p = preset.params.with_(omega0=sc.omega_from_rpm(rpm), w0=sc.w_from_newton(wob_n))
     steady = analysis.trivial_solution(p)
-    return br.law_slope_nm_s(preset.bit_law, steady.depth_of_cut, min(p.w0, p.lam), p.beta,
+    return br.law_slope_nm_s(preset.bit_law, steady.depth_of_cut, steady.wearflat, p.beta,
                              p.omega0, sc.torque_nm, sc.time_s)
 
 

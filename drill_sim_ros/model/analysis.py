@@ -24,13 +24,15 @@ from drill_sim_ros.model.params import DimensionlessParams
 
 @dataclass(frozen=True)
 class TrivialSolution:
-    """Steady drilling (eq. 34): rate of penetration v0, depth of cut delta0, torque T0."""
+    """Steady drilling (eq. 34): rate of penetration v0, depth of cut delta0, torque T0, and
+    the wearflat force W_f = min(W0, lam) it carries."""
 
     v: float
     depth_of_cut: float
     torque: float
     wob: float
     omega: float
+    wearflat: float
 
 
 def trivial_solution(p: DimensionlessParams) -> TrivialSolution:
@@ -40,8 +42,9 @@ def trivial_solution(p: DimensionlessParams) -> TrivialSolution:
     """
     doc = max(p.w0 - p.lam, 0.0)
     v = p.omega0 * doc / (2.0 * math.pi)
-    torque = doc + p.beta * min(p.w0, p.lam)
-    return TrivialSolution(v=v, depth_of_cut=doc, torque=torque, wob=p.w0, omega=p.omega0)
+    wearflat = min(p.w0, p.lam)
+    return TrivialSolution(v=v, depth_of_cut=doc, torque=doc + p.beta * wearflat, wob=p.w0,
+                           omega=p.omega0, wearflat=wearflat)
 
 
 def trivial_delay(p: DimensionlessParams) -> float:

@@ -273,7 +273,7 @@ class Simulator:
         triv, p, law = trivial_solution(self.params), self.params, self.bit_law
         if law.law == br.LAW_RGD07:
             return triv
-        return replace(triv, torque=law.torque(triv.depth_of_cut, min(p.w0, p.lam), p.beta,
+        return replace(triv, torque=law.torque(triv.depth_of_cut, triv.wearflat, p.beta,
                                                p.omega0))
 
     def reset(self) -> None:
