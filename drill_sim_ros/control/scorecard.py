@@ -214,10 +214,14 @@ def motor_effort(rows: np.ndarray, period_s: float) -> dict[str, float]:
             "motor_energy_in_mj": float(np.sum(np.maximum(power_w, 0.0)) * period_s * 1e-6)}
 
 
+def time_step_s(t: np.ndarray, single: float) -> float:
+    """The median step of the times ``t`` (s); ``single`` when there is one time or none."""
+    return float(np.median(np.diff(t))) if t.size > 1 else single
+
+
 def sample_period_s(rows: np.ndarray) -> float:
     """The sampling period of ``rows`` (s): the median step of their time (1 if one row)."""
-    t = rows[:, F["sim_time_s"]]
-    return float(np.median(np.diff(t))) if t.size > 1 else 1.0
+    return time_step_s(rows[:, F["sim_time_s"]], 1.0)
 
 
 def lowpassed_bit_rpm(rows: np.ndarray, cutoff_hz: float) -> np.ndarray:
@@ -265,7 +269,7 @@ def stick_spans_s(t: np.ndarray, stuck: np.ndarray) -> list[tuple[float, float]]
     and the turning between two sticks is P per turning sample."""
     edges = np.diff(np.concatenate(([0], stuck.astype(np.int8), [0])))
     starts, ends = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
-    step = float(np.median(np.diff(t))) if t.size > 1 else 0.0
+    step = time_step_s(t, 0.0)
     return [(float(t[a]), float(t[b - 1]) + step) for a, b in zip(starts, ends, strict=True)]
 
 
