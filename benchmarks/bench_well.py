@@ -30,7 +30,7 @@ def kernel_ns_per_step(preset: Preset, steps: int = 400_000) -> float:
     for _ in range(3):
         sim = Simulator(preset.params, SimConfig(dtau=preset.dtau, n_nodes=2048),
                         top_drive=preset.top_drive, scales=preset.scales,
-                        string=preset.kernel_string)
+                        string=preset.kernel_string, bit_law=preset.bit_law)
         start = time.perf_counter()
         sim.advance(steps, 100)
         best = min(best, (time.perf_counter() - start) / steps * 1e9)

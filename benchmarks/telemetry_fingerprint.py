@@ -62,13 +62,13 @@ def main() -> None:
     for preset in ("fig5_8a", "fig7"):
         p = load_preset(preset)
         sim = Simulator(p.params, SimConfig(dtau=p.dtau, method="exact"), top_drive=p.top_drive,
-                        scales=p.scales, string=p.kernel_string)
+                        scales=p.scales, string=p.kernel_string, bit_law=p.bit_law)
         out = sim.advance(20000, every=10)
         print("exact", preset, h(out.data if hasattr(out, "data") else out.rows), h(sim.state),
               flush=True)
     p = load_preset("field_8p5in_shale")
     sim = Simulator(p.params, SimConfig(dtau=p.dtau), top_drive=p.top_drive, scales=p.scales,
-                    string=p.kernel_string)
+                    string=p.kernel_string, bit_law=p.bit_law)
     sim.hang_off_bottom()
     out = sim.advance(5000, every=10)
     print("hang", h(sim.state), h(sim.string_profile()[0]), flush=True)
