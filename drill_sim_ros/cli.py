@@ -1,7 +1,7 @@
 """Offline command line ``drill_sim``: runs, maps, figures and closed-loop tests of the model.
 
 Subcommands: ``run | sweep | presets | params | info | closed-loop | suite | modes |
-reflection | stability | startup | map | map-plot | figures``.
+reflection | stability | startup | torque-drag | map | map-plot | figures``.
 
 ``drill_sim run`` integrates the RGD07 model without ROS and prints a summary (or one JSON
 object with ``--json``). The run is dimensionless unless ``--params`` names a physical
@@ -24,7 +24,13 @@ from dataclasses import dataclass, fields, replace
 from pathlib import Path
 from typing import Any, TextIO
 
-from drill_sim_ros import closed_loop_cli, stability_cli, startup_cli, string_cli
+from drill_sim_ros import (
+    closed_loop_cli,
+    stability_cli,
+    startup_cli,
+    string_cli,
+    torque_drag_cli,
+)
 from drill_sim_ros.archive.output import open_output
 from drill_sim_ros.model import analysis, telemetry
 from drill_sim_ros.model import kernel as k
@@ -146,6 +152,7 @@ def build_parser() -> argparse.ArgumentParser:
     string_cli.add_parsers(sub)
     stability_cli.add_parser(sub)
     startup_cli.add_parser(sub)
+    torque_drag_cli.add_parser(sub)
     suite_cli.add_parser(sub)
     return parser
 
@@ -464,7 +471,8 @@ def main(argv: Sequence[str] | None = None) -> int:
                 "figures": study_cli.cmd_figures, "modes": string_cli.cmd_modes,
                 "reflection": string_cli.cmd_reflection,
                 "stability": stability_cli.cmd_stability,
-                "startup": startup_cli.cmd_startup}[args.command](args)
+                "startup": startup_cli.cmd_startup,
+                "torque-drag": torque_drag_cli.cmd_torque_drag}[args.command](args)
     except DrillSimError as exc:
         print(f"drill_sim: error: {' '.join(str(exc).splitlines())}", file=sys.stderr)
         return 2

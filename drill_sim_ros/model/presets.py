@@ -146,8 +146,9 @@ def available_presets() -> list[str]:
     return []
 
 
-def preset_from_dict(name: str, data: dict[str, Any]) -> Preset:
-    """Build a :class:`Preset` from a parsed preset mapping."""
+def preset_from_dict(name: str, data: dict[str, Any], base_dir: Path | None = None) -> Preset:
+    """Build a :class:`Preset` from a parsed preset mapping (files it names, such as a
+    well's survey CSV, relative to ``base_dir``)."""
     if not isinstance(data, dict):
         raise ParameterError(f"preset '{name}' must be a mapping")
     check_preset_mapping(data)                # unknown, missing and mistyped keys, one line
@@ -167,7 +168,7 @@ def preset_from_dict(name: str, data: dict[str, Any]) -> Preset:
             raise ParameterError(f"preset '{name}': physical {', '.join(shorthand)} would be "
                                  "ignored: string.sections defines the string (give one)")
         params, scales = scale(physical, string)
-        string = _with_well(name, data, string)
+        string = _with_well(name, data, string, base_dir)
     else:
         for key in ("string", "well"):
             if key in data:
@@ -184,7 +185,8 @@ def preset_from_dict(name: str, data: dict[str, Any]) -> Preset:
                   string=string, friction_weakening=weakening)
 
 
-def _with_well(name: str, data: dict[str, Any], string: StringSpec) -> StringSpec:
+def _with_well(name: str, data: dict[str, Any], string: StringSpec,
+               base_dir: Path | None) -> StringSpec:
     """``string`` in the preset's ``well`` (model.well), which needs the distributed string
     (the wall holds the string along its length); no ``well``: a vertical hole."""
     if data.get("well") is None:
@@ -192,7 +194,7 @@ def _with_well(name: str, data: dict[str, Any], string: StringSpec) -> StringSpe
     if not string.distributed:
         raise ParameterError(f"preset '{name}': 'well' needs string.model: distributed (the "
                              "wall's friction acts along the string)")
-    return replace(string, well=well_from_dict(data["well"]))
+    return replace(string, well=well_from_dict(data["well"], base_dir))
 
 
 SECTION_FIELDS = {f.name: f for f in fields(Section)}
@@ -301,7 +303,7 @@ def load_preset(name_or_path: Any = DEFAULT_PRESET) -> Preset:
     path = preset_path(name_or_path)
     data = read_preset_file(path)
     try:
-        return preset_from_dict(path.stem, data)
+        return preset_from_dict(path.stem, data, path.parent)
     except ParameterError as exc:
         raise ParameterError(f"preset file {path}: {exc}") from None
 

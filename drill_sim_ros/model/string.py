@@ -373,15 +373,16 @@ def _wall_friction(spec: StringSpec, s: Section, top_m: float, points: int,
                    axial: bool) -> tuple[list[float], list[float], float, float]:
     """The wall's friction limits at the ``points`` elements of ``s`` (its top at measured
     depth ``top_m``), SI: static and dynamic torque r_o mu N (axial: force mu N) of each
-    element's share of the normal force (:meth:`Well.normal_force_n`), the stick band
+    element's share of the normal force (:meth:`Well.string_normal_force_n`: weight and
+    tension x curvature, the tension static, rotating off bottom), the stick band
     (rad/s; axial: r_o omega_s m/s) and the surface slip per unit speed (r_o; 1)."""
     well = spec.well
     if well is None or not well.has_friction:
         return [0.0] * points, [0.0] * points, 0.0, 0.0
     arm = 1.0 if axial else s.outer_radius_m
     share = s.length_m / points
-    normal = [well.normal_force_n(top_m + i * share, top_m + (i + 1) * share, s.area_m2,
-                                  s.density_kg_m3) for i in range(points)]
+    normal = [well.string_normal_force_n(spec.sections, top_m + i * share,
+                                         top_m + (i + 1) * share) for i in range(points)]
     mu = well.side_friction
     band = mu.stick_speed_rad_s * (s.outer_radius_m if axial else 1.0)
     return ([arm * mu.static * n for n in normal], [arm * mu.dynamic * n for n in normal],

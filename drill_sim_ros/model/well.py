@@ -1,20 +1,22 @@
 """The well around the string: its path, the mud, and the string's friction on the wall.
 
-A soft-string model (Johancsik, Friesen & Dawson, SPE 11380, 1984, without the bends' term;
-the side-friction model of Aarsnes & Shor, J. Pet. Sci. Eng. 163, 2018): the string lies on
-the low side of the hole, pressed on it by its buoyed weight per metre,
+A soft-string model (Johancsik, Friesen & Dawson, SPE 11380, 1984; the side-friction model
+of Aarsnes & Shor, J. Pet. Sci. Eng. 163, 2018): the string lies along the hole's path
+(:mod:`drill_sim_ros.model.survey`: stations of measured depth, inclination and azimuth,
+minimum curvature between them), pressed on the wall by its buoyed weight's part across
+the hole and, in a bend, by tension x curvature (:mod:`drill_sim_ros.model.torque_drag`,
+eq. 1):
 
-    N(s) = w_b sin(inc(s)),    w_b = (rho_steel - rho_mud) A g,
+    n(s) = | T dt/ds + w_b (e_z - (e_z . t) t) |,    w_b = (rho_steel - rho_mud) A g,
 
-with ``inc`` linear in measured depth s between the survey's points. The tension x curvature
-term of a bend needs an azimuth (a dog-leg); the survey here has inclination only, so it is
-left out, and a build section presses only by its weight. The wall holds a Coulomb friction
-on the string's surface: a torque r_o mu N and an axial force mu N per metre, static up to
-``mu_s`` while the element is within the stick band |speed| <= omega_s (a slip speed of
-r_o omega_s on the surface), sliding at ``mu_d`` outside it. The kernel lumps it at the
-wave guide's junctions the way it lumps the dampers (:func:`drill_sim_ros.model.string
-.wave_line`), and splits the sliding force between rotation and axial motion along the
-surface slip velocity (the torque-and-drag rule: a string that rotates drags little axially).
+the tension T the static one of the string rotating off bottom (or on the WOB). The wall
+holds a Coulomb friction on the string's surface: a torque r_o mu n and an axial force
+mu n per metre, static up to ``mu_s`` while the element is within the stick band
+|speed| <= omega_s (a slip speed of r_o omega_s on the surface), sliding at ``mu_d``
+outside it. The kernel lumps it at the wave guide's junctions the way it lumps the dampers
+(:func:`drill_sim_ros.model.string.wave_line`), and splits the sliding force between
+rotation and axial motion along the surface slip velocity (the torque-and-drag rule: a
+string that rotates drags little axially).
 
 No well (``None``) is a vertical hole without wall contact: the model as before it.
 SI throughout; ROS-free.
@@ -22,17 +24,19 @@ SI throughout; ROS-free.
 
 from __future__ import annotations
 
-import itertools
-import math
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
+import numpy as np
+
+from drill_sim_ros.model import torque_drag
 from drill_sim_ros.model.checks import check_known_keys, number_in
 from drill_sim_ros.model.errors import ParameterError
+from drill_sim_ros.model.survey import COLUMNS, Survey, read_survey_csv, survey_from_rows
 
-GRAVITY_M_S2 = 9.80665
+GRAVITY_M_S2 = torque_drag.GRAVITY_M_S2
 WELL_KEYS = ("survey", "mud_density_kg_m3", "side_friction")
-SURVEY_KEYS = ("md_m", "inclination_deg")
 FRICTION_KEYS = ("static", "dynamic", "stick_speed_rad_s")
 
 
@@ -48,29 +52,34 @@ class SideFriction:
 
 @dataclass(frozen=True)
 class Well:
-    """A well path (measured depth m, inclination deg; linear between points, constant past
-    the last), the mud density (kg/m^3; 0: in air) and the side friction."""
+    """A well path (:class:`Survey`: minimum curvature between stations, straight past the
+    last), the mud density (kg/m^3; 0: in air) and the side friction."""
 
-    survey: tuple[tuple[float, float], ...] = ((0.0, 0.0),)
+    survey: Survey = field(default_factory=Survey)
     mud_density_kg_m3: float = 0.0
     side_friction: SideFriction = field(default_factory=SideFriction)
 
     def inclination_rad(self, md_m: float) -> float:
-        """The inclination at measured depth ``md_m``, linear between survey points."""
-        pts = self.survey
-        if md_m <= pts[0][0]:
-            return math.radians(pts[0][1])
-        for (md0, inc0), (md1, inc1) in itertools.pairwise(pts):
-            if md_m <= md1:
-                return math.radians(inc0 + (inc1 - inc0) * (md_m - md0) / (md1 - md0))
-        return math.radians(pts[-1][1])
+        """The inclination at measured depth ``md_m`` on the minimum-curvature path (in a
+        2-D well: linear between stations)."""
+        return float(self.survey.attitude_rad(md_m)[0][0])
+
+    def string_normal_force_n(self, sections: tuple[Any, ...], top_m: float,
+                              bottom_m: float, bit_force_n: float = 0.0) -> float:
+        """The wall's normal force between ``top_m`` and ``bottom_m`` on the string of
+        ``sections`` (hung from md 0), N: weight across the hole and tension x curvature,
+        the tension the static one rotating with ``bit_force_n`` on the bit (0 off bottom;
+        :func:`torque_drag.element_normal_force_n`). What the string's builder reads."""
+        return torque_drag.element_normal_force_n(self.survey, tuple(sections),
+                                                  self.mud_density_kg_m3, top_m, bottom_m,
+                                                  bit_force_n)
 
     def normal_force_n(self, top_m: float, bottom_m: float, area_m2: float,
                        density_kg_m3: float, pieces: int = 64) -> float:
-        """The wall's normal force on the string between measured depths ``top_m`` and
+        """The buoyed weight's part across the hole between measured depths ``top_m`` and
         ``bottom_m``: the integral of (rho - rho_mud) A g sin(inc) ds (midpoint rule on
-        ``pieces`` pieces, exact where the inclination is constant)."""
-        return self._buoyed_integral(math.sin, top_m, bottom_m, area_m2, density_kg_m3,
+        ``pieces`` pieces), WITHOUT the bend term (:meth:`string_normal_force_n` has it)."""
+        return self._buoyed_integral(np.sin, top_m, bottom_m, area_m2, density_kg_m3,
                                      pieces)
 
     def axial_weight_n(self, top_m: float, bottom_m: float, area_m2: float,
@@ -78,15 +87,15 @@ class Well:
         """The buoyed weight along the hole's axis between ``top_m`` and ``bottom_m``: the
         integral of (rho - rho_mud) A g cos(inc) ds, what the string hangs from the hook
         with it when nothing drags (the hook load at rest off bottom)."""
-        return self._buoyed_integral(math.cos, top_m, bottom_m, area_m2, density_kg_m3,
+        return self._buoyed_integral(np.cos, top_m, bottom_m, area_m2, density_kg_m3,
                                      pieces)
 
     def _buoyed_integral(self, along: Any, top_m: float, bottom_m: float, area_m2: float,
                          density_kg_m3: float, pieces: int) -> float:
         w_b = (density_kg_m3 - self.mud_density_kg_m3) * area_m2 * GRAVITY_M_S2
         ds = (bottom_m - top_m) / pieces
-        return w_b * ds * sum(along(self.inclination_rad(top_m + (i + 0.5) * ds))
-                              for i in range(pieces))
+        inc = self.survey.attitude_rad(top_m + (np.arange(pieces) + 0.5) * ds)[0]
+        return float(w_b * ds * np.sum(along(inc)))
 
     @property
     def has_friction(self) -> bool:
@@ -97,31 +106,28 @@ def _number(where: str, value: Any, low: float, high: float) -> float:
     return number_in(f"'{where}'", value, low, high)
 
 
-def _survey(raw: Any) -> tuple[tuple[float, float], ...]:
-    """The survey list, checked: md increasing from 0, inclination in [0, 180] deg."""
+def _survey(raw: Any, base_dir: Path | None) -> Survey:
+    """The survey: a list of stations {md_m, inclination_deg, azimuth_deg (optional,
+    0)}, or the name of a CSV file with those columns (relative to ``base_dir``, the
+    preset's directory); md from 0 and increasing, inclination in [0, 180] deg, azimuth
+    in [0, 360] deg."""
+    if isinstance(raw, str) and raw:
+        path = Path(raw).expanduser()
+        if not path.is_absolute() and base_dir is not None:
+            path = base_dir / path
+        return read_survey_csv(path)
     if not isinstance(raw, list) or not raw:
-        raise ParameterError("'well.survey' must be a list of {md_m, inclination_deg}, "
-                             "starting at md_m 0")
-    points = []
+        raise ParameterError("'well.survey' must be a list of {md_m, inclination_deg, "
+                             "azimuth_deg} starting at md_m 0, or a CSV file's name")
     for i, point in enumerate(raw):
-        where = f"well.survey[{i}]"
         if not isinstance(point, dict):
-            raise ParameterError(f"'{where}' must be a mapping of md_m, inclination_deg")
-        check_known_keys(point, SURVEY_KEYS, where)
-        missing = [key for key in SURVEY_KEYS if key not in point]
-        if missing:
-            raise ParameterError(f"'{where}' needs {', '.join(missing)}")
-        points.append((_number(f"{where}.md_m", point["md_m"], 0.0, 1e5),
-                       _number(f"{where}.inclination_deg", point["inclination_deg"], 0.0,
-                               180.0)))
-    if points[0][0] != 0.0:
-        raise ParameterError(f"'well.survey[0].md_m' = {points[0][0]:g} must be 0 (the "
-                             "survey starts at the surface)")
-    for i in range(1, len(points)):
-        if points[i][0] <= points[i - 1][0]:
-            raise ParameterError(f"'well.survey[{i}].md_m' = {points[i][0]:g} must be "
-                                 f"greater than the point before ({points[i - 1][0]:g})")
-    return tuple(points)
+            raise ParameterError(f"'well.survey[{i}]' must be a mapping of "
+                                 f"{', '.join(COLUMNS)}")
+        check_known_keys(point, COLUMNS, f"well.survey[{i}]")
+
+    def where(i: int | None, column: str | None) -> str:
+        return "'well.survey'" if i is None else f"'well.survey[{i}].{column}'"
+    return survey_from_rows(raw, where)
 
 
 def _friction(raw: Any) -> SideFriction:
@@ -141,14 +147,16 @@ def _friction(raw: Any) -> SideFriction:
     return SideFriction(static, dynamic, band)
 
 
-def well_from_dict(raw: Any) -> Well:
-    """A preset's ``well`` mapping (module doc), each error one line naming the key."""
+def well_from_dict(raw: Any, base_dir: Path | None = None) -> Well:
+    """A preset's ``well`` mapping (module doc), each error one line naming the key; a
+    survey file's name is read relative to ``base_dir`` (the preset's directory)."""
     if not isinstance(raw, dict):
         raise ParameterError(f"'well' must be a mapping of {', '.join(WELL_KEYS)}")
     check_known_keys(raw, WELL_KEYS, "well")
     if "survey" not in raw:
-        raise ParameterError("'well' needs a survey: [{md_m: 0, inclination_deg: 0}, ...]")
-    return Well(_survey(raw["survey"]),
+        raise ParameterError("'well' needs a survey: [{md_m: 0, inclination_deg: 0, "
+                             "azimuth_deg: 0}, ...] or a CSV file's name")
+    return Well(_survey(raw["survey"], base_dir),
                 _number("well.mud_density_kg_m3", raw.get("mud_density_kg_m3", 0.0), 0.0,
                         5000.0),
                 _friction(raw.get("side_friction", {})))
@@ -157,7 +165,8 @@ def well_from_dict(raw: Any) -> Well:
 def well_to_dict(well: Well) -> dict[str, Any]:
     """The preset mapping of ``well`` (what :func:`well_from_dict` reads)."""
     f = well.side_friction
-    return {"survey": [{"md_m": md, "inclination_deg": inc} for md, inc in well.survey],
+    return {"survey": [dict(zip(COLUMNS, station, strict=True))
+                       for station in well.survey.stations],
             "mud_density_kg_m3": well.mud_density_kg_m3,
             "side_friction": {"static": f.static, "dynamic": f.dynamic,
                               "stick_speed_rad_s": f.stick_speed_rad_s}}
