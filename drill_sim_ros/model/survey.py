@@ -145,10 +145,11 @@ def survey_from_rows(rows: list[dict[str, Any]], where: Any) -> Survey:
 
 
 def _value(row: dict[str, Any], column: str, label: str) -> float:
-    """``row[column]`` as a number in its range (azimuth 0 when absent), or one line."""
-    if column not in row or row[column] in (None, ""):
-        if column == "azimuth_deg":
-            return 0.0
+    """``row[column]`` as a number in its range, or one line; azimuth 0 when the row has no
+    such key (a CSV's short row has it, empty: that is an error)."""
+    if column == "azimuth_deg" and column not in row:
+        return 0.0                              # the old 2-D form: no azimuth key at all
+    if row.get(column) in (None, ""):
         raise ParameterError(f"{label} is missing")
     low, high = RANGES[column]
     number = as_number(row[column])

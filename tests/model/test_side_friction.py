@@ -284,11 +284,12 @@ def breakaway(points: int) -> Breakaway:
 
 def test_static_breakaway_torque_is_the_integral_of_static_friction() -> None:
     """The bit first turns when every junction has broken loose: the torque at the top is
-    then the integral of r_o mu_s N along the string (8119.03 N m, 6241.28 of it without the bend term). Tolerance 2 Z w0
-    (29.7 N m, 0.48 %): the lumped elements hold their limit exactly (the steady torque
-    steps by the limit at each junction whatever its speed); what remains is the dynamic
+    then the integral of r_o mu_s N along the string (8119.03 N m; 6241.28 without the bend
+    term). Tolerance 2 Z w0 (29.7 N m, 0.37 %): the lumped elements hold their limit
+    exactly (the steady torque steps by the limit at each junction whatever its speed);
+    what remains is the dynamic
     excess of the waves the break-aways launch, of the order of a junction's own excess
-    push - limit = 2 Z w at the drive's speed. (Measured: +1.7 N m.)"""
+    push - limit = 2 Z w at the drive's speed. (Measured: +0.5 N m.)"""
     b = breakaway(4)
     expected = quad(lambda s: wall_torque_per_m(s, MU_S), 0.0, LENGTH_M)
     assert b.max_speed_rad_s <= BREAK_BAND          # Karnopp's static zone throughout
