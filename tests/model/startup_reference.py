@@ -10,8 +10,10 @@ Numerical method (deliberately NOT the method of characteristics):
     neighbouring elements, node 0 also carries the top-drive inertia, the last
     node also carries J_bit;
   * side friction is lumped at every node: static / dynamic capacity
-    Fs_j = mu_s * int_{trib(j)} r_o (rho - rho_mud) A g sin(inc) dx (exact
-    analytic integral over the node's tributary length), Fd_j likewise;
+    Fs_j = mu_s * int_{trib(j)} r_o N dx over the node's tributary length, N the
+    soft string's |T inc' - (rho - rho_mud) A g sin(inc)| (weight and the tension
+    x build term of its 2-D well, T the hanging tension; ``friction_cumulative``),
+    Fd_j likewise;
   * time stepping: symplectic (semi-implicit) Euler -- velocities from the
     elastic + motor torques at the old angles, angles from the new velocities;
     viscous damping implicit; friction as an impulse at the velocity level
@@ -38,6 +40,7 @@ Optional numeric keys in inputs: "dx_m" (default 2.0), "cfl" (default 0.5),
 "return_series" (bool), "stick_law" ("impulse" | "karnopp_snap").  Optional
 per-section "shear_modulus_pa", "density_kg_m3" override the global values.
 """
+import itertools
 import json
 import math
 import sys
@@ -85,41 +88,39 @@ def inclination(inp, x):
     return np.interp(x, md, inc)  # linear in MD, held constant outside
 
 
-def _int_sin(a, b, th_a, th_b):
-    """exact int_a^b sin(theta) dx for theta linear between th_a and th_b."""
-    d = 0.5 * (th_b - th_a)
-    return (b - a) * np.sin(0.5 * (th_a + th_b)) * np.sinc(d / np.pi)
-
-
-def friction_cumulative(inp, x, mu=1.0):
-    """W(x) = int_0^x mu r_o (rho - rho_mud) A g sin(inc) dx   [N m], exact."""
+def friction_cumulative(inp, x, mu=1.0, cell_m=0.25):
+    """W(x) = int_0^x mu r_o N dx [N m]: N the soft string's normal force per metre in
+    its 2-D well, |T inc' - w sin(inc)| (w = (rho - rho_mud) A g; tension T along the
+    curved path pulls it towards the centre of the build, the high side, against the
+    weight's part across the hole), T(x) = int_x^L w cos(inc) the string hanging off
+    bottom; midpoint rule on cells of at most ``cell_m`` between the breakpoints (survey
+    points and section ends), where inc is linear."""
     secs = sections_table(inp)
-    md, _ = _survey(inp)
+    md, inc_pts = _survey(inp)
     rho_m = float(inp.get("mud_density_kg_m3", 0.0))
     Ltot = secs[-1]["x1"]
     bps = {0.0, Ltot}
-    for s in secs:
-        bps.add(s["x0"])
-        bps.add(s["x1"])
-    for m in md:
-        if 0.0 < m < Ltot:
-            bps.add(float(m))
+    for sec in secs:
+        bps.update((sec["x0"], sec["x1"]))
+    bps.update(float(m) for m in md if 0.0 < m < Ltot)
     bps = np.array(sorted(bps))
-    # coefficient (per unit sin) on each piece
-    mids = 0.5 * (bps[:-1] + bps[1:])
-    coef = np.empty(len(mids))
-    for k, xm in enumerate(mids):
-        for s in secs:
-            if s["x0"] <= xm <= s["x1"]:
-                coef[k] = s["ro"] * (s["rho"] - rho_m) * s["A"] * G0
-                break
-    th = inclination(inp, bps)
-    piece = coef * _int_sin(bps[:-1], bps[1:], th[:-1], th[1:])
-    cum = np.concatenate([[0.0], np.cumsum(piece)])
-    x = np.clip(np.asarray(x, float), 0.0, Ltot)
-    k = np.clip(np.searchsorted(bps, x, side="right") - 1, 0, len(mids) - 1)
-    part = coef[k] * _int_sin(bps[k], x, th[k], inclination(inp, x))
-    return mu * (cum[k] + part)
+    edges = np.concatenate([np.linspace(a, b, max(1, math.ceil((b - a) / cell_m)) + 1)[:-1]
+                            for a, b in itertools.pairwise(bps)] + [bps[-1:]])
+    mids, h = 0.5 * (edges[:-1] + edges[1:]), np.diff(edges)
+    w, ro = np.empty(mids.size), np.empty(mids.size)
+    for sec in secs:
+        inside = (mids >= sec["x0"]) & (mids <= sec["x1"])
+        w[inside] = (sec["rho"] - rho_m) * sec["A"] * G0
+        ro[inside] = sec["ro"]
+    th = inclination(inp, mids)
+    slopes = np.diff(inc_pts) / np.diff(md)
+    leg = np.searchsorted(md, mids, side="right") - 1
+    build = np.where(leg < len(slopes), slopes[np.clip(leg, 0, len(slopes) - 1)], 0.0)
+    below = np.cumsum((w * np.cos(th) * h)[::-1])[::-1]            # T at each cell's top
+    tension = below - 0.5 * w * np.cos(th) * h                     # ... and at its middle
+    normal = np.abs(tension * build - w * np.sin(th))
+    cum = np.concatenate([[0.0], np.cumsum(ro * normal * h)])
+    return mu * np.interp(np.clip(np.asarray(x, float), 0.0, Ltot), edges, cum)
 
 
 def analytic(inp, n_quad=200000):
