@@ -116,16 +116,21 @@ def _summary(s: dict[str, Any]) -> str:
 
 
 def _plot(path: Path, preset: Preset, wob_n: float) -> None:
-    """Three panels: the path (true vertical depth against horizontal departure), the
-    tension and the rotating torque against measured depth."""
+    """Four panels: the path in plan (north against east) and in section (true vertical
+    depth against horizontal departure), the tension and the rotating torque against
+    measured depth."""
     from drill_sim_ros.control.plot import pyplot
     plt = pyplot()
     well, loads = require_well(preset), torque_drag_of(preset, wob_n)
-    fig, (ax_path, ax_t, ax_m) = plt.subplots(1, 3, figsize=(13.0, 6.0))
+    fig, (ax_plan, ax_path, ax_t, ax_m) = plt.subplots(1, 4, figsize=(16.0, 6.0))
     pos = well.survey.positions_m(loads.depth_m)
+    ax_plan.plot(pos[:, 0], pos[:, 1], color="black")
+    ax_plan.set(xlabel="east, m", ylabel="north, m", title="plan")
+    ax_plan.set_aspect("equal", adjustable="datalim")
+    ax_plan.grid(alpha=0.3)
     ax_path.plot(np.hypot(pos[:, 0], pos[:, 1]), pos[:, 2], color="black")
     ax_path.set(xlabel="horizontal departure, m", ylabel="true vertical depth, m",
-                title="path")
+                title="section")
     for values, label, color in ((loads.pickup_n, "pick-up", "tab:red"),
                                  (loads.rotating_n, "rotating", "tab:green"),
                                  (loads.slackoff_n, "slack-off", "tab:blue")):
