@@ -103,6 +103,11 @@ def test_the_break_away_matches_the_reference_within_a_few_per_cent() -> None:
         refs[1]["motor_torque_nm"]["mean"], rel=0.01)
 
 
+@pytest.mark.xfail(strict=True, reason="with the bend term (2026-12-06) the same normal "
+                   "force in both (to 2e-9) gives different cycles: at 20 rpm the package "
+                   "sticks and slips (period 5.00 s) where the reference at 2 m rotates "
+                   "steadily; at 15 rpm both stick and slip, periods 5.05 s (package, 32 "
+                   "and 64 points) against 6.3-7.0 s (reference, 4-1 m); issue 50 items 1-2")
 def test_off_bottom_stick_slip_and_its_period_match_the_reference() -> None:
     """20 rpm: the wall's static friction above its dynamic one makes the string stick and
     slip off bottom near the first mode's period, in both; the period within 10 %.
