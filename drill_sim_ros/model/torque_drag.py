@@ -46,7 +46,7 @@ from __future__ import annotations
 import functools
 import itertools
 from dataclasses import dataclass
-from typing import Protocol
+from typing import Any, Protocol
 
 import numpy as np
 
@@ -179,13 +179,14 @@ def _cumulative_normal(survey: Survey, sections: tuple[StringSection, ...],
 
 
 def element_normal_force_n(survey: Survey, sections: tuple[StringSection, ...],
-                           mud_density_kg_m3: float, top_m: float, bottom_m: float,
-                           bit_force_n: float = 0.0) -> float:
+                           mud_density_kg_m3: float, top_m: Any, bottom_m: Any,
+                           bit_force_n: float = 0.0) -> Any:
     """The wall's normal force on the string between measured depths ``top_m`` and
-    ``bottom_m``, N: eq. (1) with the rotating static tension (the bit carrying
-    ``bit_force_n``, compressive; 0 off bottom), integrated over cells of at most
-    ``MAX_CELL_M`` (the profile is computed once per string and well, then read by
-    interpolating its running integral)."""
+    ``bottom_m`` (floats, or arrays of elements: then an array), N: eq. (1) with the
+    rotating static tension (the bit carrying ``bit_force_n``, compressive; 0 off
+    bottom), integrated over cells of at most ``MAX_CELL_M`` (the profile is computed once
+    per string and well, then read by interpolating its running integral)."""
     edges, running = _cumulative_normal(survey, tuple(sections), mud_density_kg_m3,
                                         float(bit_force_n))
-    return float(np.interp(bottom_m, edges, running) - np.interp(top_m, edges, running))
+    force = np.interp(bottom_m, edges, running) - np.interp(top_m, edges, running)
+    return float(force) if np.ndim(force) == 0 else force

@@ -64,10 +64,11 @@ class Well:
         2-D well: linear between stations)."""
         return float(self.survey.attitude_rad(md_m)[0][0])
 
-    def string_normal_force_n(self, sections: tuple[Any, ...], top_m: float,
-                              bottom_m: float, bit_force_n: float = 0.0) -> float:
-        """The wall's normal force between ``top_m`` and ``bottom_m`` on the string of
-        ``sections`` (hung from md 0), N: weight across the hole and tension x curvature,
+    def string_normal_force_n(self, sections: tuple[Any, ...], top_m: Any, bottom_m: Any,
+                              bit_force_n: float = 0.0) -> Any:
+        """The wall's normal force between ``top_m`` and ``bottom_m`` (floats, or arrays of
+        elements: an array) on the string of ``sections`` (hung from md 0), N: weight
+        across the hole and tension x curvature,
         the tension the static one rotating with ``bit_force_n`` on the bit (0 off bottom;
         :func:`torque_drag.element_normal_force_n`). What the string's builder reads."""
         return torque_drag.element_normal_force_n(self.survey, tuple(sections),

@@ -174,6 +174,8 @@ def test_the_builders_elements_add_up_to_the_string() -> None:
     cuts = np.linspace(0.0, preset.string.length_m, 38)
     pieces = [well.string_normal_force_n(sections, a, b) for a, b in itertools.pairwise(cuts)]
     assert sum(pieces) == pytest.approx(total, rel=1e-12)
+    at_once = well.string_normal_force_n(sections, cuts[:-1], cuts[1:])
+    np.testing.assert_array_equal(at_once, pieces)             # one call for all elements
 
 
 BUILD_TURN_SURVEY = [{"md_m": 0, "inclination_deg": 0, "azimuth_deg": 0},
