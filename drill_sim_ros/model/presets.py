@@ -51,7 +51,7 @@ from drill_sim_ros.model.string import (
 )
 from drill_sim_ros.model.top_drive import TopDrive, TopDrivePhysical, top_drive_from_dict
 from drill_sim_ros.model.validate_input import check_preset_mapping, read_preset_file
-from drill_sim_ros.model.well import Well, well_from_dict
+from drill_sim_ros.model.well import well_from_dict
 
 DEFAULT_PRESET = "field_8p5in_shale"
 GRAVITY_M_S2 = 9.80665
@@ -312,12 +312,12 @@ def submerged_string_weight_n(preset: Preset | None,
                               mud_density_kg_m3: float | None = None) -> float:
     """Buoyed weight of pipe + BHA: steel mass x g x (1 - rho_mud / rho_steel); 0 if none
     (the mud ``MUD_DENSITY_KG_M3`` unless given). In a preset's well: the weight along the
-    hole's axis in its own mud (:meth:`Well.axial_weight_n`), the wall carrying the rest."""
+    hole's axis in its own mud (:meth:`Well.hanging_weight_n`), the wall carrying the rest."""
     if preset is None or preset.physical is None:
         return 0.0
     well = preset.string.well
     if well is not None and mud_density_kg_m3 is None:
-        return _hanging_weight_n(preset.string, well)
+        return well.hanging_weight_n(preset.string.sections)
     if mud_density_kg_m3 is None:
         mud_density_kg_m3 = MUD_DENSITY_KG_M3
     phys = preset.physical
@@ -328,12 +328,3 @@ def submerged_string_weight_n(preset: Preset | None,
         * phys.pipe_length_m
     mass_kg = pipe_m3 * phys.density_kg_m3 + structure(phys).mass_kg
     return mass_kg * GRAVITY_M_S2 * (1.0 - mud_density_kg_m3 / phys.density_kg_m3)
-
-
-def _hanging_weight_n(spec: StringSpec, well: Well) -> float:
-    """The string's buoyed weight along the axis of ``well``, section by section."""
-    total, top_m = 0.0, 0.0
-    for s in spec.sections:
-        total += well.axial_weight_n(top_m, top_m + s.length_m, s.area_m2, s.density_kg_m3)
-        top_m += s.length_m
-    return total

@@ -168,11 +168,25 @@ def _dragged(cells: Cells, signed_mu: float, bit_force_n: float) -> np.ndarray:
 
 
 @functools.lru_cache(maxsize=32)
+def _cells(survey: Survey, sections: tuple[StringSection, ...],
+           mud_density_kg_m3: float) -> Cells:
+    """:func:`string_cells` once per string and well (the builder and the hook ask)."""
+    return string_cells(survey, sections, mud_density_kg_m3)
+
+
+def hanging_weight_n(survey: Survey, sections: tuple[StringSection, ...],
+                     mud_density_kg_m3: float) -> float:
+    """The string's buoyed weight along the hole's axis, N: the rotating tension at the
+    top off bottom, what the hook carries when nothing drags."""
+    return float(rotating_tension_n(_cells(survey, tuple(sections), mud_density_kg_m3))[0])
+
+
+@functools.lru_cache(maxsize=32)
 def _cumulative_normal(survey: Survey, sections: tuple[StringSection, ...],
                        mud_density_kg_m3: float,
                        bit_force_n: float) -> tuple[np.ndarray, np.ndarray]:
     """Edges and the rotating normal force integrated from the top to each edge, N."""
-    cells = string_cells(survey, sections, mud_density_kg_m3)
+    cells = _cells(survey, sections, mud_density_kg_m3)
     tension = rotating_tension_n(cells, bit_force_n)
     normal = normal_per_m(cells, 0.5 * (tension[:-1] + tension[1:]))
     return cells.edges_m, np.append(0.0, np.cumsum(normal * cells.length_m))

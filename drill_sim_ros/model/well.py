@@ -80,23 +80,17 @@ class Well:
         """The buoyed weight's part across the hole between measured depths ``top_m`` and
         ``bottom_m``: the integral of (rho - rho_mud) A g sin(inc) ds (midpoint rule on
         ``pieces`` pieces), WITHOUT the bend term (:meth:`string_normal_force_n` has it)."""
-        return self._buoyed_integral(np.sin, top_m, bottom_m, area_m2, density_kg_m3,
-                                     pieces)
-
-    def axial_weight_n(self, top_m: float, bottom_m: float, area_m2: float,
-                       density_kg_m3: float, pieces: int = 64) -> float:
-        """The buoyed weight along the hole's axis between ``top_m`` and ``bottom_m``: the
-        integral of (rho - rho_mud) A g cos(inc) ds, what the string hangs from the hook
-        with it when nothing drags (the hook load at rest off bottom)."""
-        return self._buoyed_integral(np.cos, top_m, bottom_m, area_m2, density_kg_m3,
-                                     pieces)
-
-    def _buoyed_integral(self, along: Any, top_m: float, bottom_m: float, area_m2: float,
-                         density_kg_m3: float, pieces: int) -> float:
         w_b = (density_kg_m3 - self.mud_density_kg_m3) * area_m2 * GRAVITY_M_S2
         ds = (bottom_m - top_m) / pieces
         inc = self.survey.attitude_rad(top_m + (np.arange(pieces) + 0.5) * ds)[0]
-        return float(w_b * ds * np.sum(along(inc)))
+        return float(w_b * ds * np.sum(np.sin(inc)))
+
+    def hanging_weight_n(self, sections: tuple[Any, ...]) -> float:
+        """The buoyed weight of the string of ``sections`` along the hole's axis, N: what
+        it hangs from the hook with when nothing drags (the hook load at rest off bottom;
+        :func:`torque_drag.hanging_weight_n`, the static rotating hook load)."""
+        return torque_drag.hanging_weight_n(self.survey, tuple(sections),
+                                            self.mud_density_kg_m3)
 
     @property
     def has_friction(self) -> bool:

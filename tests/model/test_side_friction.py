@@ -704,3 +704,11 @@ def test_off_bottom_needs_the_distributed_string() -> None:
         sim.start_at_rest()
     assert not sim.off_bottom
 
+
+
+def test_the_hook_carries_the_weight_along_the_axis() -> None:
+    """At rest off bottom the hook carries the buoyed weight along the hole's axis: the
+    tension at the top in closed form (0.5 m midpoint cells in the package: 1e-6)."""
+    preset = preset_from_dict("t", preset_data())
+    expected = float(tension_n(np.array([0.0]))[0])
+    assert submerged_string_weight_n(preset) == pytest.approx(expected, rel=1e-6)
