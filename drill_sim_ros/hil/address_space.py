@@ -12,6 +12,7 @@ Units are the UNECE Recommendation 20 common codes that OPC UA's EUInformation c
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 NAMESPACE_URI = "urn:drill_sim_ros"
@@ -90,6 +91,39 @@ VARIABLES = (
 VARIABLE_BY_NAME = {v.name: v for v in VARIABLES}
 SAMPLE_VARIABLES = tuple(v for v in VARIABLES if v.source is not None)
 STEP_METHOD = "Step"
+
+
+# A setting read from sim_node is given in decimal (a YAML or command-line value), so 15
+# significant digits hold it whole; a scaled preset's SI round trip (x / c * c) can add an ulp
+# (50000.00000000001), which :func:`exact_setting` takes off.
+SETTING_DIGITS = 15
+# A write within this many ulps of an EURange bound is in range (and clamped to the bound):
+# 300 rev/min is 300*pi/30 = 31.41592653589793 or 300/(30/pi) = 31.415926535897928 rad/s,
+# depending on how a PLC writes the conversion.
+RANGE_TOLERANCE_ULPS = 4
+
+
+def exact_setting(value: float) -> float:
+    """A decimal setting without the last-digit drift of a unit round trip."""
+    return float(f"{value:.{SETTING_DIGITS}g}") if math.isfinite(value) else value
+
+
+def rad_s_of_rpm(rpm: float) -> float:
+    """rev/min -> rad/s as rpm*pi/30, so 300 rev/min gives the double nearest 10*pi."""
+    return exact_setting(rpm) * math.pi / 30.0
+
+
+def within(value: float, low: float, high: float) -> float | None:
+    """``value`` in [``low``, ``high``] (one within RANGE_TOLERANCE_ULPS of a bound: that
+    bound), or None if it is not finite or outside."""
+    if not math.isfinite(value):
+        return None
+    if low <= value <= high:
+        return value
+    for bound in (low, high):
+        if abs(value - bound) <= RANGE_TOLERANCE_ULPS * math.ulp(bound):
+            return bound
+    return None
 
 
 def unece_unit_id(code: str) -> int:

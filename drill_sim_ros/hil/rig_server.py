@@ -24,6 +24,7 @@ from __future__ import annotations
 import asyncio
 import logging
 import math
+import weakref
 from collections.abc import Awaitable, Callable, Sequence
 from dataclasses import dataclass
 from datetime import datetime, timedelta, timezone
@@ -33,6 +34,7 @@ from asyncua import Server, ua
 from asyncua.common.callback import CallbackType
 
 from drill_sim_ros.control.command import Command
+from drill_sim_ros.hil import sessions
 from drill_sim_ros.hil.address_space import (
     DRIVE_MODES,
     NAMESPACE_URI,
@@ -42,10 +44,15 @@ from drill_sim_ros.hil.address_space import (
     VARIABLE_BY_NAME,
     VARIABLES,
     Variable,
+    exact_setting,
     node_id,
+    rad_s_of_rpm,
     unece_unit_id,
+    within,
 )
 from drill_sim_ros.hil.security import APPLICATION_URI, PasswordUser, Security
+from drill_sim_ros.hil.sessions import SessionUsers
+from drill_sim_ros.model.top_drive import limit_of_setting
 
 _log = logging.getLogger(__name__)
 SIM_EPOCH = datetime(1970, 1, 1, tzinfo=timezone.utc)
@@ -71,6 +78,22 @@ class RigSettings:
     wob_n: float
     drive_mode: str
     lockstep: bool
+
+    @classmethod
+    def of_sim(cls, sim: dict[str, Any]) -> RigSettings:
+        """The settings of sim_node's parameters (``SIM_PARAMETERS`` of
+        :mod:`drill_sim_ros.ros.sim_link`), in SI without a unit round trip's last-digit drift
+        (:func:`exact_setting`, :func:`rad_s_of_rpm`); sim_node's kinematic mode, which takes
+        speed setpoints too, shows as ``speed``."""
+        torque_nm = limit_of_setting(sim["top_drive.max_torque_nm"])     # 0: no limit (inf)
+        return cls(
+            max_speed_rad_s=rad_s_of_rpm(sim["limits.max_surface_rpm"]),
+            max_torque_nm=exact_setting(torque_nm),
+            max_wob_n=exact_setting(sim["limits.max_wob_n"]),
+            speed_rad_s=rad_s_of_rpm(sim["model.surface_rpm"]),
+            wob_n=sim["model.applied_wob_n"],
+            drive_mode="torque" if sim["top_drive.mode"] == "torque" else "speed",
+            lockstep=bool(sim["lockstep"]) and sim["lockstep_trigger"] == "command")
 
     def eu_range(self, name: str) -> tuple[float, float] | None:
         return {"SpeedSetpoint": (0.0, self.max_speed_rad_s),
@@ -144,6 +167,7 @@ class Rig:
         self.samples_in = 0
         self.restarts = 0
         self._waiters: list[asyncio.Future[int | None]] = []
+        self._owner: weakref.ref[Any] | None = None
 
     # -- the address space ----------------------------------------------------------------
     async def build(self, server: Server, index: int) -> dict[ua.NodeId, str]:
@@ -209,22 +233,54 @@ class Rig:
             _log.info("%s follows its sim_node: %s", self.name, settings)
 
     # -- client writes --------------------------------------------------------------------
-    def check(self, name: str, item: ua.WriteValue) -> tuple[int | None, Any]:
-        """(None, value) if writing ``item`` to ``name`` is allowed, else (Bad code, value)."""
+    def check(self, name: str, item: ua.WriteValue, user: Any = None
+              ) -> tuple[int | None, Any]:
+        """(None, value) if ``user``'s session may write ``item`` to ``name``, else (Bad code,
+        value); a value within a few ulps of an EURange bound is that bound."""
         variable = VARIABLE_BY_NAME[name]
         data = item.Value.Value
         value = data.Value if data is not None else None
         if item.AttributeId != ua.AttributeIds.Value or not variable.writable:
             return Bad.BadNotWritable, value
-        if data is None or data.VariantType != getattr(ua.VariantType, variable.type_name):
+        if (data is None or data.is_array or data.Dimensions
+                or data.VariantType != getattr(ua.VariantType, variable.type_name)):
             return Bad.BadTypeMismatch, value
+        if not self._may_write(user):
+            return Bad.BadUserAccessDenied, value
         if name == "DriveMode":
             return (None if value in DRIVE_MODES else Bad.BadOutOfRange), value
         if name == "CommandCounter":
             return self._check_counter(value), value
-        low, high = self.settings.eu_range(name)
-        return (None if math.isfinite(value) and low <= value <= high
-                else Bad.BadOutOfRange), value
+        inside = within(value, *self.settings.eu_range(name))
+        return (None, inside) if inside is not None else (Bad.BadOutOfRange, value)
+
+    # -- one writer ------------------------------------------------------------------------
+    @property
+    def owner(self) -> Any:
+        """The session (its User object) that owns the setpoints, or None."""
+        return None if self._owner is None else self._owner()
+
+    def _may_write(self, user: Any) -> bool:
+        owner = self.owner
+        return owner is None or owner is user
+
+    def _claim(self, user: Any) -> None:
+        """The first session that writes owns the setpoints (until it closes)."""
+        if self.owner is None and user is not None:
+            self._owner = weakref.ref(user)
+            _log.info("%s: the setpoints are %s's", self.name, getattr(user, "name", user))
+
+    def check_request(self, writes: dict[str, Any]) -> tuple[int, str] | None:
+        """(Bad code, why) if a request's values, each allowed, are not as a whole: a new
+        setpoint with the CommandCounter already sent is stale."""
+        if writes.get("CommandCounter", -1) != self.values["CommandCounter"]:
+            return None
+        changed = [n for n in (*SETPOINTS, "DriveMode") if n in writes
+                   and writes[n] != self.values[n]]
+        if changed:
+            return Bad.BadInvalidState, (f"stale: {', '.join(changed)} with CommandCounter "
+                                         f"{writes['CommandCounter']}, already sent")
+        return None
 
     def _check_counter(self, counter: int) -> int | None:
         if counter == self.values["CommandCounter"]:
@@ -257,9 +313,10 @@ class Rig:
             await self.refuse("DriveMode", Bad.BadInvalidState, mode, f"sim_node: {reason}")
         self._in_force = _unset_setpoints()            # the new mode's setpoint goes next
 
-    def accept(self, writes: dict[str, Any]) -> None:
+    def accept(self, writes: dict[str, Any], user: Any = None) -> None:
         """Take a checked request's values (asyncua applies them to the nodes after this);
-        a new CommandCounter sends the command."""
+        a new CommandCounter sends the command. The writer owns the setpoints from now."""
+        self._claim(user)
         counter = writes.get("CommandCounter")
         send = counter is not None and counter != self.values["CommandCounter"]
         self.values.update(writes)
@@ -284,8 +341,14 @@ class Rig:
     async def _step(self, _parent: ua.NodeId) -> Any:
         """The method Step: CommandCounter + 1 by a call; the new SampleCounter."""
         turn = (self.values["SampleCounter"] + 1) % UINT32_MODULUS
+        user = sessions.current()
+        if not self._may_write(user) or (user is None and self.owner is not None):
+            self.rejected += 1
+            await self._set("RejectedWrites", self.rejected % UINT32_MODULUS)
+            return ua.StatusCode(Bad.BadUserAccessDenied)
         if self.latest_ns is None or self.outstanding:
             return ua.StatusCode(Bad.BadInvalidState)
+        self._claim(user)
         waiter = asyncio.get_running_loop().create_future()
         self._waiters.append(waiter)
         self._command(self.values, turn)
@@ -336,18 +399,32 @@ class Rig:
             self._answer_waiters(self.values["SampleCounter"])
 
 
+class _FaultsAreClientErrors(logging.Filter):
+    """asyncua logs every service fault it sends (a refused write too) at ERROR; the gateway
+    logs its refusals itself, so these are INFO."""
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        if record.msg.startswith("sending service fault response"):
+            record.levelno, record.levelname = logging.INFO, "INFO"
+        return True
+
+
+FAULT_FILTER = _FaultsAreClientErrors()
+
+
 class RigServer:
     """The asyncua server of the rig objects ``rigs`` at ``endpoint`` (their names differ)."""
 
     def __init__(self, endpoint: str, rigs: Sequence[Rig],
                  security: Security | None = None) -> None:
         self.security = security
-        self.server = Server(user_manager=None if security is None else PasswordUser(
-            security.user, security.password))
+        self.server = Server(user_manager=SessionUsers(None if security is None else PasswordUser(
+            security.user, security.password)))
         self.endpoint, self.rigs = endpoint, tuple(rigs)
         self._writable: dict[ua.NodeId, tuple[Rig, str]] = {}
 
     async def start(self) -> None:
+        logging.getLogger("asyncua.server.uaprocessor").addFilter(FAULT_FILTER)
         await self.server.init()
         self.server.set_endpoint(self.endpoint)
         names = ", ".join(rig.name for rig in self.rigs)
@@ -358,6 +435,7 @@ class RigServer:
             for nodeid, name in (await rig.build(self.server, index)).items():
                 self._writable[nodeid] = (rig, name)
         self.server.subscribe_server_callback(CallbackType.PreWrite, self._pre_write)
+        self.server.subscribe_server_callback(CallbackType.PreRead, self._pre_read)
         await self.server.start()
 
     async def _secure(self) -> None:
@@ -379,17 +457,28 @@ class RigServer:
     async def _pre_write(self, event: Any, _dispatcher: Any) -> None:
         """Check a whole write request (raise its Bad status code to refuse all of it), switch
         drive modes, then hand each rig its part."""
+        sessions.note(event.user)
         writes: dict[Rig, dict[str, Any]] = {}
         for item in event.request_params.NodesToWrite:
             owner = self._writable.get(item.NodeId)
             if owner is None:
                 continue
             rig, name = owner
-            code, value = rig.check(name, item)
+            code, value = rig.check(name, item, event.user)
             if code is not None:
                 await rig.refuse(name, code, value)
+            if value != item.Value.Value.Value:               # a bound, a few ulps away
+                item.Value.Value = ua.Variant(value, item.Value.Value.VariantType)
             writes.setdefault(rig, {})[name] = value
+        for rig, values in writes.items():
+            refused = rig.check_request(values)
+            if refused is not None:
+                await rig.refuse("CommandCounter", refused[0], values["CommandCounter"],
+                                 refused[1])
         for rig, values in writes.items():
             await rig.switch_drive(values)
         for rig, values in writes.items():
-            rig.accept(values)
+            rig.accept(values, event.user)
+
+    async def _pre_read(self, event: Any, _dispatcher: Any) -> None:
+        sessions.note(event.user)

@@ -51,7 +51,7 @@ from drill_sim_ros.hil.security import load_security
 from drill_sim_ros.model.errors import DrillSimError, ParameterError
 from drill_sim_ros.ros.messages import status
 from drill_sim_ros.ros.parameters import init_ros
-from drill_sim_ros.ros.sim_link import SIM_PARAMETERS, SimLink, rig_settings, sim_values
+from drill_sim_ros.ros.sim_link import SIM_PARAMETERS, SimLink, sim_values
 
 NODE_NAME = "opcua_gateway"
 USAGE = """usage: opcua_gateway [--ros-args -p endpoint:=opc.tcp://127.0.0.1:4840/drill_sim/ ...]
@@ -233,7 +233,7 @@ def _connect(link: SimLink, rig: Rig, loop: asyncio.AbstractEventLoop,
 
     link.on_sample = lambda values, time_ns: put(functools.partial(rig.sample_in, values,
                                                                    time_ns))
-    link.on_settings = lambda sim: put(functools.partial(rig.follow, rig_settings(sim)))
+    link.on_settings = lambda sim: put(functools.partial(rig.follow, RigSettings.of_sim(sim)))
     link.figures = rig.figures
     if link.latest_sample is not None:      # received while sim_node's parameters came
         events.put_nowait(functools.partial(rig.sample_in, *link.latest_sample))
@@ -282,7 +282,7 @@ def main(args: list[str] | None = None) -> int:
     try:
         node = GatewayNode()
         check_endpoint(node.endpoint, secured=node.security is not None)
-        asyncio.run(serve(node, [rig_settings(node.sim_parameters(link))
+        asyncio.run(serve(node, [RigSettings.of_sim(node.sim_parameters(link))
                                  for link in node.links]))
     except (KeyboardInterrupt, ExternalShutdownException):
         pass

@@ -25,9 +25,6 @@ from sensor_msgs.msg import JointState
 from drill_sim_ros import topics
 from drill_sim_ros.control.command import Command
 from drill_sim_ros.hil.address_space import SAMPLE_VARIABLES
-from drill_sim_ros.hil.rig_server import RigSettings
-from drill_sim_ros.model.params import RPM_PER_RAD_S
-from drill_sim_ros.model.top_drive import limit_of_setting
 from drill_sim_ros.ros.lockstep_driver import LOCKSTEP_QOS, top_drive_command
 from drill_sim_ros.ros.messages import LATEST_SAMPLE_QOS, stamp_ns
 
@@ -50,18 +47,6 @@ def sample_values(msg: JointState) -> tuple[dict[str, float], int]:
     values = {v.name: time_ns / 1e9 if v.source[0] == "stamp"
               else float(arrays[v.source[0]][v.source[1]]) for v in SAMPLE_VARIABLES}
     return values, time_ns
-
-
-def rig_settings(sim: dict[str, Any]) -> RigSettings:
-    """The rig object's settings from sim_node's parameters (``SIM_PARAMETERS``); its
-    kinematic mode, which takes speed setpoints too, shows as ``speed``."""
-    torque_nm = limit_of_setting(sim["top_drive.max_torque_nm"])        # 0: no limit (inf)
-    return RigSettings(
-        max_speed_rad_s=sim["limits.max_surface_rpm"] / RPM_PER_RAD_S, max_torque_nm=torque_nm,
-        max_wob_n=sim["limits.max_wob_n"], speed_rad_s=sim["model.surface_rpm"] / RPM_PER_RAD_S,
-        wob_n=sim["model.applied_wob_n"],
-        drive_mode="torque" if sim[MODE_PARAMETER] == "torque" else "speed",
-        lockstep=bool(sim["lockstep"]) and sim["lockstep_trigger"] == "command")
 
 
 def sim_values(response: Any) -> dict[str, Any] | None:

@@ -12,6 +12,7 @@ objects whose simulators are stand-ins, and a real asyncua client (issue 33).
 from __future__ import annotations
 
 import asyncio
+import logging
 import math
 import socket
 from collections.abc import AsyncIterator
@@ -234,3 +235,115 @@ async def start_over() -> None:
 
 def test_a_restarted_simulator_starts_the_handshake_over_from_command_counter() -> None:
     run(start_over())
+
+
+# ---- commissioning (issue 53) ---------------------------------------------------------------
+
+SIM = {"limits.max_surface_rpm": 300.0, "limits.max_wob_n": 1e6,
+       "top_drive.max_torque_nm": 50_000.0 / 7.0 * 7.0 + 1e-11,   # a scaled round trip's ulp
+       "model.surface_rpm": 60.0, "model.applied_wob_n": 6e4, "top_drive.mode": "speed",
+       "lockstep": True, "lockstep_trigger": "command"}
+
+
+def test_the_ranges_are_the_settings_without_a_unit_round_trips_drift() -> None:
+    settings = RigSettings.of_sim(SIM)
+    assert settings.eu_range("SpeedSetpoint") == (0.0, 10.0 * math.pi)
+    assert settings.eu_range("TorqueCommand") == (-50_000.0, 50_000.0)
+
+
+async def plc_arithmetic() -> None:
+    async with serving() as (rigs, _, client):
+        for rig in rigs.values():
+            await rig.follow(RigSettings.of_sim(SIM))
+        await first_samples(rigs)
+        north = await view(client, "north")
+        assert await north.eu_range("SpeedSetpoint") == (0.0, 300 * math.pi / 30)
+        # 300 rev/min as a PLC may write it: every form is in range
+        for speed in (300 * math.pi / 30, 300 / (30 / math.pi), 300 * 2 * math.pi / 60,
+                      math.radians(1800)):
+            await north.nodes["SpeedSetpoint"].write_value(ua.Variant(speed, DOUBLE))
+            assert await north.value("SpeedSetpoint") == speed
+        # an ulp above: the bound goes
+        above = math.nextafter(10 * math.pi, math.inf)
+        await north.nodes["SpeedSetpoint"].write_value(ua.Variant(above, DOUBLE))
+        assert await north.value("SpeedSetpoint") == 10 * math.pi
+        with pytest.raises(ua.uaerrors.BadOutOfRange):
+            await north.nodes["SpeedSetpoint"].write_value(ua.Variant(31.4159266, DOUBLE))
+        await north.nodes["TorqueCommand"].write_value(ua.Variant(-50_000.0, DOUBLE))
+        assert await north.value("RejectedWrites") == 1
+
+
+def test_300_rpm_written_as_a_plc_computes_it_is_in_range() -> None:
+    run(plc_arithmetic())
+
+
+async def an_array_to_a_scalar(caplog: pytest.LogCaptureFixture) -> None:
+    async with serving() as (rigs, stand_ins, client):
+        await first_samples(rigs)
+        north = await view(client, "north")
+        for name, value in (("SpeedSetpoint", ua.Variant([3.0], DOUBLE)),
+                            ("CommandCounter", ua.Variant([1], UINT32)),
+                            ("DriveMode", ua.Variant(["torque"], STRING))):
+            with pytest.raises(ua.uaerrors.BadTypeMismatch):
+                await north.nodes[name].write_value(value)
+        assert await north.value("RejectedWrites") == 3
+        assert await north.value("SpeedSetpoint") == SETTINGS.speed_rad_s
+        assert stand_ins["north"].commands == [] and stand_ins["north"].switches == []
+    assert not [r for r in caplog.records if r.levelno >= logging.ERROR]
+
+
+def test_an_array_written_to_a_scalar_is_a_counted_type_mismatch(
+        caplog: pytest.LogCaptureFixture) -> None:
+    run(an_array_to_a_scalar(caplog))
+
+
+@asynccontextmanager
+async def second_client(client: Client) -> AsyncIterator[Client]:
+    other = Client(client.server_url.geturl(), timeout=5)
+    await other.connect()
+    try:
+        yield other
+    finally:
+        await other.disconnect()
+
+
+async def two_writers() -> None:
+    async with serving() as (rigs, stand_ins, first):
+        await first_samples(rigs)
+        north, stand_in = await view(first, "north"), stand_ins["north"]
+        async with second_client(first) as second_session:
+            second = await view(second_session, "north")
+            await first.write_values([north.nodes["SpeedSetpoint"], north.nodes["CommandCounter"]],
+                                     [ua.Variant(3.0, DOUBLE), ua.Variant(1, UINT32)])
+            for name, value in (("SpeedSetpoint", ua.Variant(4.0, DOUBLE)),
+                                ("CommandCounter", ua.Variant(1, UINT32)),
+                                ("WobSetpoint", ua.Variant(1.0, DOUBLE))):
+                with pytest.raises(ua.uaerrors.BadUserAccessDenied):
+                    await second.nodes[name].write_value(value)
+            await rigs["north"].sample_in(SAMPLE, PERIOD_NS)
+            obj = await second_session.nodes.objects.get_child(
+                f"{await second_session.get_namespace_index('urn:drill_sim_ros')}:north")
+            with pytest.raises(ua.uaerrors.BadUserAccessDenied):
+                await obj.call_method(f"{obj.nodeid.NamespaceIndex}:Step")
+            assert await second.value("RejectedWrites") == 4
+            assert [c.speed_rad_s for c, _ in stand_in.commands] == [3.0]
+            assert await second.value("SpeedSetpoint") == 3.0
+            # the owner's stale write: a new value with the counter already sent
+            with pytest.raises(ua.uaerrors.BadInvalidState):
+                await first.write_values(
+                    [north.nodes["SpeedSetpoint"], north.nodes["CommandCounter"]],
+                    [ua.Variant(5.0, DOUBLE), ua.Variant(1, UINT32)])
+            assert await north.value("SpeedSetpoint") == 3.0
+            assert await north.value("RejectedWrites") == 5
+            # ... the same values again change nothing and are no error
+            await first.write_values([north.nodes["SpeedSetpoint"], north.nodes["CommandCounter"]],
+                                     [ua.Variant(3.0, DOUBLE), ua.Variant(1, UINT32)])
+            await first.disconnect()                    # the owner goes: the second may write
+            while rigs["north"].owner is not None:      # (the server closes it just after)
+                await asyncio.sleep(0.01)
+            await second.nodes["CommandCounter"].write_value(ua.Variant(2, UINT32))
+            assert len(stand_in.commands) == 2
+
+
+def test_one_session_owns_the_setpoints_and_a_stale_write_is_refused() -> None:
+    run(two_writers())

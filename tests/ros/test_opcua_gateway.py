@@ -159,7 +159,7 @@ async def check_address_space(rig: Rig) -> None:
         assert eu.NamespaceUri == "http://www.opcfoundation.org/UA/units/un/cefact"
         assert (eu.DisplayName.Text, eu.UnitId) == (symbol, int.from_bytes(code.encode()))
     speed = await (await rig.nodes["SpeedSetpoint"].get_child("0:EURange")).read_value()
-    assert (speed.Low, speed.High) == (0.0, 300.0 / (30.0 / math.pi))   # limits.max_surface_rpm
+    assert (speed.Low, speed.High) == (0.0, 300.0 * math.pi / 30.0)   # limits.max_surface_rpm
     torque = await (await rig.nodes["TorqueCommand"].get_child("0:EURange")).read_value()
     assert torque.Low == -torque.High < 0
     assert await rig.value("Lockstep") is True
