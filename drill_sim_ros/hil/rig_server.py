@@ -24,6 +24,7 @@ from __future__ import annotations
 import asyncio
 import logging
 import math
+import time
 import weakref
 from collections.abc import Awaitable, Callable, Sequence
 from dataclasses import dataclass
@@ -32,17 +33,21 @@ from typing import Any
 
 from asyncua import Server, ua
 from asyncua.common.callback import CallbackType
+from asyncua.common.structures104 import new_enum, new_enum_field
 
 from drill_sim_ros.control.command import Command
 from drill_sim_ros.hil import sessions
 from drill_sim_ros.hil.address_space import (
     DRIVE_MODES,
     NAMESPACE_URI,
+    RESET_METHOD,
     SAMPLE_VARIABLES,
+    STATUS_MEANINGS,
     STEP_METHOD,
     UNECE_URI,
     VARIABLE_BY_NAME,
     VARIABLES,
+    RigStatus,
     Variable,
     exact_setting,
     node_id,
@@ -60,6 +65,7 @@ UINT32_MODULUS = 2**32
 Bad = ua.StatusCodes
 SETPOINTS = ("SpeedSetpoint", "TorqueCommand", "WobSetpoint")
 MODE_SWITCH_TIMEOUT_S = 5.0
+SUPERVISE_PERIOD_S = 0.05
 # switch_mode(mode): None once the simulator drives in ``mode``, else its reason for refusing
 # (TimeoutError, or any OSError, if it does not answer)
 SwitchMode = Callable[[str], Awaitable[str | None]]
@@ -78,6 +84,7 @@ class RigSettings:
     wob_n: float
     drive_mode: str
     lockstep: bool
+    control_period_s: float
 
     @classmethod
     def of_sim(cls, sim: dict[str, Any]) -> RigSettings:
@@ -93,7 +100,8 @@ class RigSettings:
             speed_rad_s=rad_s_of_rpm(sim["model.surface_rpm"]),
             wob_n=sim["model.applied_wob_n"],
             drive_mode="torque" if sim["top_drive.mode"] == "torque" else "speed",
-            lockstep=bool(sim["lockstep"]) and sim["lockstep_trigger"] == "command")
+            lockstep=bool(sim["lockstep"]) and sim["lockstep_trigger"] == "command",
+            control_period_s=1.0 / sim["publish_rate_hz"])
 
     def eu_range(self, name: str) -> tuple[float, float] | None:
         return {"SpeedSetpoint": (0.0, self.max_speed_rad_s),
@@ -103,7 +111,9 @@ class RigSettings:
     def initial(self, name: str) -> Any:
         return {"SpeedSetpoint": self.speed_rad_s, "TorqueCommand": 0.0,
                 "WobSetpoint": self.wob_n, "DriveMode": self.drive_mode,
-                "Lockstep": self.lockstep, "Status": "waiting for the first sample"}.get(
+                "Lockstep": self.lockstep, "Status": int(RigStatus.WaitingForSim),
+                "StatusText": STATUS_MEANINGS[RigStatus.WaitingForSim],
+                "ControlPeriod": self.control_period_s}.get(
                     name, math.nan if name in SAMPLE_NAMES else 0)
 
 
@@ -138,6 +148,28 @@ async def _add_property(node: Any, name: str, value: ua.Variant, data_type: int)
                                    datatype=ua.NodeId(data_type))
 
 
+@dataclass(frozen=True)
+class RigTiming:
+    """A rig object's waits (wall time, s) and its safe stop's ramp."""
+
+    step_timeout_s: float = 0.5          # Step's wait for its sample (the session waits too)
+    mode_switch_timeout_s: float = MODE_SWITCH_TIMEOUT_S
+    heartbeat_timeout_s: float = 2.0     # the owner's silence that ends its ownership
+    sim_timeout_s: float = 2.0           # a command unanswered (no sample in free run): SimLost
+    safe_ramp_rad_s2: float = 2.0        # the safe stop's speed ramp (rad/s per s, sim time)
+
+
+async def status_enumeration(server: Server, index: int) -> ua.NodeId:
+    """The DataType ``RigStatus`` (an Enumeration, with EnumStrings) in namespace ``index``."""
+    fields = [new_enum_field(status.name, STATUS_MEANINGS[status]) for status in RigStatus]
+    data_type = await new_enum(server, index, "RigStatus", fields)
+    await data_type.add_property(ua.NodeId("RigStatus.EnumStrings", index),
+                                 ua.QualifiedName("EnumStrings", 0), ua.Variant(
+        [ua.LocalizedText(status.name) for status in RigStatus],
+        ua.VariantType.LocalizedText), datatype=ua.NodeId(ua.ObjectIds.LocalizedText))
+    return data_type.nodeid
+
+
 def _unset_setpoints() -> dict[str, float]:
     """No setpoint known to be in force: the next command carries them all."""
     return dict.fromkeys(SETPOINTS, math.nan)
@@ -149,14 +181,13 @@ class Rig:
     in the event loop). Its nodes exist once :meth:`build` has run."""
 
     def __init__(self, name: str, settings: RigSettings, send: Callable[[Command, int], None],
-                 switch_mode: SwitchMode | None = None, step_timeout_s: float = 10.0,
-                 mode_switch_timeout_s: float = MODE_SWITCH_TIMEOUT_S) -> None:
-        self.name, self.settings = name, settings
+                 switch_mode: SwitchMode | None = None, timing: RigTiming = RigTiming()) -> None:
+        self.name, self.settings, self.timing = name, settings, timing
         self._send, self._switch_mode = send, switch_mode
-        self.step_timeout_s, self.mode_switch_timeout_s = step_timeout_s, mode_switch_timeout_s
         self.nodes: dict[str, Any] = {}
         self._ranges: dict[str, Any] = {}               # EURange property nodes by variable
         self._server: Server | None = None
+        self._status_type: ua.NodeId | None = None
         self.values: dict[str, Any] = {v.name: settings.initial(v.name) for v in VARIABLES}
         self._in_force = {"SpeedSetpoint": settings.speed_rad_s, "WobSetpoint": settings.wob_n,
                           "TorqueCommand": math.nan}
@@ -168,11 +199,20 @@ class Rig:
         self.restarts = 0
         self._waiters: list[asyncio.Future[int | None]] = []
         self._owner: weakref.ref[Any] | None = None
+        self._owner_seen_s = 0.0                        # the owner's last write (monotonic)
+        self._sent_s = 0.0                              # when the outstanding command went
+        self._sample_s = 0.0                            # when the latest sample came
+        self.sim_lost = False
+        self.latched: tuple[RigStatus, str] | None = None   # HeartbeatLost, Faulted: Reset
+        self._ramp: tuple[float, int] | None = None     # the safe stop's start (rad/s, ns)
+        self._refused_kinds: dict[tuple[str, int], int] = {}
 
     # -- the address space ----------------------------------------------------------------
-    async def build(self, server: Server, index: int) -> dict[ua.NodeId, str]:
-        """Add the rig object under Objects; its writable variables' names by NodeId."""
-        self._server = server
+    async def build(self, server: Server, index: int, status_type: ua.NodeId
+                    ) -> dict[ua.NodeId, str]:
+        """Add the rig object under Objects (``Status`` of the enumeration ``status_type``);
+        its writable variables' names by NodeId."""
+        self._server, self._status_type = server, status_type
         rig = await server.nodes.objects.add_object(ua.NodeId(self.name, index),
                                                     ua.QualifiedName(self.name, index))
         for variable in VARIABLES:
@@ -180,12 +220,16 @@ class Rig:
         await rig.add_method(ua.NodeId(node_id(self.name, STEP_METHOD), index),
                              ua.QualifiedName(STEP_METHOD, index),
                              self._step, [], [ua.VariantType.UInt32])
+        await rig.add_method(ua.NodeId(node_id(self.name, RESET_METHOD), index),
+                             ua.QualifiedName(RESET_METHOD, index), self._reset, [], [])
         return {node.nodeid: name for name, node in self.nodes.items()}
 
     async def _add_variable(self, rig: Any, index: int, variable: Variable) -> None:
         node = await rig.add_variable(ua.NodeId(node_id(self.name, variable.name), index),
                                       ua.QualifiedName(variable.name, index),
-                                      variant(variable, self.values[variable.name]))
+                                      variant(variable, self.values[variable.name]),
+                                      datatype=self._status_type if variable.name == "Status"
+                                      else None)
         if variable.writable:
             await node.set_writable()
         if variable.unit is not None:
@@ -205,13 +249,34 @@ class Rig:
         await self._server.write_attribute_value(self.nodes[name].nodeid, ua.DataValue(
             variant(VARIABLE_BY_NAME[name], value), SourceTimestamp=stamp))
 
-    async def set_status(self, text: str) -> None:
-        if text != self.values["Status"]:
-            await self._set("Status", text)
+    def status(self, now_s: float) -> tuple[RigStatus, str]:
+        """The Status now, and its text."""
+        if self.latched is not None:
+            return self.latched
+        if self.latest_ns is None:
+            return RigStatus.WaitingForSim, STATUS_MEANINGS[RigStatus.WaitingForSim]
+        if self.sim_lost:
+            what = ("a command unanswered" if self.outstanding else "no sample")
+            return RigStatus.SimLost, (f"sim_node lost: {what} for "
+                                       f"{now_s - max(self._sent_s, self._sample_s):.1f} s")
+        if self.owner is None:
+            return RigStatus.WaitingForClient, ("samples come; no session owns the setpoints "
+                                                "(the first that writes will)")
+        return RigStatus.Running, f"running: {getattr(self.owner, 'name', 'a session')} " \
+            "owns the setpoints"
+
+    async def show_status(self, now_s: float) -> None:
+        status, text = self.status(now_s)
+        if int(status) != self.values["Status"]:
+            _log.info("%s: %s (%s)", self.name, status.name, text)
+            await self._set("Status", int(status))
+        if text != self.values["StatusText"]:
+            await self._set("StatusText", text)
 
     def figures(self) -> dict[str, str]:
         """The diagnostics' key/values (read from any thread: plain ints and strings)."""
-        return {"status": str(self.values["Status"]), "rejected_writes": str(self.rejected),
+        return {"status": f"{RigStatus(self.values['Status']).name}: "
+                          f"{self.values['StatusText']}", "rejected_writes": str(self.rejected),
                 "commands_sent": str(self.commands_sent), "samples_in": str(self.samples_in),
                 "sample_counter": str(self.values["SampleCounter"]),
                 "sim_restarts": str(self.restarts)}
@@ -226,6 +291,10 @@ class Rig:
                     _range_variant(settings.eu_range(name))))
         if settings.lockstep != self.values["Lockstep"]:
             await self._set("Lockstep", settings.lockstep)
+            if settings.lockstep:
+                self._end_ramp("sim_node went to lockstep")
+        if settings.control_period_s != self.values["ControlPeriod"]:
+            await self._set("ControlPeriod", settings.control_period_s)
         if settings.drive_mode != self.values["DriveMode"]:
             await self._set("DriveMode", settings.drive_mode)
             self._in_force = _unset_setpoints()        # the new mode's setpoint goes next
@@ -247,6 +316,10 @@ class Rig:
             return Bad.BadTypeMismatch, value
         if not self._may_write(user):
             return Bad.BadUserAccessDenied, value
+        if self.latched is not None:
+            return Bad.BadInvalidState, value
+        if name == "Heartbeat":
+            return None, value
         if name == "DriveMode":
             return (None if value in DRIVE_MODES else Bad.BadOutOfRange), value
         if name == "CommandCounter":
@@ -265,10 +338,12 @@ class Rig:
         return owner is None or owner is user
 
     def _claim(self, user: Any) -> None:
-        """The first session that writes owns the setpoints (until it closes)."""
+        """The first session that writes owns the setpoints (until it closes or goes
+        silent); each of its writes is a heartbeat."""
         if self.owner is None and user is not None:
             self._owner = weakref.ref(user)
             _log.info("%s: the setpoints are %s's", self.name, getattr(user, "name", user))
+        self._owner_seen_s = time.monotonic()
 
     def check_request(self, writes: dict[str, Any]) -> tuple[int, str] | None:
         """(Bad code, why) if a request's values, each allowed, are not as a whole: a new
@@ -290,13 +365,21 @@ class Rig:
             return Bad.BadInvalidState
         return None
 
-    async def refuse(self, name: str, code: int, value: Any, why: str = "") -> None:
-        """Count a refused write and fail its request with ``code`` (always raises)."""
+    async def count_refusal(self, name: str, code: int, value: Any, why: str = "") -> None:
+        """Count a refused write or call; log it at WARNING the first time of its kind
+        (variable and code), at DEBUG after."""
         self.rejected += 1
         await self._set("RejectedWrites", self.rejected % UINT32_MODULUS)
-        _log.warning("refused a write of %r to %s.%s: %s%s (%d refused so far)", value,
-                     self.name, name, ua.StatusCode(code).name, f" ({why})" if why else "",
-                     self.rejected)
+        kind = (name, code)
+        self._refused_kinds[kind] = self._refused_kinds.get(kind, 0) + 1
+        level = logging.WARNING if self._refused_kinds[kind] == 1 else logging.DEBUG
+        _log.log(level, "refused %r to %s.%s: %s%s (%d refused so far; further %s of %s are "
+                 "logged at DEBUG)", value, self.name, name, ua.StatusCode(code).name,
+                 f" ({why})" if why else "", self.rejected, ua.StatusCode(code).name, name)
+
+    async def refuse(self, name: str, code: int, value: Any, why: str = "") -> None:
+        """Count a refused write and fail its request with ``code`` (always raises)."""
+        await self.count_refusal(name, code, value, why)
         raise ua.UaStatusCodeError(code)
 
     async def switch_drive(self, writes: dict[str, Any]) -> None:
@@ -306,7 +389,7 @@ class Rig:
             return
         try:
             reason = await asyncio.wait_for(self._switch_mode(mode),
-                                            self.mode_switch_timeout_s)
+                                            self.timing.mode_switch_timeout_s)
         except (TimeoutError, OSError) as exc:
             await self.refuse("DriveMode", Bad.BadTimeout, mode, f"sim_node: {exc!r}")
         if reason is not None:
@@ -332,34 +415,63 @@ class Rig:
                    if values[name] != self._in_force[name]}
         self._in_force.update(changed)
         self.outstanding = True
+        self._sent_s = time.monotonic()
         self.commands_sent += 1
         self._send(Command(speed_rad_s=changed.get("SpeedSetpoint"),
                            motor_torque_nm=changed.get("TorqueCommand"),
                            wob_n=changed.get("WobSetpoint")), self.latest_ns)
         _log.debug("%s: command %d sent", self.name, counter)
 
-    async def _step(self, _parent: ua.NodeId) -> Any:
-        """The method Step: CommandCounter + 1 by a call; the new SampleCounter."""
-        turn = (self.values["SampleCounter"] + 1) % UINT32_MODULUS
+    async def _caller_refused(self, method: str) -> ua.StatusCode | None:
+        """The Bad code for a method call by a session that may not write (counted)."""
         user = sessions.current()
+        code = None
         if not self._may_write(user) or (user is None and self.owner is not None):
-            self.rejected += 1
-            await self._set("RejectedWrites", self.rejected % UINT32_MODULUS)
-            return ua.StatusCode(Bad.BadUserAccessDenied)
+            code = Bad.BadUserAccessDenied
+        elif self.latched is not None and method != RESET_METHOD:
+            code = Bad.BadInvalidState
+        if code is None:
+            return None
+        await self.count_refusal(f"{method}()", code, None, self.values["StatusText"])
+        return ua.StatusCode(code)
+
+    async def _step(self, _parent: ua.NodeId) -> Any:
+        """The method Step: CommandCounter + 1 by a call; the new SampleCounter, or BadTimeout
+        after ``step_timeout_s`` (the command stays outstanding, its sample comes later)."""
+        refused = await self._caller_refused(STEP_METHOD)
+        if refused is not None:
+            return refused
         if self.latest_ns is None or self.outstanding:
             return ua.StatusCode(Bad.BadInvalidState)
-        self._claim(user)
+        self._claim(sessions.current())
+        turn = (self.values["SampleCounter"] + 1) % UINT32_MODULUS
         waiter = asyncio.get_running_loop().create_future()
         self._waiters.append(waiter)
         self._command(self.values, turn)
         await self._set("CommandCounter", turn)
         try:
-            counter = await asyncio.wait_for(waiter, self.step_timeout_s)
+            counter = await asyncio.wait_for(waiter, self.timing.step_timeout_s)
         except TimeoutError:
             return ua.StatusCode(Bad.BadTimeout)
         if counter is None:                          # the simulator started again
             return ua.StatusCode(Bad.BadInvalidState)
         return [ua.Variant(counter, ua.VariantType.UInt32)]
+
+    async def _reset(self, _parent: ua.NodeId) -> Any:
+        """The method Reset: after HeartbeatLost (the drive at rest) or Faulted, the rig takes
+        writes again; the first session that writes owns the setpoints."""
+        refused = await self._caller_refused(RESET_METHOD)
+        if refused is not None:
+            return refused
+        if self._ramp is not None:
+            await self.count_refusal(f"{RESET_METHOD}()", Bad.BadInvalidState, None,
+                                     "the drive is still stopping")
+            return ua.StatusCode(Bad.BadInvalidState)
+        if self.latched is not None:
+            _log.warning("%s: Reset after %s", self.name, self.latched[0].name)
+        self.latched, self._owner = None, None
+        await self.show_status(time.monotonic())
+        return []
 
     def _answer_waiters(self, counter: int | None) -> None:
         for waiter in self._waiters:
@@ -367,36 +479,108 @@ class Rig:
                 waiter.set_result(counter)
         self._waiters.clear()
 
-    async def _start_over(self) -> None:
+    async def _start_over(self, why: str) -> None:
         """The simulator started again: no command is outstanding, none of its setpoints is
-        known, and the client goes on from CommandCounter."""
+        known, and the client goes on from CommandCounter (SampleCounter takes its value)."""
         self.restarts += 1
         self.latest_ns, self.outstanding = None, False
+        self._end_ramp("sim_node started again")
         self._in_force = _unset_setpoints()
         self._answer_waiters(None)
         await self._set("SampleCounter", self.values["CommandCounter"])
-        _log.warning("%s: sim_node started again (its time went back); the handshake goes "
-                     "on from CommandCounter %d", self.name, self.values["CommandCounter"])
+        _log.warning("%s: sim_node started again (%s); the handshake goes on from "
+                     "CommandCounter %d", self.name, why, self.values["CommandCounter"])
 
     async def sample_in(self, values: dict[str, float], time_ns: int) -> None:
         """A sample of sim_node (SAMPLE_VARIABLES' values, stamped ``time_ns``) into the
-        variables; it answers the outstanding command, if any. The same stamp again is
-        ignored; an older one means sim_node started again."""
-        if self.latest_ns is not None and time_ns == self.latest_ns:
-            return
+        variables; it answers the outstanding command, if any. An older stamp means sim_node
+        started again, and so does the same stamp again while sim_node was lost (a sim_node
+        restarted before it left that time); the same stamp otherwise is ignored."""
         if self.latest_ns is not None and time_ns < self.latest_ns:
-            await self._start_over()
-        first = self.latest_ns is None
+            await self._start_over("its time went back")
+        elif self.latest_ns is not None and time_ns == self.latest_ns:
+            if not (self.sim_lost and self.outstanding):
+                return
+            await self._start_over("its first sample again while a command was unanswered")
         self.latest_ns = time_ns
+        self._sample_s, self.sim_lost = time.monotonic(), False
         self.samples_in += 1
         for name, value in values.items():
             await self._set(name, value, time_ns)
-        if first:
-            await self.set_status("running")
         if self.outstanding:
             self.outstanding = False
             await self._set("SampleCounter", self.values["CommandCounter"], time_ns)
             self._answer_waiters(self.values["SampleCounter"])
+        if self._ramp is not None and not self.settings.lockstep:
+            await self._ramp_down(time_ns)
+        await self.show_status(self._sample_s)
+
+    # -- supervision: the owner's heartbeat, sim_node's answers ---------------------------
+    async def supervise(self, now_s: float) -> None:
+        """Called every SUPERVISE_PERIOD_S: a closed or silent owner, a lost sim_node."""
+        if self._owner is not None:
+            closed = self.owner is None
+            if closed or now_s - self._owner_seen_s > self.timing.heartbeat_timeout_s:
+                await self._owner_lost("its session closed" if closed else
+                                       f"it wrote nothing for {now_s - self._owner_seen_s:.1f} "
+                                       "s")
+        waited_s = now_s - (self._sent_s if self.outstanding else self._sample_s)
+        self.sim_lost = self.latest_ns is not None and waited_s > self.timing.sim_timeout_s \
+            and (self.outstanding or not self.settings.lockstep)
+        await self.show_status(now_s)
+
+    async def _owner_lost(self, why: str) -> None:
+        """The owner's heartbeat lapsed: in lockstep nothing moves without it (its ownership
+        ends); in free run the drive stops safely, and only Reset lets writes in again."""
+        self._owner = None
+        if self.settings.lockstep or self.latched is not None:
+            _log.info("%s: the owner of the setpoints is gone (%s)", self.name, why)
+            return
+        self.latched = (RigStatus.HeartbeatLost, f"heartbeat lost ({why}): the speed setpoint "
+                        f"ramps to 0 at {self.timing.safe_ramp_rad_s2:g} rad/s^2; Reset to go on")
+        _log.warning("%s: %s", self.name, self.latched[1])
+        await self._safe_stop()
+
+    async def _safe_stop(self) -> None:
+        """Start the ramp to zero speed, from the setpoint in force (speed mode) or from the
+        measured speed once sim_node has switched to speed mode (torque mode)."""
+        start = self.values["SpeedSetpoint"]
+        if self.values["DriveMode"] != "speed":
+            try:
+                await self.switch_drive({"DriveMode": "speed"})
+            except ua.UaStatusCodeError as exc:
+                self.latched = (RigStatus.Faulted, "heartbeat lost, and sim_node did not switch "
+                                f"to speed mode for the safe stop ({exc}); Reset to go on")
+                _log.error("%s: %s", self.name, self.latched[1])
+                return
+            await self._set("DriveMode", "speed")
+            start = self.values["DriveSpeed"]
+        self._ramp = (max(0.0, min(start, self.settings.max_speed_rad_s)), self.latest_ns)
+
+    def _end_ramp(self, why: str) -> None:
+        """No more of the safe stop's ramp: sim_node started again, or runs in lockstep, where
+        nothing moves without a command. Status stays HeartbeatLost until Reset."""
+        if self._ramp is None:
+            return
+        self._ramp = None
+        self.latched = (RigStatus.HeartbeatLost, f"{self.latched[1].split(':')[0]}: the safe "
+                        f"stop ended ({why}); Reset to go on")
+        _log.warning("%s: %s", self.name, self.latched[1])
+
+    async def _ramp_down(self, time_ns: int) -> None:
+        """The safe stop's speed setpoint at the sample stamped ``time_ns`` (free run): the
+        ramp from its start, sent with that sample."""
+        start_rad_s, start_ns = self._ramp
+        speed = max(0.0, start_rad_s - self.timing.safe_ramp_rad_s2 * (time_ns - start_ns) / 1e9)
+        self._ramp = None if speed == 0.0 else self._ramp
+        self._in_force["SpeedSetpoint"] = speed
+        self.commands_sent += 1
+        self._send(Command(speed_rad_s=speed), self.latest_ns)
+        await self._set("SpeedSetpoint", speed)
+        if speed == 0.0:
+            self.latched = (RigStatus.HeartbeatLost, self.latched[1].split(":")[0]
+                            + ": the drive is at rest (speed setpoint 0); Reset to go on")
+            _log.warning("%s: %s", self.name, self.latched[1])
 
 
 class _FaultsAreClientErrors(logging.Filter):
@@ -422,6 +606,7 @@ class RigServer:
             security.user, security.password)))
         self.endpoint, self.rigs = endpoint, tuple(rigs)
         self._writable: dict[ua.NodeId, tuple[Rig, str]] = {}
+        self._supervisor: asyncio.Task[None] | None = None
 
     async def start(self) -> None:
         logging.getLogger("asyncua.server.uaprocessor").addFilter(FAULT_FILTER)
@@ -431,12 +616,23 @@ class RigServer:
         self.server.set_server_name(f"drill_sim_ros OPC UA gateway ({names})")
         await self._secure()
         index = await self.server.register_namespace(NAMESPACE_URI)
+        status_type = await status_enumeration(self.server, index)
         for rig in self.rigs:
-            for nodeid, name in (await rig.build(self.server, index)).items():
+            for nodeid, name in (await rig.build(self.server, index, status_type)).items():
                 self._writable[nodeid] = (rig, name)
         self.server.subscribe_server_callback(CallbackType.PreWrite, self._pre_write)
         self.server.subscribe_server_callback(CallbackType.PreRead, self._pre_read)
         await self.server.start()
+        self._supervisor = asyncio.create_task(self._supervise())
+
+    async def _supervise(self) -> None:
+        while True:
+            await asyncio.sleep(SUPERVISE_PERIOD_S)
+            for rig in self.rigs:
+                try:
+                    await rig.supervise(time.monotonic())
+                except Exception:       # one rig's bug must not stop the others' watchdog
+                    _log.exception("%s: supervision failed", rig.name)
 
     async def _secure(self) -> None:
         """Anonymous and unencrypted (loopback only), or Basic256Sha256 Sign & Encrypt
@@ -452,6 +648,8 @@ class RigServer:
         await self.server.load_private_key(str(self.security.private_key))
 
     async def stop(self) -> None:
+        if self._supervisor is not None:
+            self._supervisor.cancel()
         await self.server.stop()
 
     async def _pre_write(self, event: Any, _dispatcher: Any) -> None:
@@ -479,6 +677,7 @@ class RigServer:
             await rig.switch_drive(values)
         for rig, values in writes.items():
             rig.accept(values, event.user)
+            await rig.show_status(time.monotonic())
 
     async def _pre_read(self, event: Any, _dispatcher: Any) -> None:
         sessions.note(event.user)

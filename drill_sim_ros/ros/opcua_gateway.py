@@ -45,7 +45,7 @@ from rclpy.validate_namespace import validate_namespace
 from drill_sim_ros import topics
 from drill_sim_ros.hil.address_space import DEFAULT_ENDPOINT, rig_name
 from drill_sim_ros.hil.endpoint import check_endpoint
-from drill_sim_ros.hil.rig_server import Rig, RigServer, RigSettings
+from drill_sim_ros.hil.rig_server import Rig, RigServer, RigSettings, RigTiming
 from drill_sim_ros.hil.security import SETTINGS as SECURITY_SETTINGS
 from drill_sim_ros.hil.security import load_security
 from drill_sim_ros.model.errors import DrillSimError, ParameterError
@@ -100,8 +100,16 @@ SETTINGS = (
     Setting("sim_node", topics.NODE_NAME, "sim_node's node name, in each rig's namespace"),
     Setting("sim_wait_s", 30.0, "how long to wait at start for each sim_node's parameters "
             "[s]", seconds=True),
-    Setting("step_timeout_s", 10.0, "Step returns BadTimeout after this many wall seconds "
-            "without the sample [s]", seconds=True),
+    Setting("step_timeout_s", 0.5, "Step returns BadTimeout after this many wall seconds "
+            "without the sample; the session's other requests wait behind it, so keep it below "
+            "the client's own timeouts (asyncua's watchdog: 1 s) [s]", seconds=True),
+    Setting("heartbeat_timeout_s", 2.0, "the owner of the setpoints that writes nothing (nor "
+            "calls Step) for this long loses them; in free run the drive then stops safely "
+            "(HeartbeatLost, Reset to go on) [s]", seconds=True),
+    Setting("sim_timeout_s", 2.0, "a command unanswered (in free run: no sample) for this "
+            "long makes Status SimLost [s]", seconds=True),
+    Setting("safe_ramp_rad_s2", 2.0, "the safe stop's ramp of the speed setpoint to 0 "
+            "[rad/s per s of simulated time]", seconds=True),
     Setting("security.certificate", "", "the server's certificate, DER or PEM, with the URI "
             "urn:drill_sim_ros:opcua_gateway ('' = not secured: loopback only)"),
     Setting("security.private_key", "", "the certificate's private key, PEM"),
@@ -162,7 +170,9 @@ class GatewayNode(Node):
         super().__init__(NODE_NAME, **node_kwargs)
         values = {s.name: s.declared(self) for s in SETTINGS}
         self.endpoint = values["endpoint"]
-        self.sim_wait_s, self.step_timeout_s = values["sim_wait_s"], values["step_timeout_s"]
+        self.sim_wait_s = values["sim_wait_s"]
+        self.timing = RigTiming(**{name: values[name] for name in (
+            "step_timeout_s", "heartbeat_timeout_s", "sim_timeout_s", "safe_ramp_rad_s2")})
         self.security = load_security({name: values[name] for name in SECURITY_SETTINGS})
         listed, rig, sim_node = values["rigs"], values["rig"], values["sim_node"]
         namespaces = rig_namespaces(list(listed or []), self.get_namespace())
@@ -243,7 +253,7 @@ async def serve(node: GatewayNode, settings: list[RigSettings]) -> None:
     """Run the OPC UA server until ROS shuts down (SIGINT, SIGTERM)."""
     loop = asyncio.get_running_loop()
     events: asyncio.Queue[Event] = asyncio.Queue()
-    rigs = [Rig(link.rig, start_settings, link.send, _switcher(link), node.step_timeout_s)
+    rigs = [Rig(link.rig, start_settings, link.send, _switcher(link), node.timing)
             for link, start_settings in zip(node.links, settings, strict=True)]
     server = RigServer(node.endpoint, rigs, node.security)
     await server.start()

@@ -29,6 +29,7 @@ from drill_sim_ros.ros.lockstep_driver import LOCKSTEP_QOS, top_drive_command
 from drill_sim_ros.ros.messages import LATEST_SAMPLE_QOS, stamp_ns
 
 SIM_PARAMETERS = ("limits.max_surface_rpm", "limits.max_wob_n", "top_drive.max_torque_nm",
+                  "publish_rate_hz",
                   "model.surface_rpm", "model.applied_wob_n", "top_drive.mode", "lockstep",
                   "lockstep_trigger")
 MODE_PARAMETER = "top_drive.mode"

@@ -20,15 +20,17 @@ ISSUE_33_NAMES = {"DriveSpeed", "MotorTorque", "QuillTorque", "HookLoad", "WobEs
                   "BitDepth", "Rop", "SimTime", "SpeedSetpoint", "TorqueCommand",
                   "WobSetpoint", "DriveMode", "CommandCounter", "SampleCounter", "Lockstep",
                   "Status", "RejectedWrites"}
+ISSUE_53_NAMES = {"Heartbeat", "StatusText", "ControlPeriod"}
 
 
 def test_the_variables_are_the_issues_browse_names_and_the_table_lists_them() -> None:
-    assert {v.name for v in VARIABLES} == ISSUE_33_NAMES
+    assert {v.name for v in VARIABLES} == ISSUE_33_NAMES | ISSUE_53_NAMES
     table = markdown_table()
-    for name in ISSUE_33_NAMES | {"Step()"}:
+    for name in ISSUE_33_NAMES | ISSUE_53_NAMES | {"Step()", "Reset()"}:
         assert f"| `{name}` |" in table
     assert {v.name for v in VARIABLES if v.writable} == {
-        "SpeedSetpoint", "TorqueCommand", "WobSetpoint", "DriveMode", "CommandCounter"}
+        "SpeedSetpoint", "TorqueCommand", "WobSetpoint", "DriveMode", "CommandCounter",
+        "Heartbeat"}
 
 
 def test_unece_unit_ids_follow_opc_ua_part_8() -> None:

@@ -24,11 +24,12 @@ import pytest
 from asyncua import Client, ua
 
 from drill_sim_ros.control.command import Command
-from drill_sim_ros.hil.rig_server import Rig, RigServer, RigSettings
+from drill_sim_ros.hil.rig_server import Rig, RigServer, RigSettings, RigTiming
 
 DOUBLE, UINT32, STRING = ua.VariantType.Double, ua.VariantType.UInt32, ua.VariantType.String
 SETTINGS = RigSettings(max_speed_rad_s=30.0, max_torque_nm=50_000.0, max_wob_n=1e6,
-                       speed_rad_s=4.0, wob_n=60_000.0, drive_mode="speed", lockstep=True)
+                       speed_rad_s=4.0, wob_n=60_000.0, drive_mode="speed", lockstep=True,
+                       control_period_s=0.01)
 SAMPLE = {"DriveSpeed": 4.0, "MotorTorque": 1.0, "QuillTorque": 2.0, "HookLoad": 3.0,
           "WobEstimate": 5.0, "BitDepth": 0.0, "Rop": 0.0, "SimTime": 0.0}
 PERIOD_NS = 10_000_000
@@ -85,7 +86,7 @@ async def serving(**rig_options: Any) -> AsyncIterator[tuple[dict[str, Rig],
                                                              dict[str, StandIn], Client]]:
     """Rigs ``north`` and ``south`` in one server, their stand-ins, a connected client."""
     stand_ins = {name: StandIn() for name in ("north", "south")}
-    rigs = {name: Rig(name, SETTINGS, s.send, s.switch_mode, **rig_options)
+    rigs = {name: Rig(name, SETTINGS, s.send, s.switch_mode, RigTiming(**rig_options))
             for name, s in stand_ins.items()}
     url = f"opc.tcp://127.0.0.1:{free_port()}/drill_sim/"
     server = RigServer(url, list(rigs.values()))
@@ -242,7 +243,7 @@ def test_a_restarted_simulator_starts_the_handshake_over_from_command_counter() 
 SIM = {"limits.max_surface_rpm": 300.0, "limits.max_wob_n": 1e6,
        "top_drive.max_torque_nm": 50_000.0 / 7.0 * 7.0 + 1e-11,   # a scaled round trip's ulp
        "model.surface_rpm": 60.0, "model.applied_wob_n": 6e4, "top_drive.mode": "speed",
-       "lockstep": True, "lockstep_trigger": "command"}
+       "lockstep": True, "lockstep_trigger": "command", "publish_rate_hz": 100.0}
 
 
 def test_the_ranges_are_the_settings_without_a_unit_round_trips_drift() -> None:
@@ -347,3 +348,127 @@ async def two_writers() -> None:
 
 def test_one_session_owns_the_setpoints_and_a_stale_write_is_refused() -> None:
     run(two_writers())
+
+
+RUNNING, WAITING_FOR_CLIENT, HEARTBEAT_LOST, SIM_LOST = 1, 2, 3, 4
+WAITING_FOR_SIM = 0
+
+
+async def wait_for(view_: View, name: str, value: Any, timeout_s: float = 5.0) -> None:
+    """Poll the variable ``name`` until it is ``value`` (bounded)."""
+    end = asyncio.get_running_loop().time() + timeout_s
+    while (now := await view_.value(name)) != value:
+        assert asyncio.get_running_loop().time() < end, f"{name} stayed {now}, not {value}"
+        await asyncio.sleep(0.01)
+
+
+async def method(view_: View, name: str) -> Any:
+    """Call the method ``name`` of the rig object that ``view_`` shows."""
+    nodeid = view_.nodes[name].nodeid
+    obj = view_.client.get_node(ua.NodeId(nodeid.Identifier.rpartition(".")[0],
+                                          nodeid.NamespaceIndex))
+    return await obj.call_method(nodeid)
+
+
+async def step_and_status() -> None:
+    async with serving(sim_timeout_s=0.3) as (rigs, _, client):
+        north, rig = await view(client, "north"), rigs["north"]
+        assert await north.value("Status") == WAITING_FOR_SIM
+        type_node = client.get_node(await north.nodes["Status"].read_data_type())
+        names = await (await type_node.get_child("0:EnumStrings")).read_value()
+        assert [n.Text for n in names] == ["WaitingForSim", "Running", "WaitingForClient",
+                                           "HeartbeatLost", "SimLost", "Faulted"]
+        await first_samples(rigs)
+        assert await north.value("Status") == WAITING_FOR_CLIENT
+        await north.nodes["Heartbeat"].write_value(ua.Variant(1, UINT32))
+        assert await north.value("Status") == RUNNING
+        # sim_node does not answer: Step gives up after its bounded wait, and a read sent
+        # behind it on the same session is answered; the session stays
+        step = asyncio.ensure_future(method(north, "Step"))
+        await asyncio.sleep(0.05)
+        assert await north.value("SampleCounter") == 0
+        with pytest.raises(ua.uaerrors.BadTimeout):
+            await step
+        assert rig.timing.step_timeout_s < 1.0          # below asyncua's 1 s watchdog
+        await wait_for(north, "Status", SIM_LOST)
+        assert "unanswered" in await north.value("StatusText")
+        # sim_node restarted before it left t = 0: its first sample again resyncs
+        await rig.sample_in(SAMPLE, 0)
+        assert await north.value("SampleCounter") == await north.value("CommandCounter") == 1
+        assert await north.value("Status") == RUNNING
+        await north.nodes["CommandCounter"].write_value(ua.Variant(2, UINT32))
+        await rig.sample_in(SAMPLE, PERIOD_NS)
+        assert await north.value("SampleCounter") == 2
+        assert rig.figures()["sim_restarts"] == "1"
+
+
+def test_step_waits_bounded_status_is_honest_and_a_restart_at_t0_resyncs() -> None:
+    run(step_and_status())
+
+
+FREE_RUN = replace(SETTINGS, lockstep=False)
+RAMP_RAD_S2 = 2.0
+
+
+async def feed(rig: Rig, first_ns: int, periods: int) -> int:
+    """``periods`` samples of a free-running simulator after ``first_ns``; the last stamp."""
+    for k in range(1, periods + 1):
+        await rig.sample_in(SAMPLE, first_ns + k * PERIOD_NS)
+    return first_ns + periods * PERIOD_NS
+
+
+async def heartbeat_lost(close: bool) -> None:
+    async with serving(heartbeat_timeout_s=0.3, safe_ramp_rad_s2=RAMP_RAD_S2) as (
+            rigs, stand_ins, client):
+        rig, stand_in = rigs["north"], stand_ins["north"]
+        await rig.follow(FREE_RUN)
+        await first_samples(rigs)
+        north = await view(client, "north")
+        await client.write_values([north.nodes["SpeedSetpoint"], north.nodes["CommandCounter"]],
+                                  [ua.Variant(6.0, DOUBLE), ua.Variant(1, UINT32)])
+        stamp_ns = await feed(rig, 0, 1)
+        async with second_client(client) as other_session:
+            other = await view(other_session, "north")
+            if close:                        # the client goes (the watchdog, fix 9) ...
+                await client.disconnect()
+            # ... or stays silent: HeartbeatLost either way, and the ramp starts
+            await wait_for(other, "Status", HEARTBEAT_LOST)
+            sent = len(stand_in.commands)
+            stamp_ns = await feed(rig, stamp_ns, 400)
+            speeds = [c.speed_rad_s for c, _ in stand_in.commands[sent:]]
+            # 6 rad/s at 2 rad/s^2 over 10 ms periods: 300 steps of 0.02 rad/s to rest
+            assert len(speeds) == 300 and speeds[-1] == 0.0
+            assert all(0.0 <= a - b <= RAMP_RAD_S2 * 0.01 + 1e-12
+                       for a, b in zip([6.0, *speeds], speeds, strict=False))
+            assert await other.value("SpeedSetpoint") == 0.0
+            assert "at rest" in await other.value("StatusText")
+            # writes are refused until Reset, which lets the next writer in
+            with pytest.raises(ua.uaerrors.BadInvalidState):
+                await other.nodes["SpeedSetpoint"].write_value(ua.Variant(3.0, DOUBLE))
+            await method(other, "Reset")
+            assert await other.value("Status") == WAITING_FOR_CLIENT
+            await other.nodes["SpeedSetpoint"].write_value(ua.Variant(3.0, DOUBLE))
+            assert await other.value("Status") == RUNNING
+
+
+def test_a_silent_owner_in_free_run_brings_the_drive_to_rest_until_reset() -> None:
+    run(heartbeat_lost(close=False))
+
+
+def test_a_client_gone_in_free_run_brings_the_drive_to_rest_until_reset() -> None:
+    run(heartbeat_lost(close=True))
+
+
+async def silent_in_lockstep() -> None:
+    async with serving(heartbeat_timeout_s=0.2) as (rigs, stand_ins, client):
+        await first_samples(rigs)
+        north = await view(client, "north")
+        await north.nodes["Heartbeat"].write_value(ua.Variant(1, UINT32))
+        await wait_for(north, "Status", WAITING_FOR_CLIENT)    # its ownership lapsed
+        assert stand_ins["north"].commands == []               # and nothing moved
+        await north.nodes["CommandCounter"].write_value(ua.Variant(1, UINT32))
+        assert await north.value("Status") == RUNNING
+
+
+def test_in_lockstep_a_silent_owner_only_loses_the_setpoints() -> None:
+    run(silent_in_lockstep())
