@@ -22,6 +22,7 @@
 from __future__ import annotations
 
 import asyncio
+import importlib.metadata
 import logging
 import math
 import time
@@ -66,6 +67,7 @@ Bad = ua.StatusCodes
 SETPOINTS = ("SpeedSetpoint", "TorqueCommand", "WobSetpoint")
 MODE_SWITCH_TIMEOUT_S = 5.0
 SUPERVISE_PERIOD_S = 0.05
+PRODUCT_NAME = "drill_sim_ros OPC UA gateway"
 # switch_mode(mode): None once the simulator drives in ``mode``, else its reason for refusing
 # (TimeoutError, or any OSError, if it does not answer)
 SwitchMode = Callable[[str], Awaitable[str | None]]
@@ -247,7 +249,8 @@ class Rig:
         self.values[name] = value
         stamp = sim_timestamp(time_ns) if time_ns is not None else None
         await self._server.write_attribute_value(self.nodes[name].nodeid, ua.DataValue(
-            variant(VARIABLE_BY_NAME[name], value), SourceTimestamp=stamp))
+            variant(VARIABLE_BY_NAME[name], value), SourceTimestamp=stamp,
+            ServerTimestamp=datetime.now(timezone.utc)))
 
     def status(self, now_s: float) -> tuple[RigStatus, str]:
         """The Status now, and its text."""
@@ -491,6 +494,13 @@ class Rig:
         _log.warning("%s: sim_node started again (%s); the handshake goes on from "
                      "CommandCounter %d", self.name, why, self.values["CommandCounter"])
 
+    async def sim_replaced(self) -> None:
+        """Another sim_node publishes the samples (it started again, whatever its time): none
+        of its setpoints is known, and a command left unanswered is given up (start over)."""
+        self._in_force = _unset_setpoints()
+        if self.outstanding:
+            await self._start_over("a new sim_node publishes the samples")
+
     async def sample_in(self, values: dict[str, float], time_ns: int) -> None:
         """A sample of sim_node (SAMPLE_VARIABLES' values, stamped ``time_ns``) into the
         variables; it answers the outstanding command, if any. An older stamp means sim_node
@@ -583,6 +593,13 @@ class Rig:
             _log.warning("%s: %s", self.name, self.latched[1])
 
 
+def _version() -> str:
+    try:
+        return importlib.metadata.version("drill_sim_ros")
+    except importlib.metadata.PackageNotFoundError:
+        return "unknown"
+
+
 class _FaultsAreClientErrors(logging.Filter):
     """asyncua logs every service fault it sends (a refused write too) at ERROR; the gateway
     logs its refusals itself, so these are INFO."""
@@ -612,8 +629,8 @@ class RigServer:
         logging.getLogger("asyncua.server.uaprocessor").addFilter(FAULT_FILTER)
         await self.server.init()
         self.server.set_endpoint(self.endpoint)
-        names = ", ".join(rig.name for rig in self.rigs)
-        self.server.set_server_name(f"drill_sim_ros OPC UA gateway ({names})")
+        await self._name_the_product()
+        self.server.set_force_server_timestamp(True)
         await self._secure()
         index = await self.server.register_namespace(NAMESPACE_URI)
         status_type = await status_enumeration(self.server, index)
@@ -634,6 +651,15 @@ class RigServer:
                 except Exception:       # one rig's bug must not stop the others' watchdog
                     _log.exception("%s: supervision failed", rig.name)
 
+    async def _name_the_product(self) -> None:
+        """The product's own ApplicationUri (the certificate's), names and build info."""
+        names = ", ".join(rig.name for rig in self.rigs)
+        self.server.set_server_name(f"{PRODUCT_NAME} ({names})")
+        await self.server.set_application_uri(APPLICATION_URI)
+        self.server.product_uri = NAMESPACE_URI
+        await self.server.set_build_info(NAMESPACE_URI, "drill_sim_ros", PRODUCT_NAME,
+                                         _version(), _version(), datetime.now(timezone.utc))
+
     async def _secure(self) -> None:
         """Anonymous and unencrypted (loopback only), or Basic256Sha256 Sign & Encrypt
         with the one user of :attr:`security`."""
@@ -641,7 +667,6 @@ class RigServer:
             self.server.set_security_policy([ua.SecurityPolicyType.NoSecurity])
             self.server.set_identity_tokens([ua.AnonymousIdentityToken])
             return
-        await self.server.set_application_uri(APPLICATION_URI)
         self.server.set_security_policy([ua.SecurityPolicyType.Basic256Sha256_SignAndEncrypt])
         self.server.set_identity_tokens([ua.UserNameIdentityToken])
         await self.server.load_certificate(str(self.security.certificate))

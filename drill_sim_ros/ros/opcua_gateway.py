@@ -28,6 +28,7 @@ import functools
 import logging
 import sys
 import threading
+import time
 from collections.abc import Awaitable, Callable
 from dataclasses import dataclass
 from typing import Any
@@ -63,6 +64,7 @@ GIL_SWITCH_INTERVAL_S = 0.0005    # as sim_node's: a thread waiting for the GIL 
 POLL_S = 0.2
 DIAGNOSTICS_PERIOD_S = 1.0        # wall time, as sim_node's
 SETTINGS_RETRY_S = 0.5            # how often stale sim_node settings are asked for again
+PROGRESS_S = 5.0                  # a line while the gateway waits for sim_node at start
 
 
 @dataclass(frozen=True)
@@ -98,8 +100,8 @@ SETTINGS = (
     Setting("rig", "", "BrowseName of a lone rig's object; '' = the namespace's last part, "
             "or Rig in /"),
     Setting("sim_node", topics.NODE_NAME, "sim_node's node name, in each rig's namespace"),
-    Setting("sim_wait_s", 30.0, "how long to wait at start for each sim_node's parameters "
-            "[s]", seconds=True),
+    Setting("sim_wait_s", 120.0, "how long to wait at start for each sim_node's parameters, "
+            "asking again until all are declared (a line every 5 s) [s]", seconds=True),
     Setting("step_timeout_s", 0.5, "Step returns BadTimeout after this many wall seconds "
             "without the sample; the session's other requests wait behind it, so keep it below "
             "the client's own timeouts (asyncua's watchdog: 1 s) [s]", seconds=True),
@@ -190,6 +192,7 @@ class GatewayNode(Node):
 
     def _poll_settings(self) -> None:
         for link in self.links:
+            link.watch_publishers()
             link.poll()
 
     def _publish_diagnostics(self) -> None:
@@ -210,17 +213,33 @@ class GatewayNode(Node):
         return status(f"{NODE_NAME}: {link.rig}", level, message, values)
 
     def sim_parameters(self, link: SimLink) -> dict[str, Any]:
-        """The SIM_PARAMETERS of ``link``'s sim_node (DrillSimError, one line, if it does not
-        answer)."""
-        if not link.parameters.wait_for_services(timeout_sec=self.sim_wait_s):
+        """The SIM_PARAMETERS of ``link``'s sim_node, asked for again until it answers with all
+        of them declared (a first start loads the kernel for a while), with a progress line
+        every PROGRESS_S; DrillSimError (one line) after ``sim_wait_s``."""
+        start_s = time.monotonic()
+        next_line_s = start_s + PROGRESS_S
+        answered = False
+        while (left_s := start_s + self.sim_wait_s - time.monotonic()) > 0:
+            if link.parameters.wait_for_services(timeout_sec=min(left_s, PROGRESS_S)):
+                answered = True
+                future = link.parameters.get_parameters(list(SIM_PARAMETERS))
+                rclpy.spin_until_future_complete(self, future, timeout_sec=min(
+                    left_s, PROGRESS_S))
+                sim = sim_values(future.result()) if future.done() else None
+                if sim is not None:
+                    return sim
+                time.sleep(min(SETTINGS_RETRY_S, max(0.0, left_s)))
+            if time.monotonic() >= next_line_s:
+                next_line_s += PROGRESS_S
+                self.get_logger().info(
+                    f"waiting for {link.sim_node}'s parameters: "
+                    f"{time.monotonic() - start_s:.0f} s of sim_wait_s {self.sim_wait_s:g} "
+                    f"({'it answers, not all declared yet' if answered else 'not there yet'})")
+        if not answered:
             raise DrillSimError(f"no sim_node {link.sim_node} answered in {self.sim_wait_s:g} "
                                 "s (start sim_node first, in the rig's namespace and domain)")
-        future = link.parameters.get_parameters(list(SIM_PARAMETERS))
-        rclpy.spin_until_future_complete(self, future, timeout_sec=self.sim_wait_s)
-        sim = sim_values(future.result()) if future.done() else None
-        if sim is None:
-            raise DrillSimError(f"{link.sim_node} did not return its parameters")
-        return sim
+        raise DrillSimError(f"{link.sim_node} did not return all its parameters in "
+                            f"{self.sim_wait_s:g} s")
 
 
 def _spin(executor: SingleThreadedExecutor) -> None:
@@ -244,6 +263,7 @@ def _connect(link: SimLink, rig: Rig, loop: asyncio.AbstractEventLoop,
     link.on_sample = lambda values, time_ns: put(functools.partial(rig.sample_in, values,
                                                                    time_ns))
     link.on_settings = lambda sim: put(functools.partial(rig.follow, RigSettings.of_sim(sim)))
+    link.on_restart = lambda: put(rig.sim_replaced)
     link.figures = rig.figures
     if link.latest_sample is not None:      # received while sim_node's parameters came
         events.put_nowait(functools.partial(rig.sample_in, *link.latest_sample))

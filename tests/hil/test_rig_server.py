@@ -25,6 +25,7 @@ from asyncua import Client, ua
 
 from drill_sim_ros.control.command import Command
 from drill_sim_ros.hil.rig_server import Rig, RigServer, RigSettings, RigTiming
+from drill_sim_ros.hil.security import APPLICATION_URI
 
 DOUBLE, UINT32, STRING = ua.VariantType.Double, ua.VariantType.UInt32, ua.VariantType.String
 SETTINGS = RigSettings(max_speed_rad_s=30.0, max_torque_nm=50_000.0, max_wob_n=1e6,
@@ -472,3 +473,22 @@ async def silent_in_lockstep() -> None:
 
 def test_in_lockstep_a_silent_owner_only_loses_the_setpoints() -> None:
     run(silent_in_lockstep())
+
+
+async def product_names() -> None:
+    async with serving() as (rigs, _, client):
+        await first_samples(rigs)
+        endpoints = await client.get_endpoints()
+        assert {e.Server.ApplicationUri for e in endpoints} == {APPLICATION_URI}
+        assert "freeopcua" not in " ".join(e.Server.ApplicationName.Text for e in endpoints)
+        build = client.get_node(ua.NodeId(ua.ObjectIds.Server_ServerStatus_BuildInfo))
+        info = await build.read_value()
+        assert (info.ProductUri, info.ProductName) == ("urn:drill_sim_ros",
+                                                       "drill_sim_ros OPC UA gateway")
+        north = await view(client, "north")
+        value = await north.nodes["QuillTorque"].read_data_value()
+        assert value.ServerTimestamp is not None and value.SourceTimestamp.year == 1970
+
+
+def test_the_server_names_itself_and_stamps_its_values() -> None:
+    run(product_names())
