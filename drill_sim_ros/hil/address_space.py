@@ -127,6 +127,13 @@ VARIABLE_BY_NAME = {v.name: v for v in VARIABLES}
 SAMPLE_VARIABLES = tuple(v for v in VARIABLES if v.source is not None)
 STEP_METHOD = "Step"
 RESET_METHOD = "Reset"
+METHOD_MEANINGS = {
+    STEP_METHOD: "sends the setpoints as the next period's command (as CommandCounter + 1 "
+    "does) and returns the new SampleCounter (UInt32) once that sample is in the values, or "
+    "BadTimeout after step_timeout_s",
+    RESET_METHOD: "after HeartbeatLost (the drive at rest) or Faulted: the rig takes writes "
+    "again, and the first session that writes owns the setpoints",
+}
 
 
 # A setting read from sim_node is given in decimal (a YAML or command-line value), so 15
@@ -200,11 +207,6 @@ def markdown_table() -> str:
         access = "read/write" if v.writable else "read"
         lines.append(f"| `{v.name}` | {v.type_name} | {access} | {unit} | "
                      f"{_range_text(v) or '–'} | {v.meaning} |")
-    lines.append(f"| `{STEP_METHOD}()` | method | call | – | – | sends the setpoints as the "
-                 "next period's command (as CommandCounter + 1 does) and returns the new "
-                 "SampleCounter (UInt32) once that sample is in the values, or BadTimeout after "
-                 "step_timeout_s |")
-    lines.append(f"| `{RESET_METHOD}()` | method | call | – | – | after HeartbeatLost (the "
-                 "drive at rest) or Faulted: the rig takes writes again, and the first session "
-                 "that writes owns the setpoints |")
+    for name, meaning in METHOD_MEANINGS.items():
+        lines.append(f"| `{name}()` | method | call | – | – | {meaning} |")
     return "\n".join(lines)

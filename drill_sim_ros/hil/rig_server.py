@@ -40,6 +40,7 @@ from drill_sim_ros.control.command import Command
 from drill_sim_ros.hil import sessions
 from drill_sim_ros.hil.address_space import (
     DRIVE_MODES,
+    METHOD_MEANINGS,
     NAMESPACE_URI,
     RESET_METHOD,
     SAMPLE_VARIABLES,
@@ -172,6 +173,20 @@ async def status_enumeration(server: Server, index: int) -> ua.NodeId:
     return data_type.nodeid
 
 
+async def _describe(node: Any, text: str) -> None:
+    await node.write_attribute(ua.AttributeIds.Description, ua.DataValue(
+        ua.Variant(ua.LocalizedText(text), ua.VariantType.LocalizedText)))
+
+
+async def _retype(node: Any, type_id: int) -> None:
+    """Make ``node`` (a BaseDataVariableType) an instance of the variable type ``type_id``
+    (AnalogItemType: EURange and EngineeringUnits; AnalogUnitType: EngineeringUnits)."""
+    await node.delete_reference(ua.NodeId(ua.ObjectIds.BaseDataVariableType),
+                                ua.ObjectIds.HasTypeDefinition, bidirectional=False)
+    await node.add_reference(ua.NodeId(type_id), ua.ObjectIds.HasTypeDefinition,
+                             bidirectional=False)
+
+
 def _unset_setpoints() -> dict[str, float]:
     """No setpoint known to be in force: the next command carries them all."""
     return dict.fromkeys(SETPOINTS, math.nan)
@@ -190,6 +205,7 @@ class Rig:
         self._ranges: dict[str, Any] = {}               # EURange property nodes by variable
         self._server: Server | None = None
         self._status_type: ua.NodeId | None = None
+        self.nodes_of_object: Any = None                # the rig object, once built
         self.values: dict[str, Any] = {v.name: settings.initial(v.name) for v in VARIABLES}
         self._in_force = {"SpeedSetpoint": settings.speed_rad_s, "WobSetpoint": settings.wob_n,
                           "TorqueCommand": math.nan}
@@ -219,11 +235,19 @@ class Rig:
                                                     ua.QualifiedName(self.name, index))
         for variable in VARIABLES:
             await self._add_variable(rig, index, variable)
-        await rig.add_method(ua.NodeId(node_id(self.name, STEP_METHOD), index),
-                             ua.QualifiedName(STEP_METHOD, index),
-                             self._step, [], [ua.VariantType.UInt32])
-        await rig.add_method(ua.NodeId(node_id(self.name, RESET_METHOD), index),
-                             ua.QualifiedName(RESET_METHOD, index), self._reset, [], [])
+        await _describe(rig, f"the rig {self.name}: a simulated drill string's surface, "
+                        "its top drive's setpoints and the lockstep handshake (docs/hil.md)")
+        step = await rig.add_method(
+            ua.NodeId(node_id(self.name, STEP_METHOD), index),
+            ua.QualifiedName(STEP_METHOD, index), self._step, [],
+            [ua.Argument(Name="SampleCounter", DataType=ua.NodeId(ua.ObjectIds.UInt32),
+                         ValueRank=-1, Description=ua.LocalizedText(
+                             "the new SampleCounter: the command's sample is in the values"))])
+        await _describe(step, METHOD_MEANINGS[STEP_METHOD])
+        reset = await rig.add_method(ua.NodeId(node_id(self.name, RESET_METHOD), index),
+                                     ua.QualifiedName(RESET_METHOD, index), self._reset, [], [])
+        await _describe(reset, METHOD_MEANINGS[RESET_METHOD])
+        self.nodes_of_object = rig
         return {node.nodeid: name for name, node in self.nodes.items()}
 
     async def _add_variable(self, rig: Any, index: int, variable: Variable) -> None:
@@ -234,6 +258,7 @@ class Rig:
                                       else None)
         if variable.writable:
             await node.set_writable()
+        await _describe(node, variable.meaning)
         if variable.unit is not None:
             await _add_property(node, "EngineeringUnits", ua.Variant(
                 eu_information(variable), ua.VariantType.ExtensionObject),
@@ -242,6 +267,9 @@ class Rig:
         if eu_range is not None:
             self._ranges[variable.name] = await _add_property(
                 node, "EURange", _range_variant(eu_range), ua.ObjectIds.Range)
+        if variable.unit is not None:         # a setpoint: AnalogItemType, else AnalogUnitType
+            await _retype(node, ua.ObjectIds.AnalogItemType if eu_range is not None
+                          else ua.ObjectIds.AnalogUnitType)
         self.nodes[variable.name] = node
 
     async def _set(self, name: str, value: Any, time_ns: int | None = None) -> None:
@@ -496,9 +524,11 @@ class Rig:
 
     async def sim_replaced(self) -> None:
         """Another sim_node publishes the samples (it started again, whatever its time): none
-        of its setpoints is known, and a command left unanswered is given up (start over)."""
+        of its setpoints is known, and a command the lost one left unanswered is given up
+        (start over). The graph can tell this after the new sim_node's first samples: a
+        command sent since (sim_node not lost) stands."""
         self._in_force = _unset_setpoints()
-        if self.outstanding:
+        if self.outstanding and self.sim_lost:
             await self._start_over("a new sim_node publishes the samples")
 
     async def sample_in(self, values: dict[str, float], time_ns: int) -> None:
@@ -600,6 +630,14 @@ def _version() -> str:
         return "unknown"
 
 
+async def _subtree(node: Any) -> list[Any]:
+    """``node`` and everything under it (children by hierarchical references, properties)."""
+    nodes = [node]
+    for child in await node.get_children():
+        nodes += await _subtree(child)
+    return nodes
+
+
 class _FaultsAreClientErrors(logging.Filter):
     """asyncua logs every service fault it sends (a refused write too) at ERROR; the gateway
     logs its refusals itself, so these are INFO."""
@@ -624,8 +662,17 @@ class RigServer:
         self.endpoint, self.rigs = endpoint, tuple(rigs)
         self._writable: dict[ua.NodeId, tuple[Rig, str]] = {}
         self._supervisor: asyncio.Task[None] | None = None
+        self.status_type: ua.NodeId | None = None
 
     async def start(self) -> None:
+        await self.build()
+        self.server.subscribe_server_callback(CallbackType.PreWrite, self._pre_write)
+        self.server.subscribe_server_callback(CallbackType.PreRead, self._pre_read)
+        await self.server.start()
+        self._supervisor = asyncio.create_task(self._supervise())
+
+    async def build(self) -> None:
+        """The address space, without listening (what :meth:`start` serves)."""
         logging.getLogger("asyncua.server.uaprocessor").addFilter(FAULT_FILTER)
         await self.server.init()
         self.server.set_endpoint(self.endpoint)
@@ -633,14 +680,18 @@ class RigServer:
         self.server.set_force_server_timestamp(True)
         await self._secure()
         index = await self.server.register_namespace(NAMESPACE_URI)
-        status_type = await status_enumeration(self.server, index)
+        self.status_type = await status_enumeration(self.server, index)
         for rig in self.rigs:
-            for nodeid, name in (await rig.build(self.server, index, status_type)).items():
+            for nodeid, name in (await rig.build(self.server, index, self.status_type)).items():
                 self._writable[nodeid] = (rig, name)
-        self.server.subscribe_server_callback(CallbackType.PreWrite, self._pre_write)
-        self.server.subscribe_server_callback(CallbackType.PreRead, self._pre_read)
-        await self.server.start()
-        self._supervisor = asyncio.create_task(self._supervise())
+
+    async def export_nodeset(self, path: str) -> None:
+        """The rigs' address space (namespace :data:`NAMESPACE_URI`: the RigStatus DataType,
+        the rig objects, their variables, properties and methods) as a NodeSet2 XML file."""
+        nodes = await _subtree(self.server.get_node(self.status_type))
+        for rig in self.rigs:
+            nodes += await _subtree(rig.nodes_of_object)
+        await self.server.export_xml(nodes, path, export_values=True)
 
     async def _supervise(self) -> None:
         while True:

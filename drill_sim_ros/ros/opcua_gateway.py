@@ -55,11 +55,12 @@ from drill_sim_ros.ros.parameters import init_ros
 from drill_sim_ros.ros.sim_link import SIM_PARAMETERS, SimLink, sim_values
 
 NODE_NAME = "opcua_gateway"
-USAGE = """usage: opcua_gateway [--ros-args -p endpoint:=opc.tcp://127.0.0.1:4840/drill_sim/ ...]
+USAGE = """usage: opcua_gateway [--export-nodeset FILE] [--ros-args -p endpoint:=... ...]
 
 sim_node's surface and commands as an OPC UA server, for a PLC's controller in the loop
 (docs/hil.md). Its settings are ROS parameters (-p "rigs:=[/rig1, /rig2]" serves the
-sim_nodes of two namespaces); start sim_node first."""
+sim_nodes of two namespaces); start sim_node first. --export-nodeset FILE writes the address
+space (with sim_node's ranges) as NodeSet2 XML for a PLC project, and exits."""
 GIL_SWITCH_INTERVAL_S = 0.0005    # as sim_node's: a thread waiting for the GIL waits less
 POLL_S = 0.2
 DIAGNOSTICS_PERIOD_S = 1.0        # wall time, as sim_node's
@@ -298,10 +299,35 @@ async def serve(node: GatewayNode, settings: list[RigSettings]) -> None:
         await server.stop()
 
 
+EXPORT_OPTION = "--export-nodeset"
+
+
+def export_option(args: list[str]) -> tuple[list[str], str | None]:
+    """``args`` without ``--export-nodeset FILE``, and FILE (None: not asked for)."""
+    if EXPORT_OPTION not in args:
+        return args, None
+    at = args.index(EXPORT_OPTION)
+    if at + 1 >= len(args) or args[at + 1].startswith("-"):
+        raise ParameterError(f"{EXPORT_OPTION} needs a FILE (the NodeSet2 XML to write)")
+    return args[:at] + args[at + 2:], args[at + 1]
+
+
+async def export(node: GatewayNode, settings: list[RigSettings], path: str) -> None:
+    """Write the rigs' address space (with these sim_nodes' ranges) as NodeSet2 XML."""
+    rigs = [Rig(link.rig, start_settings, link.send, None, node.timing)
+            for link, start_settings in zip(node.links, settings, strict=True)]
+    server = RigServer(node.endpoint, rigs, node.security)
+    await server.build()
+    await server.export_nodeset(path)
+    node.get_logger().info(f"wrote the address space of {', '.join(r.name for r in rigs)} "
+                           f"to {path} (NodeSet2 XML)")
+
+
 def main(args: list[str] | None = None) -> int:
     """Console script ``opcua_gateway``; a user's mistake (a bad argument, an off-loopback
     endpoint, no sim_node) is one line, exit 2."""
     try:
+        args, export_path = export_option(list(sys.argv if args is None else args))
         init_ros(args, USAGE)
     except DrillSimError as exc:
         rclpy.logging.get_logger(NODE_NAME).fatal(str(exc))
@@ -312,8 +338,9 @@ def main(args: list[str] | None = None) -> int:
     try:
         node = GatewayNode()
         check_endpoint(node.endpoint, secured=node.security is not None)
-        asyncio.run(serve(node, [RigSettings.of_sim(node.sim_parameters(link))
-                                 for link in node.links]))
+        settings = [RigSettings.of_sim(node.sim_parameters(link)) for link in node.links]
+        asyncio.run(serve(node, settings) if export_path is None
+                    else export(node, settings, export_path))
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     except (DrillSimError, ValueError, OSError) as exc:     # refused at start: one line

@@ -18,12 +18,14 @@ import socket
 from collections.abc import AsyncIterator
 from contextlib import asynccontextmanager
 from dataclasses import dataclass, field, replace
+from pathlib import Path
 from typing import Any
 
 import pytest
-from asyncua import Client, ua
+from asyncua import Client, Server, ua
 
 from drill_sim_ros.control.command import Command
+from drill_sim_ros.hil.address_space import VARIABLE_BY_NAME, VARIABLES, RigStatus
 from drill_sim_ros.hil.rig_server import Rig, RigServer, RigSettings, RigTiming
 from drill_sim_ros.hil.security import APPLICATION_URI
 
@@ -492,3 +494,36 @@ async def product_names() -> None:
 
 def test_the_server_names_itself_and_stamps_its_values() -> None:
     run(product_names())
+
+
+async def export_and_import(path: Path) -> None:
+    settings = RigSettings.of_sim(SIM)
+    gateway = RigServer("opc.tcp://127.0.0.1:0/export/", [Rig("Rig", settings, StandIn().send)])
+    await gateway.build()
+    await gateway.export_nodeset(str(path))
+    fresh = Server()
+    await fresh.init()
+    await fresh.import_xml(str(path))
+    index = await fresh.get_namespace_index("urn:drill_sim_ros")
+    rig = await fresh.nodes.objects.get_child(f"{index}:Rig")
+    nodes = {(await n.read_browse_name()).Name: n for n in await rig.get_children()}
+    assert set(nodes) == {v.name for v in VARIABLES} | {"Step", "Reset"}
+    speed = nodes["SpeedSetpoint"]
+    assert await speed.read_type_definition() == ua.NodeId(ua.ObjectIds.AnalogItemType)
+    assert await nodes["QuillTorque"].read_type_definition() == ua.NodeId(
+        ua.ObjectIds.AnalogUnitType)
+    eu_range = await (await speed.get_child("0:EURange")).read_value()
+    assert (eu_range.Low, eu_range.High) == (0.0, 10 * math.pi)
+    unit = await (await speed.get_child("0:EngineeringUnits")).read_value()
+    assert (unit.DisplayName.Text, unit.UnitId) == ("rad/s", int.from_bytes(b"2A"))
+    description = await speed.read_description()
+    assert description.Text == VARIABLE_BY_NAME["SpeedSetpoint"].meaning
+    status_type = fresh.get_node(await nodes["Status"].read_data_type())
+    strings = await (await status_type.get_child("0:EnumStrings")).read_value()
+    assert [s.Text for s in strings] == [s.name for s in RigStatus]
+    outputs = await (await nodes["Step"].get_child("0:OutputArguments")).read_value()
+    assert [a.Name for a in outputs] == ["SampleCounter"]
+
+
+def test_the_exported_nodeset_imports_into_a_fresh_server(tmp_path: Path) -> None:
+    run(export_and_import(tmp_path / "rig.xml"))

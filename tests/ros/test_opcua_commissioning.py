@@ -8,7 +8,8 @@ range, an array to a scalar is a counted BadTypeMismatch, a second session is re
 is left outstanding: it gives up after its bounded wait, the session's reads go on, Status says
 SimLost; sim_node restarted (in free run) resyncs the counters and a writer goes on; the
 owner's client then goes away in free run: HeartbeatLost, the drive comes to rest, and only
-Reset lets a writer in again.
+Reset lets a writer in again. Meanwhile ``opcua_gateway --export-nodeset`` writes a NodeSet2
+that a fresh asyncua server imports.
 """
 
 from __future__ import annotations
@@ -20,15 +21,20 @@ import subprocess
 from pathlib import Path
 
 import pytest
-from asyncua import Client, ua
+from asyncua import Client, Server, ua
 from rclpy.node import Node
 
 from drill_sim_ros import topics
+from drill_sim_ros.control.bench import run_in_process
+from drill_sim_ros.ros.closed_loop import read_telemetry
 from tests.archive.helpers import BIN, running, stop
 from tests.ros.harness import ros_context
+from tests.ros.opcua_pi_law import pi_step
+from tests.ros.plc_handshake import DONE, IDLE, RigHandshake
 from tests.ros.test_opcua_gateway import (
     DOUBLE,
     HEARTBEAT_LOST,
+    SCENARIO,
     SIM_LOST,
     START_TIMEOUT_S,
     UINT32,
@@ -37,6 +43,7 @@ from tests.ros.test_opcua_gateway import (
     free_port,
     make_certificates,
     run,
+    sim_and_gateway,
     sim_command,
     wait_sample,
     wait_until,
@@ -108,8 +115,25 @@ async def safe_stop_and_reset(url: str) -> None:
         await client.disconnect()
 
 
+async def export_nodeset(path: Path) -> None:
+    """``opcua_gateway --export-nodeset``, with the running sim_node's ranges, into a fresh
+    asyncua server (tests/hil/test_rig_server.py checks the whole round trip)."""
+    done = await asyncio.to_thread(subprocess.run, [str(BIN / "opcua_gateway"),
+                                                    "--export-nodeset", str(path)],
+                                   capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    fresh = Server()
+    await fresh.init()
+    await fresh.import_xml(str(path))
+    index = await fresh.get_namespace_index("urn:drill_sim_ros")
+    speed = fresh.get_node(ua.NodeId("Rig.SpeedSetpoint", index))
+    assert await speed.read_type_definition() == ua.NodeId(ua.ObjectIds.AnalogItemType)
+    assert (await (await speed.get_child("0:EURange")).read_value()).High == 10 * math.pi
+
+
 async def commission(url: str, sim: subprocess.Popen, tmp_path: Path) -> None:
     _, rig = await first_session_owns(url)
+    await export_nodeset(tmp_path / "rig.xml")
     assert await asyncio.to_thread(stop, sim, signal.SIGINT) == 0     # sim_node goes
     await step_without_sim_node(rig)
     with running([*sim_command(None, lockstep=False)], tmp_path / "sim_again.log") as again:
@@ -180,3 +204,46 @@ def test_a_certificate_that_cannot_serve_is_refused_at_start_in_one_line(
     assert len(lines) == 1 and "FATAL" in lines[0], lines
     assert ("urn:drill_sim_ros:test_client" if mismatch == "uri" else "is not the key of") \
         in lines[0]
+
+
+PLC_PERIODS = 300
+
+
+async def plc_task(url: str, periods: int) -> None:
+    """A PLC's cyclic task around FB_RigHandshake (its Python mirror): each scan one read list
+    (SampleCounter, Status, QuillTorque), the block, and the write list when it says so."""
+    client, rig = await connect(url)
+    fb, integral, written = RigHandshake(), 0.0, 0
+    reads = [rig.nodes[name] for name in ("SampleCounter", "Status", "QuillTorque")]
+    write_done = write_error = False
+    try:
+        while written < periods or fb.busy:
+            fb.sample_counter, fb.status, torque_nm = await rig.client.read_values(reads)
+            fb.write_done, fb.write_error = write_done, write_error
+            write_done = write_error = False
+            fb.execute = fb.state in (IDLE, DONE) and written < periods
+            if fb.execute:
+                speed, next_integral = pi_step(integral, torque_nm)
+            fb.cycle()
+            assert not fb.error, f"FB_RigHandshake failed: ErrorID {fb.error_id:#06x}"
+            if fb.do_write:
+                integral, written = next_integral, written + 1
+                try:
+                    await rig.write(SpeedSetpoint=ua.Variant(speed, DOUBLE),
+                                    CommandCounter=ua.Variant(fb.command_counter, UINT32))
+                    write_done = True
+                except ua.UaStatusCodeError:
+                    write_error = True
+    finally:
+        await client.disconnect()
+
+
+def test_the_structured_text_handshake_closes_the_loop_bit_for_bit(tmp_path: Path) -> None:
+    record = tmp_path / "run.mcap"
+    with sim_and_gateway(tmp_path, record) as (sim, gateway, url):
+        run(plc_task(url, PLC_PERIODS))
+        assert stop(gateway, signal.SIGINT) == 0
+        assert stop(sim, signal.SIGINT) == 0
+    remote = read_telemetry(record)
+    local = run_in_process(SCENARIO).rows[:PLC_PERIODS + 1]
+    assert remote.tobytes() == local.tobytes()
