@@ -1,22 +1,30 @@
 """The gateway's OPC UA server (asyncua): one object per rig, each with the address space of
-:mod:`.address_space`, the checks of every client write and its own lockstep handshake
-(ROS-free; the gateway node feeds it).
+:mod:`.address_space` (nodes by :mod:`.nodes`), the checks of every client write, its own
+lockstep handshake, one writer and a watchdog (ROS-free; the gateway node feeds it).
 
 - A client's write request is checked whole before any of it is applied (asyncua's PreWrite
-  callback): a read-only variable, a wrong type, NaN, ±inf, a value outside its EURange or a
-  CommandCounter out of turn fails the request with the matching Bad status code
-  (BadNotWritable, BadTypeMismatch, BadOutOfRange, BadInvalidState), counted in that rig's
-  ``RejectedWrites``; nothing of it reaches the simulator. A request may span several rigs.
+  callback): a read-only variable, a wrong type or an array, another session's write, NaN,
+  ±inf, a value outside its EURange (a few ulps beyond a bound are the bound), a
+  CommandCounter out of turn or a new setpoint with the counter already sent fails the request
+  with the matching Bad status code (BadNotWritable, BadTypeMismatch, BadUserAccessDenied,
+  BadOutOfRange, BadInvalidState), counted in that rig's ``RejectedWrites``; nothing of it
+  reaches the simulator. A request may span several rigs.
+- The first session that writes owns the rig's setpoints (:mod:`.sessions` tells sessions
+  apart) until it closes or writes nothing for ``heartbeat_timeout_s``; in free run that
+  starts the safe stop (the speed setpoint ramps to 0) and only ``Reset`` lets writes in again.
 - A new ``DriveMode`` switches the simulator's drive (``switch_mode``) before anything else of
   the request is applied; a switch the simulator refuses fails the request with
   BadInvalidState, one it does not answer with BadTimeout (both counted).
 - ``CommandCounter`` = ``SampleCounter`` + 1 (or a ``Step`` call) hands the setpoints to
   ``send`` as the next period's command, at once; when that period's sample is in the values
-  (:meth:`Rig.sample_in`), ``SampleCounter`` takes the same value and ``Step`` returns
-  it. Without a new count, nothing is sent: a client that goes away leaves the sim waiting.
-- The EURanges, ``Lockstep`` and ``DriveMode`` follow the simulator's settings
-  (:meth:`Rig.follow`); a sample older than the latest one means the simulator started
-  again: the handshake starts over from it (``SampleCounter`` = ``CommandCounter``).
+  (:meth:`Rig.sample_in`), ``SampleCounter`` takes the same value and ``Step`` returns it
+  (BadTimeout after ``step_timeout_s``: the session's other requests wait behind it).
+- The EURanges, ``Lockstep``, ``ControlPeriod`` and ``DriveMode`` follow the simulator's
+  settings (:meth:`Rig.follow`); a sample older than the latest one (or sim_node's first one
+  again, or a new sim_node, while a command was unanswered) means the simulator started again:
+  the handshake starts over (``SampleCounter`` = ``CommandCounter``).
+- ``Status`` (:class:`~.address_space.RigStatus`) and ``StatusText`` say what the rig does or
+  waits for, updated at every write, sample and SUPERVISE_PERIOD_S.
 """
 
 from __future__ import annotations
@@ -29,12 +37,11 @@ import time
 import weakref
 from collections.abc import Awaitable, Callable, Sequence
 from dataclasses import dataclass
-from datetime import datetime, timedelta, timezone
+from datetime import datetime, timezone
 from typing import Any
 
 from asyncua import Server, ua
 from asyncua.common.callback import CallbackType
-from asyncua.common.structures104 import new_enum, new_enum_field
 
 from drill_sim_ros.control.command import Command
 from drill_sim_ros.hil import sessions
@@ -46,7 +53,6 @@ from drill_sim_ros.hil.address_space import (
     SAMPLE_VARIABLES,
     STATUS_MEANINGS,
     STEP_METHOD,
-    UNECE_URI,
     VARIABLE_BY_NAME,
     VARIABLES,
     RigStatus,
@@ -54,15 +60,24 @@ from drill_sim_ros.hil.address_space import (
     exact_setting,
     node_id,
     rad_s_of_rpm,
-    unece_unit_id,
     within,
+)
+from drill_sim_ros.hil.nodes import (
+    add_property,
+    describe,
+    eu_information,
+    range_variant,
+    retype,
+    sim_timestamp,
+    status_enumeration,
+    subtree,
+    variant,
 )
 from drill_sim_ros.hil.security import APPLICATION_URI, PasswordUser, Security
 from drill_sim_ros.hil.sessions import SessionUsers
 from drill_sim_ros.model.top_drive import limit_of_setting
 
 _log = logging.getLogger(__name__)
-SIM_EPOCH = datetime(1970, 1, 1, tzinfo=timezone.utc)
 UINT32_MODULUS = 2**32
 Bad = ua.StatusCodes
 SETPOINTS = ("SpeedSetpoint", "TorqueCommand", "WobSetpoint")
@@ -123,34 +138,6 @@ class RigSettings:
 SAMPLE_NAMES = frozenset(v.name for v in SAMPLE_VARIABLES)
 
 
-def variant(variable: Variable, value: Any) -> ua.Variant:
-    return ua.Variant(value, getattr(ua.VariantType, variable.type_name))
-
-
-def eu_information(variable: Variable) -> ua.EUInformation:
-    unit = variable.unit
-    return ua.EUInformation(NamespaceUri=UNECE_URI, UnitId=unece_unit_id(unit.code),
-                            DisplayName=ua.LocalizedText(unit.symbol),
-                            Description=ua.LocalizedText(unit.description))
-
-
-def sim_timestamp(time_ns: int) -> datetime:
-    """The source timestamp of a sample: its simulated time after :data:`SIM_EPOCH`."""
-    return SIM_EPOCH + timedelta(microseconds=time_ns / 1000)
-
-
-def _range_variant(low_high: tuple[float, float]) -> ua.Variant:
-    return ua.Variant(ua.Range(*low_high), ua.VariantType.ExtensionObject)
-
-
-async def _add_property(node: Any, name: str, value: ua.Variant, data_type: int) -> Any:
-    """A standard property (BrowseName in namespace 0) of ``node``, NodeId ``<node>.<name>``."""
-    index = node.nodeid.NamespaceIndex
-    return await node.add_property(ua.NodeId(f"{node.nodeid.Identifier}.{name}", index),
-                                   ua.QualifiedName(name, 0), value,
-                                   datatype=ua.NodeId(data_type))
-
-
 @dataclass(frozen=True)
 class RigTiming:
     """A rig object's waits (wall time, s) and its safe stop's ramp."""
@@ -160,31 +147,6 @@ class RigTiming:
     heartbeat_timeout_s: float = 2.0     # the owner's silence that ends its ownership
     sim_timeout_s: float = 2.0           # a command unanswered (no sample in free run): SimLost
     safe_ramp_rad_s2: float = 2.0        # the safe stop's speed ramp (rad/s per s, sim time)
-
-
-async def status_enumeration(server: Server, index: int) -> ua.NodeId:
-    """The DataType ``RigStatus`` (an Enumeration, with EnumStrings) in namespace ``index``."""
-    fields = [new_enum_field(status.name, STATUS_MEANINGS[status]) for status in RigStatus]
-    data_type = await new_enum(server, index, "RigStatus", fields)
-    await data_type.add_property(ua.NodeId("RigStatus.EnumStrings", index),
-                                 ua.QualifiedName("EnumStrings", 0), ua.Variant(
-        [ua.LocalizedText(status.name) for status in RigStatus],
-        ua.VariantType.LocalizedText), datatype=ua.NodeId(ua.ObjectIds.LocalizedText))
-    return data_type.nodeid
-
-
-async def _describe(node: Any, text: str) -> None:
-    await node.write_attribute(ua.AttributeIds.Description, ua.DataValue(
-        ua.Variant(ua.LocalizedText(text), ua.VariantType.LocalizedText)))
-
-
-async def _retype(node: Any, type_id: int) -> None:
-    """Make ``node`` (a BaseDataVariableType) an instance of the variable type ``type_id``
-    (AnalogItemType: EURange and EngineeringUnits; AnalogUnitType: EngineeringUnits)."""
-    await node.delete_reference(ua.NodeId(ua.ObjectIds.BaseDataVariableType),
-                                ua.ObjectIds.HasTypeDefinition, bidirectional=False)
-    await node.add_reference(ua.NodeId(type_id), ua.ObjectIds.HasTypeDefinition,
-                             bidirectional=False)
 
 
 def _unset_setpoints() -> dict[str, float]:
@@ -235,7 +197,7 @@ class Rig:
                                                     ua.QualifiedName(self.name, index))
         for variable in VARIABLES:
             await self._add_variable(rig, index, variable)
-        await _describe(rig, f"the rig {self.name}: a simulated drill string's surface, "
+        await describe(rig, f"the rig {self.name}: a simulated drill string's surface, "
                         "its top drive's setpoints and the lockstep handshake (docs/hil.md)")
         step = await rig.add_method(
             ua.NodeId(node_id(self.name, STEP_METHOD), index),
@@ -243,10 +205,10 @@ class Rig:
             [ua.Argument(Name="SampleCounter", DataType=ua.NodeId(ua.ObjectIds.UInt32),
                          ValueRank=-1, Description=ua.LocalizedText(
                              "the new SampleCounter: the command's sample is in the values"))])
-        await _describe(step, METHOD_MEANINGS[STEP_METHOD])
+        await describe(step, METHOD_MEANINGS[STEP_METHOD])
         reset = await rig.add_method(ua.NodeId(node_id(self.name, RESET_METHOD), index),
                                      ua.QualifiedName(RESET_METHOD, index), self._reset, [], [])
-        await _describe(reset, METHOD_MEANINGS[RESET_METHOD])
+        await describe(reset, METHOD_MEANINGS[RESET_METHOD])
         self.nodes_of_object = rig
         return {node.nodeid: name for name, node in self.nodes.items()}
 
@@ -258,17 +220,17 @@ class Rig:
                                       else None)
         if variable.writable:
             await node.set_writable()
-        await _describe(node, variable.meaning)
+        await describe(node, variable.meaning)
         if variable.unit is not None:
-            await _add_property(node, "EngineeringUnits", ua.Variant(
+            await add_property(node, "EngineeringUnits", ua.Variant(
                 eu_information(variable), ua.VariantType.ExtensionObject),
                 ua.ObjectIds.EUInformation)
         eu_range = self.settings.eu_range(variable.name)
         if eu_range is not None:
-            self._ranges[variable.name] = await _add_property(
-                node, "EURange", _range_variant(eu_range), ua.ObjectIds.Range)
+            self._ranges[variable.name] = await add_property(
+                node, "EURange", range_variant(eu_range), ua.ObjectIds.Range)
         if variable.unit is not None:         # a setpoint: AnalogItemType, else AnalogUnitType
-            await _retype(node, ua.ObjectIds.AnalogItemType if eu_range is not None
+            await retype(node, ua.ObjectIds.AnalogItemType if eu_range is not None
                           else ua.ObjectIds.AnalogUnitType)
         self.nodes[variable.name] = node
 
@@ -319,7 +281,7 @@ class Rig:
         for name, node in self._ranges.items():
             if settings.eu_range(name) != old.eu_range(name):
                 await self._server.write_attribute_value(node.nodeid, ua.DataValue(
-                    _range_variant(settings.eu_range(name))))
+                    range_variant(settings.eu_range(name))))
         if settings.lockstep != self.values["Lockstep"]:
             await self._set("Lockstep", settings.lockstep)
             if settings.lockstep:
@@ -630,14 +592,6 @@ def _version() -> str:
         return "unknown"
 
 
-async def _subtree(node: Any) -> list[Any]:
-    """``node`` and everything under it (children by hierarchical references, properties)."""
-    nodes = [node]
-    for child in await node.get_children():
-        nodes += await _subtree(child)
-    return nodes
-
-
 class _FaultsAreClientErrors(logging.Filter):
     """asyncua logs every service fault it sends (a refused write too) at ERROR; the gateway
     logs its refusals itself, so these are INFO."""
@@ -688,9 +642,9 @@ class RigServer:
     async def export_nodeset(self, path: str) -> None:
         """The rigs' address space (namespace :data:`NAMESPACE_URI`: the RigStatus DataType,
         the rig objects, their variables, properties and methods) as a NodeSet2 XML file."""
-        nodes = await _subtree(self.server.get_node(self.status_type))
+        nodes = await subtree(self.server.get_node(self.status_type))
         for rig in self.rigs:
-            nodes += await _subtree(rig.nodes_of_object)
+            nodes += await subtree(rig.nodes_of_object)
         await self.server.export_xml(nodes, path, export_values=True)
 
     async def _supervise(self) -> None:
