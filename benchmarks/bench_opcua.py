@@ -66,7 +66,7 @@ async def connect(url: str) -> Client:
         try:
             await client.connect()
             _, _, nodes = await rig_nodes(client)
-            if await nodes["Status"].read_value() == "running":
+            if await nodes["Status"].read_value() in (1, 2):    # Running, WaitingForClient
                 return client
             await client.disconnect()
         except (OSError, asyncio.TimeoutError, ua.UaError):

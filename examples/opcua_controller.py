@@ -22,6 +22,7 @@ KP_RAD_S_PER_NM = 4e-4
 KI_RAD_S2_PER_NM = 5e-5
 PERIOD_S = 0.01                   # sim_node's publish period (publish_rate_hz 100)
 MAX_SPEED_RAD_S = 20.0
+WAITING_FOR_SIM = 0               # the rig's Status (RigStatus) before its first sample
 
 
 def pi_step(integral_nm_s: float, string_torque_nm: float) -> tuple[float, float]:
@@ -57,7 +58,7 @@ async def run(endpoint: str, periods: int, rig: str, wait_s: float) -> None:
     client = await connected(endpoint, wait_s)
     try:
         v = await rig_variables(client, rig)
-        while await v["Status"].read_value() != "running":      # the first sample is in
+        while await v["Status"].read_value() == WAITING_FOR_SIM:   # the first sample is in
             await asyncio.sleep(0.1)
         counter, integral = await v["SampleCounter"].read_value(), 0.0
         for _ in range(periods):

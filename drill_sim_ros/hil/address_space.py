@@ -12,7 +12,9 @@ Units are the UNECE Recommendation 20 common codes that OPC UA's EUInformation c
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
+from enum import IntEnum
 
 NAMESPACE_URI = "urn:drill_sim_ros"
 DEFAULT_ENDPOINT = "opc.tcp://127.0.0.1:4840/drill_sim/"
@@ -21,6 +23,31 @@ UNECE_URI = "http://www.opcfoundation.org/UA/units/un/cefact"
 DRIVE_MODES = ("speed", "torque")
 # The source timestamp of a value is its simulated time, counted from this instant (UTC).
 SIM_EPOCH_TEXT = "1970-01-01T00:00:00Z"
+
+
+class RigStatus(IntEnum):
+    """The rig object's ``Status`` (an enumeration, its text in ``StatusText``)."""
+
+    WaitingForSim = 0       # no sample yet: at start, or sim_node started again
+    Running = 1             # samples come, a session owns the setpoints
+    WaitingForClient = 2    # samples come, no session owns the setpoints
+    HeartbeatLost = 3       # the owner went silent in free run: safe stop; Reset to go on
+    SimLost = 4             # sim_node does not answer a command, or sends no samples
+    Faulted = 5             # the safe stop could not be made; Reset to go on
+
+
+STATUS_MEANINGS = {
+    RigStatus.WaitingForSim: "no sample from sim_node yet (at start, or after it started "
+    "again)",
+    RigStatus.Running: "samples come and a session owns the setpoints",
+    RigStatus.WaitingForClient: "samples come; no session owns the setpoints (none wrote yet, "
+    "or the owner closed or went silent in lockstep)",
+    RigStatus.HeartbeatLost: "in free run, the owner closed or wrote nothing for "
+    "heartbeat_timeout_s: the speed setpoint ramps to 0; writes are refused until Reset",
+    RigStatus.SimLost: "a command unanswered, or no sample in free run, for sim_timeout_s",
+    RigStatus.Faulted: "the safe stop could not be made (sim_node refused or did not answer "
+    "the switch to speed mode); writes are refused until Reset",
+}
 
 
 @dataclass(frozen=True)
@@ -84,12 +111,62 @@ VARIABLES = (
              "CommandCounter once that command's sample is in the values"),
     Variable("Lockstep", "Boolean", False, "sim_node runs in command-triggered lockstep "
              "(lockstep and lockstep_trigger, followed at runtime)"),
-    Variable("Status", "String", False, "what the gateway does or waits for, one line"),
-    Variable("RejectedWrites", "UInt32", False, "writes refused with a Bad status code"),
+    Variable("Heartbeat", "UInt32", True, "the owner's heartbeat: any write of the owner "
+             "(this counter, a setpoint, CommandCounter) or Step within heartbeat_timeout_s "
+             "keeps its ownership (and, in free run, the drive) alive"),
+    Variable("Status", "Int32", False, "RigStatus: WaitingForSim, Running, WaitingForClient, "
+             "HeartbeatLost, SimLost, Faulted (EnumStrings)"),
+    Variable("StatusText", "String", False, "what the gateway does or waits for, and why, one "
+             "line"),
+    Variable("ControlPeriod", "Double", False, "sim_node's sample period (1/publish_rate_hz): "
+             "the period a control law must use, whatever the PLC task's cycle", SECOND),
+    Variable("RejectedWrites", "UInt32", False, "writes and calls refused with a Bad status "
+             "code"),
 )
 VARIABLE_BY_NAME = {v.name: v for v in VARIABLES}
 SAMPLE_VARIABLES = tuple(v for v in VARIABLES if v.source is not None)
 STEP_METHOD = "Step"
+RESET_METHOD = "Reset"
+METHOD_MEANINGS = {
+    STEP_METHOD: "sends the setpoints as the next period's command (as CommandCounter + 1 "
+    "does) and returns the new SampleCounter (UInt32) once that sample is in the values, or "
+    "BadTimeout after step_timeout_s",
+    RESET_METHOD: "after HeartbeatLost (the drive at rest) or Faulted: the rig takes writes "
+    "again, and the first session that writes owns the setpoints",
+}
+
+
+# A setting read from sim_node is given in decimal (a YAML or command-line value), so 15
+# significant digits hold it whole; a scaled preset's SI round trip (x / c * c) can add an ulp
+# (50000.00000000001), which :func:`exact_setting` takes off.
+SETTING_DIGITS = 15
+# A write within this many ulps of an EURange bound is in range (and clamped to the bound):
+# 300 rev/min is 300*pi/30 = 31.41592653589793 or 300/(30/pi) = 31.415926535897928 rad/s,
+# depending on how a PLC writes the conversion.
+RANGE_TOLERANCE_ULPS = 4
+
+
+def exact_setting(value: float) -> float:
+    """A decimal setting without the last-digit drift of a unit round trip."""
+    return float(f"{value:.{SETTING_DIGITS}g}") if math.isfinite(value) else value
+
+
+def rad_s_of_rpm(rpm: float) -> float:
+    """rev/min -> rad/s as rpm*pi/30, so 300 rev/min gives the double nearest 10*pi."""
+    return exact_setting(rpm) * math.pi / 30.0
+
+
+def within(value: float, low: float, high: float) -> float | None:
+    """``value`` in [``low``, ``high``] (one within RANGE_TOLERANCE_ULPS of a bound: that
+    bound), or None if it is not finite or outside."""
+    if not math.isfinite(value):
+        return None
+    if low <= value <= high:
+        return value
+    for bound in (low, high):
+        if abs(value - bound) <= RANGE_TOLERANCE_ULPS * math.ulp(bound):
+            return bound
+    return None
 
 
 def unece_unit_id(code: str) -> int:
@@ -130,7 +207,6 @@ def markdown_table() -> str:
         access = "read/write" if v.writable else "read"
         lines.append(f"| `{v.name}` | {v.type_name} | {access} | {unit} | "
                      f"{_range_text(v) or '–'} | {v.meaning} |")
-    lines.append(f"| `{STEP_METHOD}()` | method | call | – | – | sends the setpoints as the "
-                 "next period's command (as CommandCounter + 1 does) and returns the new "
-                 "SampleCounter (UInt32) once that sample is in the values |")
+    for name, meaning in METHOD_MEANINGS.items():
+        lines.append(f"| `{name}()` | method | call | – | – | {meaning} |")
     return "\n".join(lines)

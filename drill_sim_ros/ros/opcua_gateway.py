@@ -28,6 +28,7 @@ import functools
 import logging
 import sys
 import threading
+import time
 from collections.abc import Awaitable, Callable
 from dataclasses import dataclass
 from typing import Any
@@ -45,24 +46,26 @@ from rclpy.validate_namespace import validate_namespace
 from drill_sim_ros import topics
 from drill_sim_ros.hil.address_space import DEFAULT_ENDPOINT, rig_name
 from drill_sim_ros.hil.endpoint import check_endpoint
-from drill_sim_ros.hil.rig_server import Rig, RigServer, RigSettings
+from drill_sim_ros.hil.rig_server import Rig, RigServer, RigSettings, RigTiming
 from drill_sim_ros.hil.security import SETTINGS as SECURITY_SETTINGS
 from drill_sim_ros.hil.security import load_security
 from drill_sim_ros.model.errors import DrillSimError, ParameterError
 from drill_sim_ros.ros.messages import status
 from drill_sim_ros.ros.parameters import init_ros
-from drill_sim_ros.ros.sim_link import SIM_PARAMETERS, SimLink, rig_settings, sim_values
+from drill_sim_ros.ros.sim_link import SIM_PARAMETERS, SimLink, sim_values
 
 NODE_NAME = "opcua_gateway"
-USAGE = """usage: opcua_gateway [--ros-args -p endpoint:=opc.tcp://127.0.0.1:4840/drill_sim/ ...]
+USAGE = """usage: opcua_gateway [--export-nodeset FILE] [--ros-args -p endpoint:=... ...]
 
 sim_node's surface and commands as an OPC UA server, for a PLC's controller in the loop
 (docs/hil.md). Its settings are ROS parameters (-p "rigs:=[/rig1, /rig2]" serves the
-sim_nodes of two namespaces); start sim_node first."""
+sim_nodes of two namespaces); start sim_node first. --export-nodeset FILE writes the address
+space (with sim_node's ranges) as NodeSet2 XML for a PLC project, and exits."""
 GIL_SWITCH_INTERVAL_S = 0.0005    # as sim_node's: a thread waiting for the GIL waits less
 POLL_S = 0.2
 DIAGNOSTICS_PERIOD_S = 1.0        # wall time, as sim_node's
 SETTINGS_RETRY_S = 0.5            # how often stale sim_node settings are asked for again
+PROGRESS_S = 5.0                  # a line while the gateway waits for sim_node at start
 
 
 @dataclass(frozen=True)
@@ -98,10 +101,18 @@ SETTINGS = (
     Setting("rig", "", "BrowseName of a lone rig's object; '' = the namespace's last part, "
             "or Rig in /"),
     Setting("sim_node", topics.NODE_NAME, "sim_node's node name, in each rig's namespace"),
-    Setting("sim_wait_s", 30.0, "how long to wait at start for each sim_node's parameters "
-            "[s]", seconds=True),
-    Setting("step_timeout_s", 10.0, "Step returns BadTimeout after this many wall seconds "
-            "without the sample [s]", seconds=True),
+    Setting("sim_wait_s", 120.0, "how long to wait at start for each sim_node's parameters, "
+            "asking again until all are declared (a line every 5 s) [s]", seconds=True),
+    Setting("step_timeout_s", 0.5, "Step returns BadTimeout after this many wall seconds "
+            "without the sample; the session's other requests wait behind it, so keep it below "
+            "the client's own timeouts (asyncua's watchdog: 1 s) [s]", seconds=True),
+    Setting("heartbeat_timeout_s", 2.0, "the owner of the setpoints that writes nothing (nor "
+            "calls Step) for this long loses them; in free run the drive then stops safely "
+            "(HeartbeatLost, Reset to go on) [s]", seconds=True),
+    Setting("sim_timeout_s", 2.0, "a command unanswered (in free run: no sample) for this "
+            "long makes Status SimLost [s]", seconds=True),
+    Setting("safe_ramp_rad_s2", 2.0, "the safe stop's ramp of the speed setpoint to 0 "
+            "[rad/s per s of simulated time]", seconds=True),
     Setting("security.certificate", "", "the server's certificate, DER or PEM, with the URI "
             "urn:drill_sim_ros:opcua_gateway ('' = not secured: loopback only)"),
     Setting("security.private_key", "", "the certificate's private key, PEM"),
@@ -162,7 +173,9 @@ class GatewayNode(Node):
         super().__init__(NODE_NAME, **node_kwargs)
         values = {s.name: s.declared(self) for s in SETTINGS}
         self.endpoint = values["endpoint"]
-        self.sim_wait_s, self.step_timeout_s = values["sim_wait_s"], values["step_timeout_s"]
+        self.sim_wait_s = values["sim_wait_s"]
+        self.timing = RigTiming(**{name: values[name] for name in (
+            "step_timeout_s", "heartbeat_timeout_s", "sim_timeout_s", "safe_ramp_rad_s2")})
         self.security = load_security({name: values[name] for name in SECURITY_SETTINGS})
         listed, rig, sim_node = values["rigs"], values["rig"], values["sim_node"]
         namespaces = rig_namespaces(list(listed or []), self.get_namespace())
@@ -180,6 +193,7 @@ class GatewayNode(Node):
 
     def _poll_settings(self) -> None:
         for link in self.links:
+            link.watch_publishers()
             link.poll()
 
     def _publish_diagnostics(self) -> None:
@@ -200,17 +214,33 @@ class GatewayNode(Node):
         return status(f"{NODE_NAME}: {link.rig}", level, message, values)
 
     def sim_parameters(self, link: SimLink) -> dict[str, Any]:
-        """The SIM_PARAMETERS of ``link``'s sim_node (DrillSimError, one line, if it does not
-        answer)."""
-        if not link.parameters.wait_for_services(timeout_sec=self.sim_wait_s):
+        """The SIM_PARAMETERS of ``link``'s sim_node, asked for again until it answers with all
+        of them declared (a first start loads the kernel for a while), with a progress line
+        every PROGRESS_S; DrillSimError (one line) after ``sim_wait_s``."""
+        start_s = time.monotonic()
+        next_line_s = start_s + PROGRESS_S
+        answered = False
+        while (left_s := start_s + self.sim_wait_s - time.monotonic()) > 0:
+            if link.parameters.wait_for_services(timeout_sec=min(left_s, PROGRESS_S)):
+                answered = True
+                future = link.parameters.get_parameters(list(SIM_PARAMETERS))
+                rclpy.spin_until_future_complete(self, future, timeout_sec=min(
+                    left_s, PROGRESS_S))
+                sim = sim_values(future.result()) if future.done() else None
+                if sim is not None:
+                    return sim
+                time.sleep(min(SETTINGS_RETRY_S, max(0.0, left_s)))
+            if time.monotonic() >= next_line_s:
+                next_line_s += PROGRESS_S
+                self.get_logger().info(
+                    f"waiting for {link.sim_node}'s parameters: "
+                    f"{time.monotonic() - start_s:.0f} s of sim_wait_s {self.sim_wait_s:g} "
+                    f"({'it answers, not all declared yet' if answered else 'not there yet'})")
+        if not answered:
             raise DrillSimError(f"no sim_node {link.sim_node} answered in {self.sim_wait_s:g} "
                                 "s (start sim_node first, in the rig's namespace and domain)")
-        future = link.parameters.get_parameters(list(SIM_PARAMETERS))
-        rclpy.spin_until_future_complete(self, future, timeout_sec=self.sim_wait_s)
-        sim = sim_values(future.result()) if future.done() else None
-        if sim is None:
-            raise DrillSimError(f"{link.sim_node} did not return its parameters")
-        return sim
+        raise DrillSimError(f"{link.sim_node} did not return all its parameters in "
+                            f"{self.sim_wait_s:g} s")
 
 
 def _spin(executor: SingleThreadedExecutor) -> None:
@@ -233,7 +263,8 @@ def _connect(link: SimLink, rig: Rig, loop: asyncio.AbstractEventLoop,
 
     link.on_sample = lambda values, time_ns: put(functools.partial(rig.sample_in, values,
                                                                    time_ns))
-    link.on_settings = lambda sim: put(functools.partial(rig.follow, rig_settings(sim)))
+    link.on_settings = lambda sim: put(functools.partial(rig.follow, RigSettings.of_sim(sim)))
+    link.on_restart = lambda: put(rig.sim_replaced)
     link.figures = rig.figures
     if link.latest_sample is not None:      # received while sim_node's parameters came
         events.put_nowait(functools.partial(rig.sample_in, *link.latest_sample))
@@ -243,7 +274,7 @@ async def serve(node: GatewayNode, settings: list[RigSettings]) -> None:
     """Run the OPC UA server until ROS shuts down (SIGINT, SIGTERM)."""
     loop = asyncio.get_running_loop()
     events: asyncio.Queue[Event] = asyncio.Queue()
-    rigs = [Rig(link.rig, start_settings, link.send, _switcher(link), node.step_timeout_s)
+    rigs = [Rig(link.rig, start_settings, link.send, _switcher(link), node.timing)
             for link, start_settings in zip(node.links, settings, strict=True)]
     server = RigServer(node.endpoint, rigs, node.security)
     await server.start()
@@ -268,10 +299,35 @@ async def serve(node: GatewayNode, settings: list[RigSettings]) -> None:
         await server.stop()
 
 
+EXPORT_OPTION = "--export-nodeset"
+
+
+def export_option(args: list[str]) -> tuple[list[str], str | None]:
+    """``args`` without ``--export-nodeset FILE``, and FILE (None: not asked for)."""
+    if EXPORT_OPTION not in args:
+        return args, None
+    at = args.index(EXPORT_OPTION)
+    if at + 1 >= len(args) or args[at + 1].startswith("-"):
+        raise ParameterError(f"{EXPORT_OPTION} needs a FILE (the NodeSet2 XML to write)")
+    return args[:at] + args[at + 2:], args[at + 1]
+
+
+async def export(node: GatewayNode, settings: list[RigSettings], path: str) -> None:
+    """Write the rigs' address space (with these sim_nodes' ranges) as NodeSet2 XML."""
+    rigs = [Rig(link.rig, start_settings, link.send, None, node.timing)
+            for link, start_settings in zip(node.links, settings, strict=True)]
+    server = RigServer(node.endpoint, rigs, node.security)
+    await server.build()
+    await server.export_nodeset(path)
+    node.get_logger().info(f"wrote the address space of {', '.join(r.name for r in rigs)} "
+                           f"to {path} (NodeSet2 XML)")
+
+
 def main(args: list[str] | None = None) -> int:
     """Console script ``opcua_gateway``; a user's mistake (a bad argument, an off-loopback
     endpoint, no sim_node) is one line, exit 2."""
     try:
+        args, export_path = export_option(list(sys.argv if args is None else args))
         init_ros(args, USAGE)
     except DrillSimError as exc:
         rclpy.logging.get_logger(NODE_NAME).fatal(str(exc))
@@ -282,8 +338,9 @@ def main(args: list[str] | None = None) -> int:
     try:
         node = GatewayNode()
         check_endpoint(node.endpoint, secured=node.security is not None)
-        asyncio.run(serve(node, [rig_settings(node.sim_parameters(link))
-                                 for link in node.links]))
+        settings = [RigSettings.of_sim(node.sim_parameters(link)) for link in node.links]
+        asyncio.run(serve(node, settings) if export_path is None
+                    else export(node, settings, export_path))
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     except (DrillSimError, ValueError, OSError) as exc:     # refused at start: one line

@@ -4,7 +4,9 @@ A :class:`SimLink` sends that sim_node's commands (``<ns>/drill/cmd/top_drive``)
 samples (``<ns>/drill/surface/measured``, latched), switches its drive mode (the runtime
 parameter ``top_drive.mode``) and keeps its settings (:data:`SIM_PARAMETERS`) in view: it
 reads them again whenever sim_node says one changed (``/parameter_events``) or sim_node
-started again (its samples' time went back), retrying until sim_node answers. Everything but
+started again (its samples' time went back, or a new publisher of them appeared: a restarted
+sim_node's parameter events can come before the gateway hears them), retrying until sim_node
+answers. Everything but
 :meth:`SimLink.send` and :meth:`SimLink.switch_mode` runs in the node's executor thread.
 """
 
@@ -25,13 +27,11 @@ from sensor_msgs.msg import JointState
 from drill_sim_ros import topics
 from drill_sim_ros.control.command import Command
 from drill_sim_ros.hil.address_space import SAMPLE_VARIABLES
-from drill_sim_ros.hil.rig_server import RigSettings
-from drill_sim_ros.model.params import RPM_PER_RAD_S
-from drill_sim_ros.model.top_drive import limit_of_setting
 from drill_sim_ros.ros.lockstep_driver import LOCKSTEP_QOS, top_drive_command
 from drill_sim_ros.ros.messages import LATEST_SAMPLE_QOS, stamp_ns
 
 SIM_PARAMETERS = ("limits.max_surface_rpm", "limits.max_wob_n", "top_drive.max_torque_nm",
+                  "publish_rate_hz",
                   "model.surface_rpm", "model.applied_wob_n", "top_drive.mode", "lockstep",
                   "lockstep_trigger")
 MODE_PARAMETER = "top_drive.mode"
@@ -52,18 +52,6 @@ def sample_values(msg: JointState) -> tuple[dict[str, float], int]:
     return values, time_ns
 
 
-def rig_settings(sim: dict[str, Any]) -> RigSettings:
-    """The rig object's settings from sim_node's parameters (``SIM_PARAMETERS``); its
-    kinematic mode, which takes speed setpoints too, shows as ``speed``."""
-    torque_nm = limit_of_setting(sim["top_drive.max_torque_nm"])        # 0: no limit (inf)
-    return RigSettings(
-        max_speed_rad_s=sim["limits.max_surface_rpm"] / RPM_PER_RAD_S, max_torque_nm=torque_nm,
-        max_wob_n=sim["limits.max_wob_n"], speed_rad_s=sim["model.surface_rpm"] / RPM_PER_RAD_S,
-        wob_n=sim["model.applied_wob_n"],
-        drive_mode="torque" if sim[MODE_PARAMETER] == "torque" else "speed",
-        lockstep=bool(sim["lockstep"]) and sim["lockstep_trigger"] == "command")
-
-
 def sim_values(response: Any) -> dict[str, Any] | None:
     """SIM_PARAMETERS' values of a GetParameters response (None: some are not declared)."""
     values = [parameter_value_to_python(value) for value in response.values]
@@ -82,8 +70,12 @@ class SimLink:
         self.sim_node = in_namespace(namespace, sim_node)
         self._pub = node.create_publisher(JointState, in_namespace(
             namespace, topics.CMD_TOP_DRIVE), LOCKSTEP_QOS)
-        node.create_subscription(JointState, in_namespace(namespace, topics.SURFACE_MEASURED),
-                                 self._on_sample, LATEST_SAMPLE_QOS)
+        self._node = node
+        self._samples_topic = in_namespace(namespace, topics.SURFACE_MEASURED)
+        node.create_subscription(JointState, self._samples_topic, self._on_sample,
+                                 LATEST_SAMPLE_QOS)
+        self._publishers: frozenset[bytes] = frozenset()    # of the samples, last seen
+        self.on_restart: Callable[[], None] | None = None
         self.parameters = AsyncParameterClient(node, self.sim_node)
         self.on_sample: Callable[[dict[str, float], int], None] | None = None
         self.on_settings: Callable[[dict[str, Any]], None] | None = None
@@ -119,6 +111,20 @@ class SimLink:
     def want_settings(self) -> None:
         self.stale = True
         self.poll()
+
+    def watch_publishers(self) -> None:
+        """A new publisher of the samples (a sim_node started again, whatever its time): its
+        settings are read again and ``on_restart`` is called."""
+        gids = frozenset(bytes(info.endpoint_gid) for info in
+                         self._node.get_publishers_info_by_topic(self._samples_topic))
+        if not gids:
+            return                             # gone: wait for the next one
+        new = self._publishers and not gids <= self._publishers
+        self._publishers = gids
+        if new:
+            self.stale = True
+            if self.on_restart is not None:
+                self.on_restart()
 
     def poll(self) -> None:
         """Read the settings if they are stale, sim_node answers and no read is under way

@@ -50,6 +50,7 @@ NAMESPACE_URI = "urn:drill_sim_ros"
 START_TIMEOUT_S = 60.0        # sim_node's start (kernel cache load) and the gateway's
 RUN_TIMEOUT_S = 120.0
 DOUBLE, UINT32 = ua.VariantType.Double, ua.VariantType.UInt32
+WAITING_FOR_SIM, HEARTBEAT_LOST, SIM_LOST = 0, 3, 4      # RigStatus values (docs/hil.md)
 
 
 def free_port() -> int:
@@ -109,8 +110,8 @@ async def plain_client(url: str) -> Client:
 
 async def connect(url: str, deadline_s: float = START_TIMEOUT_S, rig_name: str = "Rig",
                   make_client: Any = plain_client) -> tuple[Client, Rig]:
-    """A client (``await make_client(url)``) connected to the gateway's ``rig_name`` once its
-    Status is running (bounded)."""
+    """A client (``await make_client(url)``) connected to the gateway's ``rig_name`` once
+    its samples come (Status neither WaitingForSim nor SimLost; bounded)."""
     loop = asyncio.get_running_loop()
     end = loop.time() + deadline_s
     while True:
@@ -121,7 +122,7 @@ async def connect(url: str, deadline_s: float = START_TIMEOUT_S, rig_name: str =
             obj = await client.nodes.objects.get_child(f"{index}:{rig_name}")
             nodes = {(await n.read_browse_name()).Name: n for n in await obj.get_children()}
             rig = Rig(client, index, obj, nodes)
-            if await rig.value("Status") == "running":
+            if await rig.value("Status") not in (WAITING_FOR_SIM, SIM_LOST):
                 return client, rig
             await client.disconnect()
         except (OSError, asyncio.TimeoutError, ua.UaError):
@@ -146,10 +147,11 @@ def run(coroutine: Any, timeout_s: float = RUN_TIMEOUT_S) -> Any:
 EXPECTED_UNITS = {"DriveSpeed": ("rad/s", "2A"), "MotorTorque": ("N·m", "NU"),
                   "QuillTorque": ("N·m", "NU"), "HookLoad": ("N", "NEW"),
                   "WobEstimate": ("N", "NEW"), "BitDepth": ("m", "MTR"), "Rop": ("m/s", "MTS"),
-                  "SimTime": ("s", "SEC"), "SpeedSetpoint": ("rad/s", "2A"),
+                  "SimTime": ("s", "SEC"), "ControlPeriod": ("s", "SEC"),
+                  "SpeedSetpoint": ("rad/s", "2A"),
                   "TorqueCommand": ("N·m", "NU"), "WobSetpoint": ("N", "NEW")}
 OTHERS = {"DriveMode", "CommandCounter", "SampleCounter", "Lockstep", "Status",
-          "RejectedWrites", "Step"}
+          "RejectedWrites", "Step", "Heartbeat", "StatusText", "Reset"}
 
 
 async def check_address_space(rig: Rig) -> None:
@@ -159,7 +161,7 @@ async def check_address_space(rig: Rig) -> None:
         assert eu.NamespaceUri == "http://www.opcfoundation.org/UA/units/un/cefact"
         assert (eu.DisplayName.Text, eu.UnitId) == (symbol, int.from_bytes(code.encode()))
     speed = await (await rig.nodes["SpeedSetpoint"].get_child("0:EURange")).read_value()
-    assert (speed.Low, speed.High) == (0.0, 300.0 / (30.0 / math.pi))   # limits.max_surface_rpm
+    assert (speed.Low, speed.High) == (0.0, 300.0 * math.pi / 30.0)   # limits.max_surface_rpm
     torque = await (await rig.nodes["TorqueCommand"].get_child("0:EURange")).read_value()
     assert torque.Low == -torque.High < 0
     assert await rig.value("Lockstep") is True

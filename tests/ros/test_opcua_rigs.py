@@ -38,6 +38,7 @@ from tests.archive.helpers import running, stop
 from tests.ros.harness import Ros, ros_context
 from tests.ros.test_opcua_gateway import (
     DOUBLE,
+    HEARTBEAT_LOST,
     SCENARIO,
     START_TIMEOUT_S,
     UINT32,
@@ -54,8 +55,12 @@ from tests.ros.test_opcua_gateway import (
 
 pytestmark = pytest.mark.ros
 STRING = ua.VariantType.String
-RPM_PER_RAD_S = 30.0 / math.pi
 ROS_TIMEOUT_S = 10.0
+
+
+def rad_s(rpm: float) -> float:
+    """rev/min in rad/s as a PLC writes it (docs/hil.md: the EURange is rpm*pi/30)."""
+    return rpm * math.pi / 30.0
 
 
 @contextmanager
@@ -234,11 +239,11 @@ async def wait_eu_high(rig: Rig, name: str, high: float, timeout_s: float = 20.0
 async def follow_at_runtime(url: str, sim: SimParameters) -> None:
     client, rig = await connect(url)
     try:
-        assert await eu_high(rig, "SpeedSetpoint") == 300.0 / RPM_PER_RAD_S
+        assert await eu_high(rig, "SpeedSetpoint") == rad_s(300.0)
         await rig.write(SpeedSetpoint=ua.Variant(25.0, DOUBLE))
         await asyncio.to_thread(sim.set, limits__max_surface_rpm=120.0,
                                 top_drive__max_torque_nm=9000.0)
-        await wait_eu_high(rig, "SpeedSetpoint", 120.0 / RPM_PER_RAD_S)
+        await wait_eu_high(rig, "SpeedSetpoint", rad_s(120.0))
         await wait_eu_high(rig, "TorqueCommand", 9000.0)
         with pytest.raises(ua.uaerrors.BadOutOfRange):
             await rig.write(SpeedSetpoint=ua.Variant(25.0, DOUBLE))
@@ -251,9 +256,12 @@ async def follow_at_runtime(url: str, sim: SimParameters) -> None:
 async def follow_a_restart(url: str) -> None:
     client, rig = await connect(url)
     try:
-        await wait_eu_high(rig, "SpeedSetpoint", 200.0 / RPM_PER_RAD_S, START_TIMEOUT_S)
+        await wait_eu_high(rig, "SpeedSetpoint", rad_s(200.0), START_TIMEOUT_S)
         await wait_until(rig, "Lockstep", lambda on: on is True)
         await wait_until(rig, "SimTime", lambda t: t == 0.0)
+        # the client that wrote SpeedSetpoint closed in free run: the watchdog's safe stop
+        assert await rig.value("Status") == HEARTBEAT_LOST
+        await rig.obj.call_method(f"{rig.index}:Reset")
         counter = await rig.value("SampleCounter")
         assert await rig.value("CommandCounter") == counter
         await rig.write(SpeedSetpoint=ua.Variant(15.0, DOUBLE),
