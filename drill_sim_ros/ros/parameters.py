@@ -25,6 +25,7 @@ from rclpy.impl.implementation_singleton import rclpy_implementation
 from rclpy.utilities import remove_ros_args
 
 from drill_sim_ros.model import defaults
+from drill_sim_ros.model.consistency import check_stick_band, check_wob_carried
 from drill_sim_ros.model.errors import ParameterError
 from drill_sim_ros.model.measurement import MAX_DELAY_PERIODS, SIGNALS
 from drill_sim_ros.model.params import UNIT_SCALES
@@ -315,7 +316,21 @@ def declare_all(node: Any, load: Callable[[str], Preset]) -> tuple[Preset, dict[
         if reason is not None:
             raise ParameterError(reason)
         values[spec.name] = coerce(spec, value)
+    check_operating_point(preset, values)
     return preset, values
+
+
+def check_operating_point(preset: Preset, values: dict[str, Any]) -> None:
+    """The start's WOB and speed against the string (model.consistency): the WOB within
+    the buoyed weight (when one is modelled, > 0), a turning string above the wall's stick
+    band; one ParameterError line naming both."""
+    weight_n = values["model.submerged_string_weight_n"]
+    if weight_n > 0.0:
+        check_wob_carried("model.applied_wob_n", values["model.applied_wob_n"], weight_n)
+    well = preset.string.well
+    if well is not None and well.has_friction:
+        check_stick_band("model.surface_rpm", values["model.surface_rpm"],
+                         well.side_friction.stick_speed_rad_s)
 
 
 _KIND_TEXT = {DOUBLE: "a number", INTEGER: "an integer", BOOL: "true or false",
