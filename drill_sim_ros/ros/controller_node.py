@@ -21,7 +21,6 @@ import time
 from typing import Any
 
 import rclpy
-import yaml
 from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 
@@ -33,6 +32,7 @@ from drill_sim_ros.control.isolation import ControllerError
 from drill_sim_ros.control.registry import BUILTIN
 from drill_sim_ros.control.scenario import Scenario, load_scenario
 from drill_sim_ros.model.errors import DrillSimError, ParameterError
+from drill_sim_ros.model.yaml_input import load_yaml
 from drill_sim_ros.ros.lockstep_driver import LockstepDriver
 from drill_sim_ros.ros.parameters import check_parameter_rules, check_plain_args
 
@@ -92,7 +92,7 @@ class ControllerNode(LockstepDriver):
             description="the controller's parameters as a YAML mapping (for module:Class "
                         "controllers), e.g. '{gain: 2.0}'", read_only=True)).value
         if text:
-            params.update(yaml.safe_load(text) or {})
+            params.update(load_yaml(text) or {})
         for cls in BUILTIN.values():
             for key, description in cls.PARAMS.items():
                 value = self.declare_parameter(f"{cls.name}.{key}", 0.0, _double(

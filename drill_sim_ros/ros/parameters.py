@@ -37,6 +37,7 @@ from drill_sim_ros.model.top_drive import (
     paper_drive,
     setting_of_limit,
 )
+from drill_sim_ros.model.yaml_input import load_yaml
 from drill_sim_ros.ros.params_file_check import check_params_content
 from drill_sim_ros.topics import NODE_NAME
 
@@ -371,7 +372,7 @@ def check_params_files(args: list[str]) -> None:
             continue
         try:
             with open(path, encoding="utf-8") as stream:
-                data = yaml.safe_load(stream)
+                data = load_yaml(stream)
         except OSError as exc:
             raise ParameterError(f"--params-file {path}: {exc.strerror or exc}") from None
         except yaml.YAMLError as exc:
