@@ -46,6 +46,7 @@ from drill_sim_ros.hil.address_space import (
     unece_unit_id,
 )
 from drill_sim_ros.hil.security import APPLICATION_URI, PasswordUser, Security
+from drill_sim_ros.model.errors import DrillSimError
 
 _log = logging.getLogger(__name__)
 SIM_EPOCH = datetime(1970, 1, 1, tzinfo=timezone.utc)
@@ -53,6 +54,7 @@ UINT32_MODULUS = 2**32
 Bad = ua.StatusCodes
 SETPOINTS = ("SpeedSetpoint", "TorqueCommand", "WobSetpoint")
 MODE_SWITCH_TIMEOUT_S = 5.0
+ASYNCUA_SERVER_LOGGER = "asyncua.server.server"   # logs a failed start's traceback
 # switch_mode(mode): None once the simulator drives in ``mode``, else its reason for refusing
 # (TimeoutError, or any OSError, if it does not answer)
 SwitchMode = Callable[[str], Awaitable[str | None]]
@@ -358,7 +360,23 @@ class RigServer:
             for nodeid, name in (await rig.build(self.server, index)).items():
                 self._writable[nodeid] = (rig, name)
         self.server.subscribe_server_callback(CallbackType.PreWrite, self._pre_write)
-        await self.server.start()
+        await self._listen()
+
+    async def _listen(self) -> None:
+        """Start listening; a port that cannot be bound (in use, not allowed) is one
+        DrillSimError line. asyncua logs such a failure's traceback before it raises it, so
+        its server logger is quiet for this one call."""
+        quiet = logging.getLogger(ASYNCUA_SERVER_LOGGER)
+        was_disabled, quiet.disabled = quiet.disabled, True
+        try:
+            await self.server.start()
+        except OSError as exc:
+            reason = exc.strerror or str(exc)
+            raise DrillSimError(f"endpoint {self.endpoint}: cannot listen: {reason} (another "
+                                "gateway or server on this port? choose another port with "
+                                "-p endpoint:=...)") from None
+        finally:
+            quiet.disabled = was_disabled
 
     async def _secure(self) -> None:
         """Anonymous and unencrypted (loopback only), or Basic256Sha256 Sign & Encrypt
