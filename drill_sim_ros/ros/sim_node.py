@@ -85,6 +85,10 @@ CLOCK_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=10,
 # a publisher's own history overwrites is reported lost): in command-triggered lockstep a
 # controller's answer is never lost behind other commands.
 COMMAND_QOS = QoSProfile(history=HistoryPolicy.KEEP_ALL, reliability=ReliabilityPolicy.RELIABLE)
+# The services (~/reset, ~/pause, ~/off_bottom, ~/step) keep every request and every reply
+# (the default keeps the last 10: a burst of 1000 calls got 31 replies); a client that sends
+# bursts needs a queue as deep on its side (its requests and the replies it has not taken).
+SERVICE_QOS = QoSProfile(history=HistoryPolicy.KEEP_ALL, reliability=ReliabilityPolicy.RELIABLE)
 # Reliable volatile publishers match every subscriber but transient-local ones; without the
 # default QoS-event handlers the executor's wait set is 2 entities per publisher smaller.
 QUIET_PUBLISHER = PublisherEventCallbacks(use_default_callbacks=False)
@@ -238,10 +242,11 @@ class SimNode(Node):
 
     def _add_services(self) -> None:
         """``~/reset``, ``~/pause`` and ``~/step``, and the lockstep handshake of ``~/step``."""
-        self.create_service(Trigger, "~/reset", self._on_reset)
-        self.create_service(SetBool, "~/pause", self._on_pause)
-        self.create_service(SetBool, "~/off_bottom", self._on_off_bottom)
-        step = self.create_service(Trigger, "~/step", self._on_step)
+        self.create_service(Trigger, "~/reset", self._on_reset, qos_profile=SERVICE_QOS)
+        self.create_service(SetBool, "~/pause", self._on_pause, qos_profile=SERVICE_QOS)
+        self.create_service(SetBool, "~/off_bottom", self._on_off_bottom,
+                            qos_profile=SERVICE_QOS)
+        step = self.create_service(Trigger, "~/step", self._on_step, qos_profile=SERVICE_QOS)
         self._handshake = Handshake(self.get_logger(), self._command_names[topics.CMD_TOP_DRIVE],
                                     self.resolve_service_name(step.srv_name),
                                     time.monotonic())
