@@ -94,7 +94,7 @@ SERVICE_QOS = QoSProfile(history=HistoryPolicy.KEEP_ALL, reliability=Reliability
 QUIET_PUBLISHER = PublisherEventCallbacks(use_default_callbacks=False)
 FREE_RUN_BATCH = 20          # periods per turn when running as fast as possible
 MAX_CATCH_UP = 50            # periods per turn when catching up in real time
-BACKLOG_WAIT_S = 0.005       # free run: wait this long while the recorder catches up
+BACKLOG_WAIT_S = 0.005       # wait this long while the recorder catches up
 DIAGNOSTICS_PERIOD_S = 1.0
 STATUS_PERIOD_S = 0.25
 WARN_THROTTLE_S = 1.0
@@ -455,9 +455,9 @@ class SimNode(Node):
         try:
             if self._closing or self._lockstep or self._paused or self._fault is not None:
                 return None
+            if self._sinks.backlogged():              # the recorder's loss bound
+                return BACKLOG_WAIT_S
             if self._rtf <= 0:                        # free run
-                if self._sinks.backlogged():
-                    return BACKLOG_WAIT_S
                 self._advance(FREE_RUN_BATCH)
                 return 0.0
             pacer = self._pacer
