@@ -25,6 +25,7 @@ from rclpy.impl.implementation_singleton import rclpy_implementation
 from rclpy.utilities import remove_ros_args
 
 from drill_sim_ros.model import defaults
+from drill_sim_ros.model.checks import as_number, shown
 from drill_sim_ros.model.consistency import check_stick_band, check_wob_carried
 from drill_sim_ros.model.errors import ParameterError
 from drill_sim_ros.model.measurement import MAX_DELAY_PERIODS, SIGNALS
@@ -273,6 +274,9 @@ def descriptor(spec: ParamSpec) -> ParameterDescriptor:
 def validate(spec: ParamSpec, value: Any) -> str | None:
     """None if ``value`` is acceptable for ``spec``, else the reason (naming the range)."""
     if spec.kind == DOUBLE:
+        if isinstance(value, str) and _beyond_a_double(value):     # rcl keeps it as text
+            return (f"{spec.name} = {_shown_text(value)} is beyond a double; it must be a "
+                    f"number in [{spec.low:g}, {spec.high:g}]")
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             return f"{spec.name} must be a number, got {value!r}"
         if not (math.isfinite(value) and spec.low <= value <= spec.high):
@@ -352,6 +356,19 @@ def _declare(node: Any, spec: ParamSpec, default: Any) -> Any:
         shown = f"{given.group(1)!r} ({given.group(2).lower()})" if given else "another type"
         raise ParameterError(f"{spec.name} must be {_KIND_TEXT[spec.kind]}, got "
                              f"{shown}") from None
+
+
+def _beyond_a_double(text: str) -> bool:
+    """``text`` (what rcl kept as a string) is a number too large for a double (rcl reads
+    ``1e400`` and a 400-digit integer as strings)."""
+    number = as_number(text)
+    return number is not None and math.isinf(number)
+
+
+def _shown_text(text: str) -> str:
+    """A number's text as an error shows it (checks.shown: a long integer as its size)."""
+    stripped = text.strip().lstrip("+-")
+    return shown(int(text)) if stripped.isdigit() else repr(text)
 
 
 # rclpy's exception texts (rclpy/exceptions.py) carry the rejected value; they hold no field.
