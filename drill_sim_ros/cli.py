@@ -11,7 +11,6 @@ preset, in which case SI figures are added.
 from __future__ import annotations
 
 import argparse
-import contextlib
 import csv
 import io
 import json
@@ -19,7 +18,6 @@ import math
 import os
 import signal
 import sys
-import threading
 import time
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, fields, replace
@@ -28,6 +26,7 @@ from typing import Any, TextIO
 
 from drill_sim_ros import closed_loop_cli, stability_cli, startup_cli, string_cli
 from drill_sim_ros.archive.output import open_output
+from drill_sim_ros.archive.signals import stop_on_signals
 from drill_sim_ros.model import analysis, telemetry
 from drill_sim_ros.model import kernel as k
 from drill_sim_ros.model.bit_rock import LAWS, RGD07_LAW, BitLaw
@@ -448,42 +447,14 @@ def _cmd_info(args: argparse.Namespace) -> int:
     return 0
 
 
-STOP_SIGNALS = (signal.SIGTERM, signal.SIGHUP)     # Ctrl-C: Python's KeyboardInterrupt
-STOP_GRACE_S = 10.0    # after a stop signal, the longest the command may take to unwind
-
-
-def _stop(signum: int, _frame: Any) -> None:
-    """A stop signal: the outputs under way removed at once (plot_file.remove_unfinished),
-    then the command unwinds through its ``finally`` blocks, SystemExit(128 + signal).
-    Python ignores an exception raised while a C callback runs (numba's compiler calls
-    some), so a timer ends the process after STOP_GRACE_S if it is still running then."""
-    remove_unfinished()
-    timer = threading.Timer(STOP_GRACE_S, os._exit, args=(128 + signum,))
-    timer.daemon = True
-    timer.start()
-    raise SystemExit(128 + signum)
-
-
-@contextlib.contextmanager
-def _stopped_through_exits() -> Iterator[None]:
-    """SIGTERM and SIGHUP end the command through Python's exits (:func:`_stop`), as Ctrl-C
-    does, so every ``finally`` runs: a temporary file beside --plot and the directories made for it
-    go (SIGTERM's default action ends the process on the spot). The previous handlers are
-    back afterwards (a test calling :func:`main` in process)."""
-    previous = {}
-    for sig in STOP_SIGNALS:
-        with contextlib.suppress(ValueError):     # not the main thread: left as it is
-            previous[sig] = signal.signal(sig, _stop)
-    try:
-        yield
-    finally:
-        for sig, handler in previous.items():
-            signal.signal(sig, handler)
+STOP_GRACE_S = 10.0    # after SIGTERM or SIGHUP, the longest a command may take to unwind
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
-    with _stopped_through_exits():
+    # SIGTERM and SIGHUP stop a command as Ctrl-C does (every ``finally`` runs); the outputs
+    # under way (--plot's temporary file, the directories made for it) go at once
+    with stop_on_signals(remove_unfinished, STOP_GRACE_S):
         return _main(args)
 
 
