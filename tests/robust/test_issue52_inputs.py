@@ -96,3 +96,25 @@ def test_sim_node_refuses_the_unit_slip_and_a_duplicate_key(tmp_path: Path) -> N
                   "    publish_rate_hz: 50.0\n    publish_rate_hz: 100.0\n")
     line = _sim_node("--params-file", twice)
     assert "'publish_rate_hz' twice" in line and twice in line
+
+
+@pytest.mark.parametrize(("text", "names"), [
+    ("{gain: 1, gain: 2}", ("not valid YAML", "'gain' twice")),
+    ("{gain: [}", ("not valid YAML",)),
+    ("[1, 2]", ("must be a YAML mapping",)),
+    ("{gain: abc}", ("params.gain = 'abc'", "finite number")),
+    (f"{{gain: {HUGE}}}", ("params.gain = ~1e400", "finite number")),
+])
+def test_the_controller_nodes_params_text_is_one_line(text: str,
+                                                      names: tuple[str, ...]) -> None:
+    """top_drive_controller's ``params`` parameter (a YAML mapping in a string); before, a
+    bad text was a traceback."""
+    from drill_sim_ros.model.errors import ParameterError
+    from drill_sim_ros.ros.controller_node import params_from_text
+    with pytest.raises(ParameterError) as caught:
+        params_from_text(text)
+    message = str(caught.value)
+    assert "\n" not in message and len(message) < 400, message
+    for name in names:
+        assert name in message, (name, message)
+    assert params_from_text("{gain: 2.0e1}") == {"gain": 20.0}       # YAML 1.1's text
