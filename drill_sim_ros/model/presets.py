@@ -221,6 +221,12 @@ def check_consistency(preset: Preset, data: dict[str, Any]) -> None:
     if well is not None and well.has_friction:
         check_stick_band("physical.surface_rpm", phys.surface_rpm,
                          well.side_friction.stick_speed_rad_s)
+    elif well is not None:
+        friction = data["well"].get("side_friction") or {}
+        if "stick_speed_rad_s" in friction:
+            raise ParameterError("'well.side_friction.stick_speed_rad_s' = "
+                                 f"{friction['stick_speed_rad_s']!r} has no effect: the wall "
+                                 "has no friction (give static and dynamic, or drop it)")
 
 
 def _with_well(name: str, data: dict[str, Any], string: StringSpec) -> StringSpec:

@@ -58,6 +58,8 @@ def _sections(density_kg_m3: float) -> dict[str, Any]:
      ("'physical.applied_wob_n' = 2e+06", "buoyed weight")),
     (DEVIATED, {"physical": {"surface_rpm": 5.0}},
      ("'physical.surface_rpm' = 5", "'well.side_friction.stick_speed_rad_s' = 0.9")),
+    (DEVIATED, {"well": {"side_friction": {"stick_speed_rad_s": 0.5}}},
+     ("'well.side_friction.stick_speed_rad_s' = 0.5", "no effect")),
     (LUMPED, {"physical": {"pipe_inner_radius_m": 0.07}},
      ("pipe_inner_radius_m", "0.07", "pipe_outer_radius_m")),
 ])
