@@ -32,6 +32,7 @@ from drill_sim_ros import (
     torque_drag_cli,
 )
 from drill_sim_ros.archive.output import open_output
+from drill_sim_ros.archive.signals import stop_on_signals
 from drill_sim_ros.model import analysis, telemetry
 from drill_sim_ros.model import kernel as k
 from drill_sim_ros.model.bit_rock import LAWS, RGD07_LAW, BitLaw
@@ -47,6 +48,7 @@ from drill_sim_ros.model.top_drive import (
     limit_of_setting,
     paper_drive,
 )
+from drill_sim_ros.plot_file import remove_unfinished
 from drill_sim_ros.study import cli as study_cli
 from drill_sim_ros.study import suite_cli
 from drill_sim_ros.terminal import StatusLine
@@ -452,8 +454,18 @@ def _cmd_info(args: argparse.Namespace) -> int:
     return 0
 
 
+STOP_GRACE_S = 10.0    # after SIGTERM or SIGHUP, the longest a command may take to unwind
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
+    # SIGTERM and SIGHUP stop a command as Ctrl-C does (every ``finally`` runs); the outputs
+    # under way (--plot's temporary file, the directories made for it) go at once
+    with stop_on_signals(remove_unfinished, STOP_GRACE_S):
+        return _main(args)
+
+
+def _main(args: argparse.Namespace) -> int:
     try:
         if args.command == "presets":
             for name in available_presets():

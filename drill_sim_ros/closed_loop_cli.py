@@ -27,7 +27,7 @@ from drill_sim_ros.control.scenario import (
     scenario_path,
     seeded,
 )
-from drill_sim_ros.control.schedule import Schedule
+from drill_sim_ros.control.schedule import Schedule, check_points, late_points
 from drill_sim_ros.control.scorecard import SCORE_FIELDS, score, status_text, summarize
 from drill_sim_ros.model.errors import DrillSimError
 from drill_sim_ros.model.presets import Preset
@@ -126,6 +126,19 @@ def _scenario(args: argparse.Namespace) -> Scenario:
                       duration_s=args.t_end, enable_at_s=enable_at_s, params=params)
 
 
+def _warn_late_points(scenario: Scenario) -> None:
+    """One warning line for the schedule's points that a shorter --t-end leaves out (a
+    scenario file's own points past its duration_s are refused; a shorter run of a valid
+    file is allowed, so they are only named)."""
+    points = check_points(list(scenario.schedule))
+    late = late_points(points, scenario.duration_s)
+    if late:
+        times = ", ".join(f"{points[i]['t_s']:g}" for i in late)
+        print(f"drill_sim: warning: the schedule's points at t_s = {times} s come at or after "
+              f"the end of the run (--t-end = {scenario.duration_s:g} s) and never act",
+              file=sys.stderr)
+
+
 def _run(scenario: Scenario, ros: bool, label: str,
          record_path: Path | None = None) -> ClosedLoopRun:
     line = StatusLine()
@@ -163,6 +176,7 @@ def cmd_closed_loop(args: argparse.Namespace) -> int:
     if args.ensemble > 1 and args.ros:
         raise DrillSimError("--ensemble runs in process; drop --ros (or --ensemble)")
     scenario = _scenario(args)
+    _warn_late_points(scenario)
     if scenario.enable_at_s >= scenario.duration_s:
         raise DrillSimError(f"--enable-at = {scenario.enable_at_s:g} s must come before the "
                             f"end of the run (--t-end = {scenario.duration_s:g} s): nothing "

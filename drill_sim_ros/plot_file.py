@@ -69,12 +69,48 @@ def output_into(path: Path | None, overwrite: bool, option: str = "--plot",
                 suffixes: tuple[str, ...] = PLOT_SUFFIXES) -> Iterator[Path | None]:
     """:func:`_output_target` for the run inside the ``with``, removed after it whatever
     happened (:func:`commit_output` has moved it on when the file was done)."""
+    created = [] if path is None else _missing_directories(path)
     temporary = _output_target(path, overwrite, option, suffixes)
+    if temporary is not None:
+        _UNFINISHED[temporary] = created
     try:
         yield temporary
     finally:
         if temporary is not None:
+            _UNFINISHED.pop(temporary, None)
             temporary.unlink(missing_ok=True)
+        if path is not None and not path.exists():
+            _remove_empty(created)
+
+
+# the temporary files of the outputs under way, and the directories made for each
+_UNFINISHED: dict[Path, list[Path]] = {}
+
+
+def remove_unfinished() -> None:
+    """Remove every output under way (its temporary file, the empty directories made for
+    it): what a stop signal's handler calls before the command unwinds, so nothing is left
+    even where its exception cannot unwind (raised inside a C callback, e.g. numba's
+    compiler, Python ignores it)."""
+    for temporary, created in list(_UNFINISHED.items()):
+        temporary.unlink(missing_ok=True)
+        _remove_empty(created)
+
+
+def _missing_directories(path: Path) -> list[Path]:
+    """The directories above ``path`` that do not exist yet (deepest first): the ones
+    writing it creates."""
+    return [d for d in (path.parent, *path.parent.parents) if not d.exists()]
+
+
+def _remove_empty(directories: list[Path]) -> None:
+    """Remove ``directories`` (deepest first) that are still empty: a run that made them for
+    its file and failed, or was stopped, leaves none behind."""
+    for directory in directories:
+        try:
+            directory.rmdir()
+        except OSError:                      # not empty (something else wrote there), gone
+            return
 
 
 def plot_into(path: Path | None, overwrite: bool) -> Any:

@@ -13,6 +13,7 @@ from typing import Any
 
 from drill_sim_ros.model import startup
 from drill_sim_ros.model.checks import number_in
+from drill_sim_ros.model.consistency import check_stick_band
 from drill_sim_ros.model.defaults import MAX_SURFACE_RPM
 from drill_sim_ros.model.presets import DEFAULT_PRESET, Preset, load_preset
 from drill_sim_ros.plot_file import add_plot_arguments, commit_plot, plot_into
@@ -59,6 +60,9 @@ def cmd_startup(args: Any) -> int:
     _check_args(args)
     preset = load_preset(args.params)
     startup.require_startup_preset(preset)
+    well = preset.string.well
+    if well is not None and well.has_friction:
+        check_stick_band("--rpm", args.rpm, well.side_friction.stick_speed_rad_s)
     with plot_into(args.plot, args.overwrite) as plot_tmp:
         return _startup(args, preset, plot_tmp)
 

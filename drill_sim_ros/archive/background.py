@@ -100,6 +100,19 @@ class BackgroundWriter:
         return len(self._items)
 
     @property
+    def backlog_ns(self) -> int:
+        """The log time the queue spans (its newest message's less its oldest's; 0 when it
+        holds fewer than two messages): what a SIGKILL would lose beyond the open chunk."""
+        items = self._items
+        try:
+            first, last = items[0], items[-1]
+        except IndexError:                       # emptied by the writer meanwhile
+            return 0
+        if isinstance(first, _Channel) or isinstance(last, _Channel):
+            return 0
+        return max(0, last[2] - first[2])
+
+    @property
     def written(self) -> int:
         """Messages the sink handed to the OS (a full disk stops this count)."""
         return self._sink.messages_on_disk

@@ -136,6 +136,11 @@ class InProcessRecorder:
         return self._writer.backlog
 
     @property
+    def backlog_s(self) -> float:
+        """The log time (= simulated time) the queued messages span, s."""
+        return self._writer.backlog_ns * 1e-9
+
+    @property
     def error(self) -> str | None:
         """One line: why recording stopped (e.g. a full disk), None while it works."""
         return self._close_error or self._writer.failure

@@ -1,33 +1,61 @@
 """One way for the command-line tools to stop on SIGINT, SIGTERM and SIGHUP alike.
 
-Outside rclpy (``mcap_reindex``, ``mcap_to_rerun``), :func:`stop_on_signals` turns SIGTERM and
-SIGHUP (a closed terminal) into the KeyboardInterrupt that SIGINT raises, so every tool
-finishes or discards its output the same way on all three. rclpy tools keep rclpy's SIGINT
-and SIGTERM handling and add :func:`interrupt_on_hangup`.
+Outside rclpy (``drill_sim``, ``mcap_reindex``, ``mcap_to_rerun``), :func:`stop_on_signals`
+turns SIGTERM and SIGHUP (a closed terminal) into the KeyboardInterrupt that SIGINT raises, so
+every tool finishes or discards its output the same way on all three. rclpy tools keep
+rclpy's SIGINT and SIGTERM handling and add :func:`interrupt_on_hangup`.
+
+Python ignores an exception raised while a C callback runs (numba's compiler calls some), so
+a tool may also ask for a first step that cannot be lost (``on_stop``: remove what is under
+way) and a last resort (``grace_s``: the process ends with status 130 if it is still running
+that long after the signal).
 """
 
 from __future__ import annotations
 
+import os
 import signal
-from collections.abc import Iterator
+import threading
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 
 STOP_SIGNALS = (signal.SIGTERM, signal.SIGHUP)
+INTERRUPTED_STATUS = 130      # as after Ctrl-C
 
 
 def _interrupt(signum: int, frame: object) -> None:
     raise KeyboardInterrupt(signal.Signals(signum).name)
 
 
+def _stopper(on_stop: Callable[[], None] | None,
+             grace_s: float | None) -> Callable[[int, object], None]:
+    def stop(signum: int, frame: object) -> None:
+        if on_stop is not None:
+            on_stop()
+        if grace_s is not None:
+            timer = threading.Timer(grace_s, os._exit, args=(INTERRUPTED_STATUS,))
+            timer.daemon = True
+            timer.start()
+        _interrupt(signum, frame)
+    return stop
+
+
 @contextmanager
-def stop_on_signals() -> Iterator[None]:
-    """Within the block, SIGTERM and SIGHUP raise KeyboardInterrupt (named by the signal)."""
-    previous = {sig: signal.signal(sig, _interrupt) for sig in STOP_SIGNALS}
+def stop_on_signals(on_stop: Callable[[], None] | None = None,
+                    grace_s: float | None = None) -> Iterator[None]:
+    """Within the block, SIGTERM and SIGHUP raise KeyboardInterrupt (named by the signal),
+    after ``on_stop()`` and, with ``grace_s``, arming the last resort (module doc). Outside
+    the main thread (a test calling a tool in process) nothing changes."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    handler = _stopper(on_stop, grace_s)
+    previous = {sig: signal.signal(sig, handler) for sig in STOP_SIGNALS}
     try:
         yield
     finally:
-        for sig, handler in previous.items():
-            signal.signal(sig, handler)
+        for sig, old in previous.items():
+            signal.signal(sig, old)
 
 
 def interrupt_on_hangup() -> None:

@@ -48,8 +48,13 @@ from typing import Any
 
 import yaml
 
-from drill_sim_ros.control.scenario_check import check_scenario_mapping, check_scenario_size
+from drill_sim_ros.control.scenario_check import (
+    DEFAULT_DURATION_S,
+    check_scenario_mapping,
+    check_scenario_size,
+)
 from drill_sim_ros.control.schedule import Schedule, schedule_from_list
+from drill_sim_ros.model.checks import as_number, shown
 from drill_sim_ros.model.errors import ParameterError
 from drill_sim_ros.model.measurement import SIGNALS, RigSensors, SignalSpec
 from drill_sim_ros.model.presets import (
@@ -62,6 +67,7 @@ from drill_sim_ros.model.presets import (
 )
 from drill_sim_ros.model.top_drive import limit_of_setting
 from drill_sim_ros.model.validate_input import read_preset_file
+from drill_sim_ros.model.yaml_input import load_yaml
 
 SCENARIO_KEYS = ("preset", "duration_s", "control_rate_hz", "mode", "controller", "params",
                  "enable_at_s", "schedule", "sensors", "description", "overrides", "drive",
@@ -80,7 +86,7 @@ class Scenario:
     """One closed-loop experiment (SI)."""
 
     preset: str = DEFAULT_PRESET
-    duration_s: float = 180.0
+    duration_s: float = DEFAULT_DURATION_S
     control_rate_hz: float = 100.0
     mode: str = "speed"
     controller: str = "stiff"
@@ -97,7 +103,8 @@ class Scenario:
     def __post_init__(self) -> None:
         for name, low in (("duration_s", 0.0), ("control_rate_hz", 0.0)):
             value = getattr(self, name)
-            if not (isinstance(value, (int, float)) and math.isfinite(value) and value > low):
+            number = as_number(value)
+            if not (number is not None and math.isfinite(number) and number > low):
                 raise ParameterError(f"scenario: '{name}' = {value!r} must be a number > 0")
         check_scenario_size(self.duration_s, self.control_rate_hz)
         if not (math.isfinite(self.enable_at_s) and 0.0 <= self.enable_at_s <= self.duration_s):
@@ -204,15 +211,18 @@ class Scenario:
                 "needs": list(self.needs)}
 
 
-def _check_drive(drive: Any) -> None:
+def _check_drive(drive: Any) -> dict[str, float]:
+    """The ``drive`` mapping's values as floats (YAML 1.1's ``2.0e6`` text too), each in
+    its range; one ParameterError line naming the key otherwise."""
     if not isinstance(drive, dict):
         raise ParameterError(f"scenario: 'drive' must be a mapping of {list(DRIVE_KEYS)}")
     for key, value in drive.items():
         if key not in DRIVE_KEYS:
             raise ParameterError(f"scenario: drive.{key} is not one of {list(DRIVE_KEYS)}")
         delay = key in ("command_delay_s", "motor_lag_s")
-        number = not isinstance(value, bool) and isinstance(value, (int, float)) and \
-            math.isfinite(value)
+        parsed = as_number(value)
+        number = parsed is not None and math.isfinite(parsed)
+        value = parsed if number else value
         if delay:
             ok, allowed = number and 0.0 <= value <= 60.0, "in [0, 60]"
         elif key == "max_torque_rate_nm_s":             # 0: none, as sim_node's parameter
@@ -220,8 +230,9 @@ def _check_drive(drive: Any) -> None:
         else:
             ok, allowed = number and value > 0.0, "> 0"
         if not ok:
-            raise ParameterError(f"scenario: drive.{key} = {value!r} must be a number "
+            raise ParameterError(f"scenario: drive.{key} = {shown(value)} must be a number "
                                  f"{allowed}")
+    return {key: float(as_number(value) or 0.0) for key, value in drive.items()}
 
 
 def scenario_from_dict(data: dict[str, Any]) -> Scenario:
@@ -232,8 +243,8 @@ def scenario_from_dict(data: dict[str, Any]) -> Scenario:
     if unknown:
         raise ParameterError(f"scenario: unknown key(s) {unknown}; known: {list(SCENARIO_KEYS)}")
     values = check_scenario_mapping(data)
-    for key in ("overrides", "drive"):
-        values[key] = dict(values.get(key) or {})
+    values["overrides"] = dict(values.get("overrides") or {})
+    values["drive"] = _check_drive(values.get("drive") or {})
     values["formation"] = tuple(values.get("formation") or ())
     values["needs"] = tuple(values.get("needs") or ())
     values["description"] = " ".join(str(values.get("description") or "").split())
@@ -244,7 +255,7 @@ def load_scenario(path: str | Path) -> Scenario:
     """A scenario YAML file; ParameterError naming the file when it cannot be read."""
     path = Path(path)
     try:
-        data = yaml.safe_load(path.read_text())
+        data = load_yaml(path.read_text())
     except OSError as exc:
         raise ParameterError(f"scenario file {path}: {exc.strerror}") from exc
     except yaml.YAMLError as exc:

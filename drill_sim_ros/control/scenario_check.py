@@ -13,15 +13,19 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from drill_sim_ros.model.checks import as_number, check_known_keys
+from drill_sim_ros.control.schedule import check_points
+from drill_sim_ros.model.checks import as_number, check_known_keys, shown
 from drill_sim_ros.model.errors import ParameterError
 from drill_sim_ros.model.measurement import MAX_DELAY_PERIODS, SIGNALS
+from drill_sim_ros.model.validate_input import check_no_empty_block
 
 CONTROL_RATE_RANGE_HZ = (1.0, 1000.0)      # sim_node's publish_rate_hz
 MAX_PERIODS = 2_000_000                    # 2e6 rows x 24 float64 = 384 MB per run
 SIGNAL_KEYS = ("noise_std", "quantum", "delay_periods")
 _STRINGS = ("preset", "mode", "controller")
 _NUMBERS = ("duration_s", "control_rate_hz", "enable_at_s")
+_BLOCKS = ("params", "schedule", "sensors", "overrides", "drive", "formation", "needs")
+DEFAULT_DURATION_S = 180.0                 # a scenario's duration_s when it gives none
 
 
 def check_number(where: str, value: Any) -> float:
@@ -29,7 +33,7 @@ def check_number(where: str, value: Any) -> float:
     string that is a number, ``abc`` is not)."""
     number = as_number(value)
     if number is None or not math.isfinite(number):
-        raise ParameterError(f"scenario: '{where}' = {value!r} must be a finite number")
+        raise ParameterError(f"scenario: '{where}' = {shown(value)} must be a finite number")
     return float(number)
 
 
@@ -37,7 +41,7 @@ def check_integer(where: str, value: Any, low: int, high: int) -> int:
     """``value`` if it is a whole number in [low, high]."""
     number = as_number(value)
     if number is None or not float(number).is_integer() or not low <= number <= high:
-        raise ParameterError(f"scenario: '{where}' = {value!r} must be a whole number in "
+        raise ParameterError(f"scenario: '{where}' = {shown(value)} must be a whole number in "
                              f"[{low}, {high}]")
     return int(number)
 
@@ -50,12 +54,16 @@ def check_params(params: Any) -> dict[str, float]:
     return {str(k): check_number(f"params.{k}", v) for k, v in params.items()}
 
 
-def check_schedule(schedule: Any) -> tuple[dict[str, Any], ...]:
-    """A list of mappings (their keys and values: :mod:`~drill_sim_ros.control.schedule`)."""
+def check_schedule(schedule: Any, duration_s: float) -> tuple[dict[str, Any], ...]:
+    """A list of mappings, their keys and values checked, each point before the run's end
+    (:func:`~drill_sim_ros.control.schedule.check_points`)."""
     if not isinstance(schedule, list) or not all(isinstance(p, dict) for p in schedule):
         raise ParameterError(f"scenario: 'schedule' = {schedule!r} must be a list of "
                              "mappings, e.g. [{t_s: 0, rpm: 60}]")
-    return tuple(schedule)
+    try:
+        return check_points(schedule, duration_s)
+    except ParameterError as exc:
+        raise ParameterError(f"scenario: {exc}") from None
 
 
 def check_sensors(sensors: Any) -> dict[str, Any]:
@@ -90,6 +98,10 @@ def check_sensors(sensors: Any) -> dict[str, Any]:
 def check_scenario_mapping(data: dict[str, Any]) -> dict[str, Any]:
     """The values of a scenario file's mapping (its keys already known), type-checked."""
     values = dict(data)
+    try:
+        check_no_empty_block(values, "", _BLOCKS)
+    except ParameterError as exc:
+        raise ParameterError(f"scenario: {exc}") from None
     for key in _STRINGS:
         if key in values and not (isinstance(values[key], str) and values[key]):
             raise ParameterError(f"scenario: '{key}' = {values[key]!r} must be a name "
@@ -107,7 +119,8 @@ def check_scenario_mapping(data: dict[str, Any]) -> dict[str, Any]:
         if not isinstance(values.get(key) or [], list):
             raise ParameterError(f"scenario: '{key}' = {values[key]!r} must be a list")
     values["params"] = check_params(values.get("params") or {})
-    values["schedule"] = check_schedule(values.get("schedule") or [])
+    values["schedule"] = check_schedule(values.get("schedule") or [],
+                                        values.get("duration_s", DEFAULT_DURATION_S))
     values["sensors"] = check_sensors(values.get("sensors") or {})
     return values
 

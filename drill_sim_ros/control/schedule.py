@@ -11,10 +11,10 @@ values are the starting levels (the preset's when left out; on bottom).
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import Any
 
+from drill_sim_ros.model.checks import number_in
 from drill_sim_ros.model.errors import ParameterError
 
 KEYS = ("t_s", "rpm", "wob_n", "ramp_s", "off_bottom")
@@ -62,14 +62,64 @@ class Schedule:
         return _level(float(self.off_bottom0), self.off_bottom_changes, t_s) == 1.0
 
 
-def _number(point: dict[str, Any], key: str, low: float) -> float | None:
+# each value's range: sim_node's model.surface_rpm and model.applied_wob_n (the schedule
+# moves them), times within any run (a run is at most 2e6 periods: scenario_check)
+RANGES = {"t_s": (0.0, 1e9), "rpm": (0.0, 1e4), "wob_n": (0.0, 1e9), "ramp_s": (0.0, 1e9)}
+
+
+def _number(i: int, point: dict[str, Any], key: str) -> float | None:
+    """``schedule[i].key`` as a float in its range (checks.number_in: YAML 1.1's ``6.0e4``
+    text counts as its number), None when the point does not give it."""
     if key not in point:
         return None
-    value = point[key]
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or \
-            not (math.isfinite(value) and value >= low):
-        raise ParameterError(f"schedule: '{key}' = {value!r} must be a number >= {low:g}")
-    return float(value)
+    return number_in(f"'schedule[{i}].{key}'", point[key], *RANGES[key])
+
+
+def _point(i: int, point: Any) -> dict[str, Any]:
+    """Point ``i`` checked: its keys, its numbers (as floats), a point that sets something,
+    and no ``ramp_s`` where nothing ramps (``off_bottom`` is an action, never ramped)."""
+    if not isinstance(point, dict) or set(point) - set(KEYS):
+        raise ParameterError(f"'schedule[{i}]' must be a mapping of {', '.join(KEYS)}; got "
+                             f"{point!r}")
+    out: dict[str, Any] = {key: _number(i, point, key) for key in RANGES if key in point}
+    if "off_bottom" in point:
+        out["off_bottom"] = _flag(i, point)
+    if not set(out) & {"rpm", "wob_n", "off_bottom"}:
+        raise ParameterError(f"'schedule[{i}]' = {point!r} sets nothing (give rpm, wob_n or "
+                             "off_bottom)")
+    if "ramp_s" in out and not set(out) & {"rpm", "wob_n"}:
+        raise ParameterError(f"'schedule[{i}].ramp_s' = {point['ramp_s']!r} has no effect: "
+                             "the point has no rpm or wob_n to ramp (off_bottom is an action "
+                             "at t_s, never ramped)")
+    return out
+
+
+def check_points(points: Any, duration_s: float | None = None) -> tuple[dict[str, Any], ...]:
+    """The schedule's points checked (:func:`_point`), in time order and, with a
+    ``duration_s``, each before the run's end (a later point never acts)."""
+    if not isinstance(points, list):
+        raise ParameterError(f"'schedule' = {points!r} must be a list of mappings, e.g. "
+                             "[{t_s: 0, rpm: 60}]")
+    checked = tuple(_point(i, p) for i, p in enumerate(points))
+    times = [p.get("t_s") or 0.0 for p in checked]
+    for i in range(1, len(times)):
+        if times[i] < times[i - 1]:
+            raise ParameterError(f"'schedule[{i}].t_s' = {times[i]:g} comes before "
+                                 f"{times[i - 1]:g}; points must be in time order")
+    late = late_points(checked, duration_s)
+    if late:
+        raise ParameterError(f"'schedule[{late[0]}].t_s' = {times[late[0]]:g} s is at or past "
+                             f"the run's end (duration_s = {duration_s:g} s): it would never "
+                             "act")
+    return checked
+
+
+def late_points(points: tuple[dict[str, Any], ...], duration_s: float | None) -> list[int]:
+    """The indices of the points at or past ``duration_s`` (a point at 0 always acts)."""
+    if duration_s is None:
+        return []
+    return [i for i, p in enumerate(points) if (p.get("t_s") or 0.0) > 0.0
+            and p["t_s"] >= duration_s]
 
 
 def schedule_from_list(points: list[dict[str, Any]] | None, rpm0: float,
@@ -79,19 +129,9 @@ def schedule_from_list(points: list[dict[str, Any]] | None, rpm0: float,
     wob_changes: list[Change] = []
     lifts: list[Change] = []
     off0 = False
-    last_t = -math.inf
-    for point in points or []:
-        if not isinstance(point, dict) or set(point) - set(KEYS):
-            raise ParameterError(f"schedule: each point is a mapping of {list(KEYS)}, "
-                                 f"got {point!r}")
-        t_s = _number(point, "t_s", 0.0) or 0.0
-        if t_s < last_t:
-            raise ParameterError(f"schedule: t_s = {t_s:g} comes before {last_t:g}; "
-                                 "points must be in time order")
-        last_t = t_s
-        ramp_s = _number(point, "ramp_s", 0.0) or 0.0
-        rpm, wob = _number(point, "rpm", 0.0), _number(point, "wob_n", 0.0)
-        lift = _flag(point, "off_bottom")
+    for point in check_points(list(points or [])):
+        t_s, ramp_s = point.get("t_s") or 0.0, point.get("ramp_s") or 0.0
+        rpm, wob, lift = point.get("rpm"), point.get("wob_n"), point.get("off_bottom")
         if t_s == 0.0 and lift is not None:
             off0 = lift
         elif lift is not None:
@@ -106,9 +146,8 @@ def schedule_from_list(points: list[dict[str, Any]] | None, rpm0: float,
     return Schedule(rpm0, wob0_n, tuple(rpm_changes), tuple(wob_changes), tuple(lifts), off0)
 
 
-def _flag(point: dict[str, Any], key: str) -> bool | None:
-    if key not in point:
-        return None
-    if not isinstance(point[key], bool):
-        raise ParameterError(f"schedule: '{key}' = {point[key]!r} must be true or false")
-    return point[key]
+def _flag(i: int, point: dict[str, Any]) -> bool:
+    if not isinstance(point["off_bottom"], bool):
+        raise ParameterError(f"'schedule[{i}].off_bottom' = {point['off_bottom']!r} must be "
+                             "true or false")
+    return point["off_bottom"]

@@ -75,6 +75,7 @@ from drill_sim_ros.hil.nodes import (
 )
 from drill_sim_ros.hil.security import APPLICATION_URI, PasswordUser, Security
 from drill_sim_ros.hil.sessions import SessionUsers
+from drill_sim_ros.model.errors import DrillSimError
 from drill_sim_ros.model.top_drive import limit_of_setting
 
 _log = logging.getLogger(__name__)
@@ -84,6 +85,7 @@ SETPOINTS = ("SpeedSetpoint", "TorqueCommand", "WobSetpoint")
 MODE_SWITCH_TIMEOUT_S = 5.0
 SUPERVISE_PERIOD_S = 0.05
 PRODUCT_NAME = "drill_sim_ros OPC UA gateway"
+ASYNCUA_SERVER_LOGGER = "asyncua.server.server"   # logs a failed start's traceback
 # switch_mode(mode): None once the simulator drives in ``mode``, else its reason for refusing
 # (TimeoutError, or any OSError, if it does not answer)
 SwitchMode = Callable[[str], Awaitable[str | None]]
@@ -622,7 +624,7 @@ class RigServer:
         await self.build()
         self.server.subscribe_server_callback(CallbackType.PreWrite, self._pre_write)
         self.server.subscribe_server_callback(CallbackType.PreRead, self._pre_read)
-        await self.server.start()
+        await self._listen()
         self._supervisor = asyncio.create_task(self._supervise())
 
     async def build(self) -> None:
@@ -664,6 +666,22 @@ class RigServer:
         self.server.product_uri = NAMESPACE_URI
         await self.server.set_build_info(NAMESPACE_URI, "drill_sim_ros", PRODUCT_NAME,
                                          _version(), _version(), datetime.now(timezone.utc))
+
+    async def _listen(self) -> None:
+        """Start listening; a port that cannot be bound (in use, not allowed) is one
+        DrillSimError line. asyncua logs such a failure's traceback before it raises it, so
+        its server logger is quiet for this one call."""
+        quiet = logging.getLogger(ASYNCUA_SERVER_LOGGER)
+        was_disabled, quiet.disabled = quiet.disabled, True
+        try:
+            await self.server.start()
+        except OSError as exc:
+            reason = exc.strerror or str(exc)
+            raise DrillSimError(f"endpoint {self.endpoint}: cannot listen: {reason} (another "
+                                "gateway or server on this port? choose another port with "
+                                "-p endpoint:=...)") from None
+        finally:
+            quiet.disabled = was_disabled
 
     async def _secure(self) -> None:
         """Anonymous and unencrypted (loopback only), or Basic256Sha256 Sign & Encrypt

@@ -13,12 +13,20 @@ from typing import Any
 from drill_sim_ros.model.errors import ParameterError
 
 
-def as_number(value: Any) -> float | int | None:
-    """``value`` as a number; YAML 1.1 reads ``79.3e9`` (no dot, no exponent sign) as a
-    string, so a string that is a number counts as one (``abc`` does not)."""
+def as_number(value: Any) -> float | None:
+    """``value`` as a float, the one number parser of every input path; None if it is no
+    number (``abc``, ``true``, a list). YAML 1.1 reads ``79.3e9``, ``6.0e4`` and ``1e1`` (no
+    dot or no exponent sign) as strings, so a string that is a number counts as one. An
+    integer beyond a double (``10**400``) is +-inf, which the callers' finiteness check
+    names, instead of Python's OverflowError."""
     if isinstance(value, bool):
         return None
-    if isinstance(value, (int, float)):
+    if isinstance(value, int):
+        try:
+            return float(value)
+        except OverflowError:
+            return math.inf if value > 0 else -math.inf
+    if isinstance(value, float):
         return value
     if isinstance(value, str):
         try:
@@ -26,6 +34,15 @@ def as_number(value: Any) -> float | int | None:
         except ValueError:
             return None
     return None
+
+
+def shown(value: Any) -> str:
+    """``value`` as an error line shows it: its repr, but an integer too long to read (one
+    beyond a double has over 300 digits) as its order of magnitude."""
+    if isinstance(value, int) and not isinstance(value, bool) and abs(value) >= 10**30:
+        sign = "-" if value < 0 else ""
+        return f"{sign}~1e{len(str(abs(value))) - 1} (an integer of {len(str(abs(value)))} digits)"
+    return repr(value)
 
 
 def check_blade_counts(values: Iterable[float], where: str) -> None:
@@ -53,6 +70,6 @@ def number_in(label: str, value: Any, low: float, high: float, low_open: bool = 
     x = math.nan if number is None else float(number)
     if not (math.isfinite(x) and (x > low if low_open else x >= low) and x <= high):
         bracket = "(" if low_open else "["
-        raise ParameterError(f"{label} = {value!r} must be a number in {bracket}{low:g}, "
+        raise ParameterError(f"{label} = {shown(value)} must be a number in {bracket}{low:g}, "
                              f"{high:g}]")
     return x

@@ -13,5 +13,10 @@ class NumericalFault(DrillSimError, FloatingPointError):
     """The integration produced a non-finite state; the simulator must be reset."""
 
 
+class EnergyFault(NumericalFault):
+    """The string created energy (the physics guard, Simulator._check_wall_energy); the
+    message names the element, its depth and the time. The simulator must be reset."""
+
+
 class HistoryOverflow(DrillSimError):
     """The exact-delay reference ran out of history storage (raise its capacity)."""

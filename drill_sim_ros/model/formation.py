@@ -19,7 +19,7 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
-from drill_sim_ros.model.checks import check_known_keys
+from drill_sim_ros.model.checks import as_number, check_known_keys, shown
 from drill_sim_ros.model.errors import ParameterError
 
 LAYER_KEYS = ("top_m", "intrinsic_specific_energy_pa", "mu_gamma",
@@ -51,12 +51,10 @@ class Rock:
 def _value(i: int, layer: dict[str, Any], key: str, default: float, low: float,
            high: float) -> float:
     value = layer.get(key, default)
-    try:
-        x = float(value)
-    except (TypeError, ValueError):
-        x = math.nan
+    number = as_number(value)
+    x = math.nan if number is None else number
     if not (math.isfinite(x) and low <= x <= high):
-        raise ParameterError(f"formation[{i}].{key} = {value!r} must be a number in "
+        raise ParameterError(f"formation[{i}].{key} = {shown(value)} must be a number in "
                              f"[{low:g}, {high:g}]")
     return x
 

@@ -29,6 +29,14 @@ from drill_sim_ros.model.bit_rock import (
     friction_weakening_from_dict,
 )
 from drill_sim_ros.model.checks import check_known_keys, number_in
+from drill_sim_ros.model.consistency import (
+    DEFAULT_MUD_KEY,
+    check_bit_clears,
+    check_densities,
+    check_stick_band,
+    check_wob_carried,
+    section_keys,
+)
 from drill_sim_ros.model.errors import ParameterError
 from drill_sim_ros.model.formation import Rock
 from drill_sim_ros.model.params import (
@@ -178,11 +186,48 @@ def preset_from_dict(name: str, data: dict[str, Any], base_dir: Path | None = No
     n_nodes = numerics.get("n_nodes")
     section = data.get("top_drive")
     drive = top_drive_from_dict(section, scales, has_phys)    # SI, as the file gives it
-    return Preset(name=name, description=str(data.get("description", "")).strip(),
-                  params=params, scales=scales, physical=physical,
-                  dtau=float(numerics.get("dtau", 1e-4)),
-                  n_nodes=None if n_nodes is None else int(n_nodes), drive=drive,
-                  string=string, friction_weakening=weakening)
+    preset = Preset(name=name, description=str(data.get("description", "")).strip(),
+                    params=params, scales=scales, physical=physical,
+                    dtau=float(numerics.get("dtau", 1e-4)),
+                    n_nodes=None if n_nodes is None else int(n_nodes), drive=drive,
+                    string=string, friction_weakening=weakening)
+    if physical is not None:
+        check_consistency(preset, data)
+    return preset
+
+
+def check_consistency(preset: Preset, data: dict[str, Any]) -> None:
+    """The relations between the values of the physical ``preset`` built from ``data``
+    (model.consistency), each error naming the keys as the file gives them."""
+    phys = preset.physical
+    assert phys is not None
+    well = preset.string.well
+    sections = preset.string.sections
+    if sections:
+        rho = [s.density_kg_m3 for s in sections]
+        radii = [s.outer_radius_m for s in sections]
+    else:                                          # RGD07's lumped pipe and BHA
+        rho = [phys.density_kg_m3] * 2
+        radii = [phys.pipe_outer_radius_m, phys.bha_outer_radius_m]
+    n = len(rho)
+    mud_key = "well.mud_density_kg_m3" if well is not None else DEFAULT_MUD_KEY
+    mud = well.mud_density_kg_m3 if well is not None else MUD_DENSITY_KG_M3
+    check_densities(list(zip(section_keys(data, n, "density_kg_m3", ("density_kg_m3",)), rho,
+                             strict=True)), mud_key, mud)
+    outer = section_keys(data, n, "outer_radius_m", ("pipe_outer_radius_m",
+                                                     "bha_outer_radius_m"))
+    check_bit_clears(list(zip(outer, radii, strict=True)), phys.bit_radius_m)
+    check_wob_carried("physical.applied_wob_n", phys.applied_wob_n,
+                      submerged_string_weight_n(preset))
+    if well is not None and well.has_friction:
+        check_stick_band("physical.surface_rpm", phys.surface_rpm,
+                         well.side_friction.stick_speed_rad_s)
+    elif well is not None:
+        friction = data["well"].get("side_friction") or {}
+        if "stick_speed_rad_s" in friction:
+            raise ParameterError("'well.side_friction.stick_speed_rad_s' = "
+                                 f"{friction['stick_speed_rad_s']!r} has no effect: the wall "
+                                 "has no friction (give static and dynamic, or drop it)")
 
 
 def _with_well(name: str, data: dict[str, Any], string: StringSpec,

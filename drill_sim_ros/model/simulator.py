@@ -20,7 +20,12 @@ from drill_sim_ros.model import kernel as k
 from drill_sim_ros.model import string as sg
 from drill_sim_ros.model import top_drive as td
 from drill_sim_ros.model.analysis import TrivialSolution, trivial_solution
-from drill_sim_ros.model.errors import HistoryOverflow, NumericalFault, ParameterError
+from drill_sim_ros.model.errors import (
+    EnergyFault,
+    HistoryOverflow,
+    NumericalFault,
+    ParameterError,
+)
 from drill_sim_ros.model.formation import Layer
 from drill_sim_ros.model.params import UNIT_SCALES, DimensionlessParams, Scales
 
@@ -216,12 +221,15 @@ class Simulator:
     def _wave_layout(self) -> None:
         """The delay lines of a distributed string at this step (none for the lumped one);
         every part must span at least one step."""
+        self._wall_work: np.ndarray | None = None       # the guard's row: no wall, none
         if self.string.model != sg.STRING_DISTRIBUTED:
             self._wave_i, self._wave_f, self._parts = k.NO_WAVE_I, k.NO_WAVE_F, ()
             self._wave = k.NO_WAVE
             return
         self._wave_i, self._wave_f, self._wave, self._parts = sg.build_lines(
             self.string.lines, self.wave_dtau)
+        if np.any(self._wave_f[sg.W_FS] != 0.0) or np.any(self._wave_f[sg.W_FD] != 0.0):
+            self._wall_work = self._wave_f[sg.W_WORK]
         if self._wave_i[sg.W_LEN].min() < 1:
             raise ParameterError(
                 f"a string section (or damping part) is shorter than one step of the wave "
@@ -556,6 +564,33 @@ class Simulator:
         NumericalFault or HistoryOverflow when it failed."""
         self._unchecked_steps += n_steps
         self._check(status)
+        self._check_wall_energy()
+
+    def _check_wall_energy(self) -> None:
+        """The physics guard: the wall's friction only takes energy. Each junction's work
+        (W_WORK) grows by limit |w| dtau or c w^2 dtau, never negative for a wall that
+        presses on the string; a negative one means the string creates energy there (a
+        negative normal force: a string lighter than the mud). Then the simulator faults
+        (:class:`EnergyFault`) naming the junction, its depth and the time, instead of
+        returning numbers."""
+        work = self._wall_work
+        if work is None or work.min() >= 0.0:
+            return
+        j = int(np.argmin(work))
+        parts_t = self._parts[0]
+        axial = j >= parts_t
+        line = self.string.lines[1 if axial else 0]
+        local = j - (parts_t if axial else 0)
+        depth_m = float(sum(line.length_m[:local + 1]))
+        sc = self.scales
+        joules = float(work[j]) * self.wave_dtau * (sc.force_n * sc.length_m if axial
+                                                    else sc.torque_nm)
+        self.fault = (f"energy fault at t = {self.tau * sc.time_s:.6g} s (tau = {self.tau:.6g})"
+                      f": the wall at the {'axial' if axial else 'torsional'} line's junction "
+                      f"{local} ({depth_m:.1f} m below the top) gave the string "
+                      f"{-joules:.4g} J (its friction can only take energy: is the string "
+                      "lighter than the mud?)")
+        raise EnergyFault(self.fault)
 
     @property
     def offsets(self) -> tuple[float, float]:

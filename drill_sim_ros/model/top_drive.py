@@ -35,6 +35,7 @@ from typing import Any
 
 from numba import njit
 
+from drill_sim_ros.model.checks import as_number
 from drill_sim_ros.model.errors import ParameterError
 from drill_sim_ros.model.lag import lag_share, lag_step
 from drill_sim_ros.model.params import Scales
@@ -286,7 +287,13 @@ def _from_dict(cls: type, values: dict[str, Any]) -> Any:
     unknown = sorted(set(values) - known)
     if unknown:
         raise ParameterError(f"unknown top_drive parameter(s) {unknown}; known: {sorted(known)}")
-    return cls(**{key: (str(v) if key == "mode" else float(v)) for key, v in values.items()})
+    return cls(**{key: (str(v) if key == "mode" else _float(v)) for key, v in values.items()})
+
+
+def _float(value: Any) -> float:
+    """A checked number (checks.as_number: an integer beyond a double is inf, no limit)."""
+    number = as_number(value)
+    return float(value) if number is None else number
 
 
 def paper_drive(scales: Scales) -> TopDrivePhysical:

@@ -18,10 +18,11 @@ from typing import Any
 
 import yaml
 
-from drill_sim_ros.model.checks import as_number, check_known_keys
+from drill_sim_ros.model.checks import as_number, check_known_keys, shown
 from drill_sim_ros.model.errors import ParameterError
 from drill_sim_ros.model.params import DimensionlessParams, PhysicalParams
 from drill_sim_ros.model.top_drive import MODES, TopDrive, TopDrivePhysical
+from drill_sim_ros.model.yaml_input import load_yaml
 
 PRESET_SECTIONS = ("description", "physical", "dimensionless", "numerics", "top_drive",
                    "string", "well")  # 'string' and 'well': checked by model.presets and
@@ -51,10 +52,11 @@ def check_value(where: str, key: str, value: Any) -> None:
     number = as_number(value)
     if number is None:
         raise ParameterError(f"'{where}.{key}' = {value!r} must be a number")
-    if key in INTEGER_KEYS and not float(number).is_integer():
-        raise ParameterError(f"'{where}.{key}' = {value!r} must be a whole number")
     if not math.isfinite(number) and not (key.startswith("max_torque") and number > 0):
-        raise ParameterError(f"'{where}.{key}' = {value!r} must be finite")
+        raise ParameterError(f"'{where}.{key}' = {shown(value)} must be finite")
+    if key in INTEGER_KEYS and not number.is_integer():
+        raise ParameterError(f"'{where}.{key}' = {value!r} must be a whole number")
+
 
 
 def check_section(where: str, values: Any, known: tuple[str, ...], required: bool,
@@ -73,6 +75,15 @@ def check_section(where: str, values: Any, known: tuple[str, ...], required: boo
         check_value(where, key, value)
 
 
+def check_no_empty_block(data: dict[str, Any], where: str, keys: tuple[str, ...]) -> None:
+    """None of ``keys`` written with nothing under it (``well:`` alone reads as no well,
+    which is not what a file that names the block means); one line naming the key."""
+    for key in keys:
+        if key in data and data[key] is None:
+            raise ParameterError(f"'{where}{key}' is empty: give its keys or remove the line "
+                                 "(an empty block is not read as its default)")
+
+
 def check_numerics(values: Any) -> None:
     """``numerics``: dtau in DTAU_RANGE, n_nodes a whole number in N_NODES_RANGE."""
     check_section("numerics", values, NUMERICS_KEYS, required=False)
@@ -88,6 +99,10 @@ def check_preset_mapping(data: Any) -> None:
         raise ParameterError(f"a preset file holds a mapping of {', '.join(PRESET_SECTIONS)}; "
                              f"got {data!r}")
     check_known_keys(data, PRESET_SECTIONS)
+    check_no_empty_block(data, "", PRESET_SECTIONS[1:])
+    for section, keys in (("string", ("sections",)), ("physical", PHYSICAL_MAPPINGS)):
+        if isinstance(data.get(section), dict):
+            check_no_empty_block(data[section], f"{section}.", keys)
     physical = "physical" in data
     if physical == ("dimensionless" in data):
         raise ParameterError("a preset needs exactly one of 'physical' or 'dimensionless'")
@@ -117,7 +132,7 @@ def read_preset_file(path: Path) -> Any:
     """The parsed YAML of the preset file ``path``, read once (checked by
     :func:`check_preset_mapping` where it is built); the error names the file."""
     try:
-        return yaml.safe_load(path.read_text())
+        return load_yaml(path.read_text())
     except OSError as exc:
         raise ParameterError(f"preset file {path}: {exc.strerror or exc}") from None
     except yaml.YAMLError as exc:

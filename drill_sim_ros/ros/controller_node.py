@@ -32,7 +32,9 @@ from drill_sim_ros.control.controllers import CONTROL_MODES
 from drill_sim_ros.control.isolation import ControllerError
 from drill_sim_ros.control.registry import BUILTIN
 from drill_sim_ros.control.scenario import Scenario, load_scenario
+from drill_sim_ros.model.checks import as_number, shown
 from drill_sim_ros.model.errors import DrillSimError, ParameterError
+from drill_sim_ros.model.yaml_input import load_yaml
 from drill_sim_ros.ros.lockstep_driver import LockstepDriver
 from drill_sim_ros.ros.parameters import check_parameter_rules, check_plain_args
 
@@ -92,7 +94,7 @@ class ControllerNode(LockstepDriver):
             description="the controller's parameters as a YAML mapping (for module:Class "
                         "controllers), e.g. '{gain: 2.0}'", read_only=True)).value
         if text:
-            params.update(yaml.safe_load(text) or {})
+            params.update(params_from_text(text))
         for cls in BUILTIN.values():
             for key, description in cls.PARAMS.items():
                 value = self.declare_parameter(f"{cls.name}.{key}", 0.0, _double(
@@ -116,6 +118,26 @@ class ControllerNode(LockstepDriver):
                 "periods_per_s": (self.received - 1) / wall if wall > 0 else math.nan,
                 "clamped_commands": int(getattr(self.controller, "clamped_commands", 0))}
 
+
+
+def params_from_text(text: str) -> dict[str, float]:
+    """The ``params`` parameter's YAML mapping of names to numbers (checks.as_number: YAML
+    1.1's ``2.0e1`` text too); one ParameterError line naming what is wrong."""
+    try:
+        data = load_yaml(text)
+    except yaml.YAMLError as exc:
+        raise ParameterError(f"params = {text!r} is not valid YAML: "
+                             f"{' '.join(str(exc).split())}") from None
+    if not isinstance(data, dict):
+        raise ParameterError(f"params = {text!r} must be a YAML mapping of names to numbers, "
+                             "e.g. '{gain: 2.0}'")
+    out = {}
+    for key, value in data.items():
+        number = as_number(value)
+        if number is None or not math.isfinite(number):
+            raise ParameterError(f"params.{key} = {shown(value)} must be a finite number")
+        out[str(key)] = number
+    return out
 
 def main(args: list[str] | None = None) -> int:
     """Console script ``top_drive_controller``; with ``periods`` > 0 it prints one JSON line

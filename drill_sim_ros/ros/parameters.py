@@ -25,6 +25,8 @@ from rclpy.impl.implementation_singleton import rclpy_implementation
 from rclpy.utilities import remove_ros_args
 
 from drill_sim_ros.model import defaults
+from drill_sim_ros.model.checks import as_number, shown
+from drill_sim_ros.model.consistency import check_stick_band, check_wob_carried
 from drill_sim_ros.model.errors import ParameterError
 from drill_sim_ros.model.measurement import MAX_DELAY_PERIODS, SIGNALS
 from drill_sim_ros.model.params import UNIT_SCALES
@@ -36,6 +38,7 @@ from drill_sim_ros.model.top_drive import (
     paper_drive,
     setting_of_limit,
 )
+from drill_sim_ros.model.yaml_input import load_yaml
 from drill_sim_ros.ros.params_file_check import check_params_content
 from drill_sim_ros.topics import NODE_NAME
 
@@ -271,6 +274,9 @@ def descriptor(spec: ParamSpec) -> ParameterDescriptor:
 def validate(spec: ParamSpec, value: Any) -> str | None:
     """None if ``value`` is acceptable for ``spec``, else the reason (naming the range)."""
     if spec.kind == DOUBLE:
+        if isinstance(value, str) and _beyond_a_double(value):     # rcl keeps it as text
+            return (f"{spec.name} = {_shown_text(value)} is beyond a double; it must be a "
+                    f"number in [{spec.low:g}, {spec.high:g}]")
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             return f"{spec.name} must be a number, got {value!r}"
         if not (math.isfinite(value) and spec.low <= value <= spec.high):
@@ -315,7 +321,21 @@ def declare_all(node: Any, load: Callable[[str], Preset]) -> tuple[Preset, dict[
         if reason is not None:
             raise ParameterError(reason)
         values[spec.name] = coerce(spec, value)
+    check_operating_point(preset, values)
     return preset, values
+
+
+def check_operating_point(preset: Preset, values: dict[str, Any]) -> None:
+    """The start's WOB and speed against the string (model.consistency): the WOB within
+    the buoyed weight (when one is modelled, > 0), a turning string above the wall's stick
+    band; one ParameterError line naming both."""
+    weight_n = values["model.submerged_string_weight_n"]
+    if weight_n > 0.0:
+        check_wob_carried("model.applied_wob_n", values["model.applied_wob_n"], weight_n)
+    well = preset.string.well
+    if well is not None and well.has_friction:
+        check_stick_band("model.surface_rpm", values["model.surface_rpm"],
+                         well.side_friction.stick_speed_rad_s)
 
 
 _KIND_TEXT = {DOUBLE: "a number", INTEGER: "an integer", BOOL: "true or false",
@@ -338,6 +358,19 @@ def _declare(node: Any, spec: ParamSpec, default: Any) -> Any:
                              f"{shown}") from None
 
 
+def _beyond_a_double(text: str) -> bool:
+    """``text`` (what rcl kept as a string) is a number too large for a double (rcl reads
+    ``1e400`` and a 400-digit integer as strings)."""
+    number = as_number(text)
+    return number is not None and math.isinf(number)
+
+
+def _shown_text(text: str) -> str:
+    """A number's text as an error shows it (checks.shown: a long integer as its size)."""
+    stripped = text.strip().lstrip("+-")
+    return shown(int(text)) if stripped.isdigit() else repr(text)
+
+
 # rclpy's exception texts (rclpy/exceptions.py) carry the rejected value; they hold no field.
 _VALUE_IN_REASON = re.compile(r"Invalid parameter value \((.*?)\) for parameter")
 _TYPE_IN_REASON = re.compile(r"to '(.*?)' of type '(\w+)'")
@@ -356,7 +389,7 @@ def check_params_files(args: list[str]) -> None:
             continue
         try:
             with open(path, encoding="utf-8") as stream:
-                data = yaml.safe_load(stream)
+                data = load_yaml(stream)
         except OSError as exc:
             raise ParameterError(f"--params-file {path}: {exc.strerror or exc}") from None
         except yaml.YAMLError as exc:

@@ -85,12 +85,16 @@ CLOCK_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=10,
 # a publisher's own history overwrites is reported lost): in command-triggered lockstep a
 # controller's answer is never lost behind other commands.
 COMMAND_QOS = QoSProfile(history=HistoryPolicy.KEEP_ALL, reliability=ReliabilityPolicy.RELIABLE)
+# The services (~/reset, ~/pause, ~/off_bottom, ~/step) keep every request and every reply
+# (the default keeps the last 10: a burst of 1000 calls got 31 replies); a client that sends
+# bursts needs a queue as deep on its side (its requests and the replies it has not taken).
+SERVICE_QOS = QoSProfile(history=HistoryPolicy.KEEP_ALL, reliability=ReliabilityPolicy.RELIABLE)
 # Reliable volatile publishers match every subscriber but transient-local ones; without the
 # default QoS-event handlers the executor's wait set is 2 entities per publisher smaller.
 QUIET_PUBLISHER = PublisherEventCallbacks(use_default_callbacks=False)
 FREE_RUN_BATCH = 20          # periods per turn when running as fast as possible
 MAX_CATCH_UP = 50            # periods per turn when catching up in real time
-BACKLOG_WAIT_S = 0.005       # free run: wait this long while the recorder catches up
+BACKLOG_WAIT_S = 0.005       # wait this long while the recorder catches up
 DIAGNOSTICS_PERIOD_S = 1.0
 STATUS_PERIOD_S = 0.25
 WARN_THROTTLE_S = 1.0
@@ -238,10 +242,11 @@ class SimNode(Node):
 
     def _add_services(self) -> None:
         """``~/reset``, ``~/pause`` and ``~/step``, and the lockstep handshake of ``~/step``."""
-        self.create_service(Trigger, "~/reset", self._on_reset)
-        self.create_service(SetBool, "~/pause", self._on_pause)
-        self.create_service(SetBool, "~/off_bottom", self._on_off_bottom)
-        step = self.create_service(Trigger, "~/step", self._on_step)
+        self.create_service(Trigger, "~/reset", self._on_reset, qos_profile=SERVICE_QOS)
+        self.create_service(SetBool, "~/pause", self._on_pause, qos_profile=SERVICE_QOS)
+        self.create_service(SetBool, "~/off_bottom", self._on_off_bottom,
+                            qos_profile=SERVICE_QOS)
+        step = self.create_service(Trigger, "~/step", self._on_step, qos_profile=SERVICE_QOS)
         self._handshake = Handshake(self.get_logger(), self._command_names[topics.CMD_TOP_DRIVE],
                                     self.resolve_service_name(step.srv_name),
                                     time.monotonic())
@@ -450,9 +455,9 @@ class SimNode(Node):
         try:
             if self._closing or self._lockstep or self._paused or self._fault is not None:
                 return None
+            if self._sinks.backlogged():              # the recorder's loss bound
+                return BACKLOG_WAIT_S
             if self._rtf <= 0:                        # free run
-                if self._sinks.backlogged():
-                    return BACKLOG_WAIT_S
                 self._advance(FREE_RUN_BATCH)
                 return 0.0
             pacer = self._pacer

@@ -18,9 +18,13 @@ from drill_sim_ros.model.session import Block
 from drill_sim_ros.model.telemetry import N_FIELDS
 from drill_sim_ros.ros.frame import SampleFrame
 
-# In free run the ticker waits while the recorder has this many messages queued (about 2 s
-# of the writer thread's work), so a run as fast as possible loses nothing.
+# The ticker waits while the recorder has this many messages queued (about 2 s of the writer
+# thread's work), so a run as fast as possible loses nothing,
 RECORDER_HIGH_WATER = 100_000 // 2
+# or while its queue spans more than this much simulated time: with the chunk it has open
+# (at most 0.5 s of log time, archive.writer) a SIGKILL loses at most 1 s of simulated time
+# in free run too (docs/archive.md), where the sim outruns the writer.
+RECORDER_MAX_LAG_S = 0.5
 
 
 @dataclass(frozen=True)
@@ -94,5 +98,8 @@ class SampleSinks:
             self.recorder.write_serialized(publisher.topic_name, payload, time_ns)
 
     def backlogged(self) -> bool:
-        """The recorder is behind by more than :data:`RECORDER_HIGH_WATER` messages."""
-        return self.recorder is not None and self.recorder.backlog > RECORDER_HIGH_WATER
+        """The recorder is behind by more than :data:`RECORDER_HIGH_WATER` messages or
+        :data:`RECORDER_MAX_LAG_S` of simulated time."""
+        recorder = self.recorder
+        return recorder is not None and (recorder.backlog > RECORDER_HIGH_WATER
+                                         or recorder.backlog_s > RECORDER_MAX_LAG_S)

@@ -57,7 +57,7 @@ def test_errors_name_the_bad_input(data, names) -> None:
 def test_off_bottom_is_an_action_at_its_time() -> None:
     s = schedule_from_list([{"t_s": 0, "rpm": 0, "off_bottom": True},
                             {"t_s": 1, "rpm": 60, "ramp_s": 10},
-                            {"t_s": 40, "off_bottom": False, "ramp_s": 5},
+                            {"t_s": 40, "off_bottom": False},
                             {"t_s": 50, "off_bottom": True}], 35.0, 6e4)
     assert [s.off_bottom_at(t) for t in (0, 39.99, 40, 42, 49.9, 50, 99)] == \
         [True, True, False, False, False, True, True]
@@ -67,7 +67,8 @@ def test_off_bottom_is_an_action_at_its_time() -> None:
 
 @pytest.mark.parametrize("value", [1, "yes", None])
 def test_off_bottom_must_be_true_or_false(value) -> None:
-    with pytest.raises(ParameterError, match=r"'off_bottom' = .* must be true or false"):
+    with pytest.raises(ParameterError, match=r"'schedule\[0\].off_bottom' = .* must be true or "
+                                             "false"):
         schedule_from_list([{"t_s": 5, "off_bottom": value}], 35.0, 6e4)
 
 
