@@ -16,8 +16,12 @@ half a step). At a junction, speed is continuous and the torques balance; with a
 damper D there (torque D w), w = (a_in - b_in) / (Z_up + Z_down + D), and the outgoing waves
 follow. Distributed viscous damping (force per length proportional to the local speed,
 rate ``gamma`` = damping per unit mass, 1/s) is lumped into ``damping_points`` point dampers
-per section, each at the middle of an equal part. Axial waves use the same machinery with
-force and velocity.
+per section, each at the middle of an equal part. A string in a well whose wall holds a
+friction is cut instead into cells of one wave step (:func:`wall_cells`), and every junction
+between two cells carries the damping and the wall's Coulomb friction of half of each
+(:func:`to_junctions`): the friction's resolution is the wave step. Axial waves use the same
+machinery with force and velocity; a torsional junction and the axial one nearest in depth
+share one wall contact (:func:`junction_pairs`).
 
 Everything compiled here works in the kernel's units (time t*, torque C, force unit
 zeta eps a L*, length L*; RGD07 eqs. 19-20).
@@ -139,8 +143,9 @@ class StringSpec:
     is the BHA for the lumped equivalent. ``bit_inertia_kg_m2``: lumped inertia at the bit
     beyond the sections. ``hook_wob_time_s``: time constant of the hook's WOB loop (the
     driller's brake / autodriller holding the top so that the weight on bit follows the
-    applied-WOB command). ``damping_points``: point dampers (and wall-friction points) per
-    section. Off bottom the hook picks the string up at ``hook_pickup_m_s`` until the bit
+    applied-WOB command). ``damping_points``: point dampers per section of a string
+    without wall friction (a walled string has an element in every cell). Off bottom the
+    hook picks the string up at ``hook_pickup_m_s`` until the bit
     is ``off_bottom_clearance_m`` above the rock, and holds it there; tagging bottom again
     it lowers at most at ``hook_tag_m_s`` (the driller's slack-off). ``bit_substeps``:
     steps of the bit law and the drive per step of the wave guide (1: one step for all; n:
