@@ -48,6 +48,7 @@ from drill_sim_ros.model.string import (
     StringSpec,
     fastest_hook_loop_s,
     kernel_string,
+    walled,
 )
 from drill_sim_ros.model.top_drive import TopDrive, TopDrivePhysical, top_drive_from_dict
 from drill_sim_ros.model.validate_input import check_preset_mapping, read_preset_file
@@ -109,7 +110,8 @@ class Preset:
     def kernel_string(self) -> KernelString:
         """The string in kernel units (what the simulator builds its delay lines from)."""
         sc = self.scales
-        return kernel_string(self.string, sc.time_s, sc.torque_nm, sc.length_m, sc.force_n)
+        return kernel_string(self.string, sc.time_s, sc.torque_nm, sc.length_m, sc.force_n,
+                             self.dtau * self.string.bit_substeps)
 
 
 def config_dirs() -> list[Path]:
@@ -192,7 +194,14 @@ def _with_well(name: str, data: dict[str, Any], string: StringSpec) -> StringSpe
     if not string.distributed:
         raise ParameterError(f"preset '{name}': 'well' needs string.model: distributed (the "
                              "wall's friction acts along the string)")
-    return replace(string, well=well_from_dict(data["well"]))
+    spec = replace(string, well=well_from_dict(data["well"]))
+    if walled(spec) and "damping_points" in data.get("string", {}):
+        raise ParameterError(
+            f"preset '{name}': 'string.damping_points' lumps the damping of a string without "
+            "wall friction; in a well with side friction every cell of the wave guide "
+            "carries its damping and friction (the resolution: numerics.dtau x "
+            "string.bit_substeps): remove the key")
+    return spec
 
 
 SECTION_FIELDS = {f.name: f for f in fields(Section)}

@@ -227,7 +227,8 @@ class Simulator:
                 f"a string section (or damping part) is shorter than one step of the wave "
                 f"guide (dtau = {self.config.dtau:g} x string.bit_substeps = "
                 f"{self.string.substeps}); lengthen it, merge it with its neighbour, lower "
-                "string.damping_points or string.bit_substeps")
+                "string.damping_points or string.bit_substeps (a walled string's cells are "
+                "cut for the preset's numerics.dtau)")
 
     @property
     def wave_dtau(self) -> float:
@@ -257,9 +258,9 @@ class Simulator:
         and torque command on the torque that this leaves at the top."""
         parts_t, parts = self._parts[0], self._wave_i.shape[1]
         top_torque = sg.fill_steady(self._wave, self._wave_i, self._wave_f, 0, parts_t,
-                                    bit_torque, speed, axial_speed, parts_t)
+                                    bit_torque, speed, axial_speed)
         sg.fill_steady(self._wave, self._wave_i, self._wave_f, parts_t, parts, bit_force,
-                       axial_speed, speed, -parts_t)
+                       axial_speed, speed)
         self._wave_f[sg.W_WORK] = 0.0
         st = self._state
         st[k.S_SUB_COUNT:k.S_SUB_V_BIT + 1] = 0.0     # a new wave step starts now
