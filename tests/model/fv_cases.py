@@ -3,8 +3,12 @@
 
 * ``deviated``: the shipped ``field_8p5in_deviated`` (vertical to 300 m, built to 40 deg,
   again to 45 deg, held; mu_s / mu_d 0.885 / 0.425, a stick band of 0.9 rad/s; the stiff
-  speed loop with its motor lag and torque-rate limit), 30 rpm in 10 s: it breaks away and
-  sticks and slips off bottom (docs/string.md).
+  speed loop with its motor lag and torque-rate limit), 30 rpm in 10 s, for 25 s: the
+  break-away (17.9 s) and the first slip. Only that: the cycle after it is not a property of
+  the resolution-independent physics here. The independent solver itself gives periods of
+  12.4, 10.1 and 8.7 s at 1000, 2000 and 4000 cells over 60 s, and at 40 rpm sticks and
+  slips at 1000 cells and rotates steadily at 2000 (stick-slip and steady rotation coexist,
+  docs/string.md), while its break-away moves by 0.2 % (measured 2026-12-06).
 * ``tangent``: a Well B-like string of our own on a long 60 deg tangent, after Aarsnes &
   Shor's own inputs (Open-Source-Drilling-Community/Aarsnes-and-Shor-Torsional-Model,
   ``parameters_WellB.m``: pipe OD 0.146529 m, ID 0.123024 m; 230 m of collars; inclination
@@ -52,5 +56,5 @@ def tangent() -> dict[str, Any]:
 
 
 # name: (preset mapping, rpm, ramp s, seconds)
-CASES = {"deviated": (deviated, 30.0, 10.0, 60.0),
+CASES = {"deviated": (deviated, 30.0, 10.0, 25.0),
          "tangent": (tangent, 40.0, 2.0, 60.0)}
