@@ -30,13 +30,24 @@ Sci. Eng. 163, 2018; their code, Open-Source-Drilling-Community/Aarsnes-and-Shor
 Model, ``torsionalWaveStep.m``: ``Palpha - dt/dx c diff(Palpha_pad) - dt S`` and the same for
 beta, the pipe-collar interface by the impedance ratio ``Zbar``), here at a Courant number
 below 1 (default 0.9; 1 would turn it into the method of characteristics, which the package
-uses), so the two share no numerical method. The friction is a source on the cell's speed
-only, as theirs (their ``S_P`` enters alpha and beta alike), applied per cell as an implicit
-Coulomb impulse: the cell's momentum after the fluxes, p, is brought toward rest by at most
-dt x its capacity, never through zero. Where Aarsnes & Shor hold a cell inside the band at
-the speed it had (their ``Pci``: the torque that keeps ``op`` unchanged, clamped to the static
-threshold), this solver holds it at rest, as the package's documented law does (docs/
-string.md: "stuck ... the junction's speed is 0"). The band is judged on the last speeds.
+uses), so the two share no numerical method.
+
+The wall's friction sits at the faces, inside their Riemann problem (:func:`wall_faces`): each
+face carries the wall between the centres of its two cells and moves only when the
+invariants' push exceeds it (implicit Coulomb, never through zero); a stuck face has
+w* = 0 and passes a torque jump up to its capacity. That is the balance law's steady state
+kept exactly (the source at the interfaces: Bale, LeVeque, Mitran & Rossmanith, SIAM J. Sci.
+Comput. 24, 2002): a stuck stretch of string keeps its torques. Aarsnes & Shor instead add
+the friction to each cell's speed after the upwind step (their ``Pci`` / ``S_P``, in alpha and
+beta alike), so the strain of a held cell still moves with its faces: the torques diffuse
+through a stuck stretch at C c dx / 2 (1900 m^2/s at 2000 cells), and the bit creeps before
+it breaks away. Written that way first, this solver broke away at 20.8 s on the deviated
+case at 1000-2500 cells and at 17.9 s at 3000-4000 (Courant 0.9), against 17.85-17.94 s at
+every resolution and Courant number (0.6, 0.9) with the friction at the faces (measured
+2026-12-06). Inside the band their cell keeps the speed it had (the torque that keeps
+``op`` unchanged, clamped to the static threshold); here, as in the package's documented law
+(docs/string.md: "stuck ... the junction's speed is 0"), a held face is at rest. The band is
+judged on each face's last speed.
 
 **The ends.** Top, torsion: the drive's speed w_s over the step, T* = b_1 + Z_1 w_s; the
 drive as the package documents it in speed mode (docs/model.md, model/top_drive.py's module
