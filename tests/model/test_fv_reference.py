@@ -18,6 +18,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 import yaml
 
@@ -60,6 +61,29 @@ def test_the_solver_meets_the_static_and_sliding_closed_forms() -> None:
                   * s.length_m for s in case.sections) * 30.0 * RAD_S_PER_RPM
     late = run.t_s > 20.0
     assert run.motor_torque_nm[late].mean() == pytest.approx(wall + viscous, rel=0.01)
+
+
+def test_the_solver_s_contact_holds_and_shares_the_sliding_force() -> None:
+    """One face law, three states: a push within the static capacity holds the face still
+    and passes the torque jump; beyond it the face slides with the push less the capacity
+    over Z_up + Z_down; and with the axial slip equal to the rotation's, the torsional line
+    feels only 1/sqrt(2) of the sliding force (the force along the slip velocity)."""
+    case = short_case(0.3, 0.3)
+    line = fv.build_line(case, [20, 2], 1e-4, axial=False)
+    cap = line.cap_s[:-1]
+    for scale, other in ((0.5, None), (3.0, None), (3.0, "equal")):
+        line.t = -np.cumsum(np.concatenate(([0.0], scale * cap)))
+        line.w_face[:] = 1.0                         # sliding last step (band 0.05 rad/s)
+        push = line.t[:-1] - line.t[1:]
+        slip = np.abs(push * line.inv_zsum * line.arm[:-1])
+        other_slip = None if other is None else np.append(slip, 0.0)
+        w_star, t_up, t_down = fv.wall_faces(line, line.inv_zsum, 1e-4, other_slip)
+        share = 1.0 if other is None else 1.0 / math.sqrt(2.0)
+        expected = np.maximum(push - share * cap, 0.0) * line.inv_zsum
+        np.testing.assert_allclose(w_star, expected, rtol=1e-12, atol=1e-15)
+        held = w_star == 0.0
+        assert held.all() == (scale < 1.0)
+        np.testing.assert_allclose((t_up - t_down)[held], push[held], rtol=1e-12)
 
 
 def test_the_solver_converges_on_its_own() -> None:
