@@ -427,6 +427,9 @@ def run_startup(case: Case, rpm: float, ramp_s: float, seconds: float, cells: in
                                      d.angle, bit_angle)
             if on_sample is not None:
                 on_sample(step * dt, tor)
+        # The hook is held and the bit end free, so nothing forces the axial line: it stays
+        # exactly at rest (every flux and friction term zero) until something moves it, and
+        # is stepped, and felt by the torsional contact, only from then on.
         axial_moving = axl.w.any() or axl.t.any()
         v_at_t = np.interp(tor.depth_m, axl.depth_m, axl.w_face) if axial_moving else None
         inner = wall_faces(tor, inv_t, dt, v_at_t)
