@@ -16,7 +16,7 @@ export FASTRTPS_DEFAULT_PROFILES_FILE := $(or $(FASTRTPS_DEFAULT_PROFILES_FILE),
 export AMENT_PREFIX_PATH := $(if $(AMENT_PREFIX_PATH),$(AMENT_PREFIX_PATH):$(abspath $(VENV)),$(abspath $(VENV)))
 # The compiled kernel inlines functions of other model files, and numba's cache only notices
 # changes to the kernel's own file: one cache per state of drill_sim_ros/model.
-export NUMBA_CACHE_DIR ?= $(abspath .cache/numba)/$(shell cat drill_sim_ros/model/*.py | sha1sum | cut -c1-12)
+export NUMBA_CACHE_DIR ?= $(abspath .cache/numba)/$(shell cat drill_sim_ros/model/*.py drill_sim_ros/model/*/*.py | sha1sum | cut -c1-12)
 export PYTHONUNBUFFERED := 1
 
 RUN_DIR ?= runs/$(shell date -u +%Y%m%dT%H%M%SZ)

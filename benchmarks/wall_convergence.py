@@ -6,7 +6,7 @@ Prints, no asserts. For a preset with a walled string, ``drill_sim startup``'s f
 friction's resolution too), each resolution's change against the finest, and the time each
 run took.
 With ``--statics``: instead, the torque at the top when the bit breaks away on a slow
-ramp inside the stick band (to half of it in 60 s) against the integral of r_o mu_s N, and
+ramp inside the stick band (to a tenth of it in 60 s) against the integral of r_o mu_s N, and
 the mean torque at the top turning steadily at 60 rpm (the last 20 s of 120) against the
 integral of r_o mu_d N plus the viscous drag, both integrals taken here on 20 000 pieces.
 Usage: .venv/bin/python benchmarks/wall_convergence.py --params field_8p5in_deviated
@@ -50,8 +50,8 @@ def wall_integral_nm(preset: Preset, mu: float, pieces: int = 20_000) -> float:
 def statics(preset: Preset) -> None:
     """The slow break-away and the steady sliding torque against the integrals."""
     mu = preset.string.well.side_friction
-    slow_rpm = 0.5 * mu.stick_speed_rad_s * startup.RPM_PER_RAD_S
-    run = startup.run_startup(preset, slow_rpm, 60.0, 400.0)
+    slow_rpm = 0.1 * mu.stick_speed_rad_s * startup.RPM_PER_RAD_S
+    run = startup.run_startup(preset, slow_rpm, 60.0, 1500.0)
     scores = startup.startup_scores(run)
     static = wall_integral_nm(preset, mu.static)
     print(f"slow ramp to {slow_rpm:.2f} rpm: break-away at {scores['breakaway_s']} s with "

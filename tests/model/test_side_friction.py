@@ -496,6 +496,14 @@ def test_a_well_on_the_lumped_string_is_refused() -> None:
     _one_line_error(paper, "'well' needs a 'physical' preset")
 
 
+def test_damping_points_on_a_walled_string_are_refused() -> None:
+    """A walled string has an element in every cell; ``damping_points`` (the lumped dampers
+    of a string without wall friction) on it is one line naming the key, not ignored."""
+    data = preset_data()
+    data["string"]["damping_points"] = 16
+    _one_line_error(data, "'string.damping_points'", "remove the key")
+
+
 # ---- 7: the reader ----------------------------------------------------------------------------
 def _survey(*points: tuple[float, float]) -> list[dict[str, float]]:
     return [{"md_m": md, "inclination_deg": inc} for md, inc in points]
