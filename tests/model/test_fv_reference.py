@@ -127,17 +127,17 @@ def mismatches(package: dict, reference: dict) -> list[str]:
     return out
 
 
-# Today's package lumps the wall at ``string.damping_points`` junctions per section, and the
-# drop from static to dynamic friction at a few coarse points releases the string otherwise
-# than the wall does (issue 50, point 1): measured 2026-12-06, break-away 15 % (deviated)
-# and 20 % (tangent) late, docs/string.md's table. Strict: the day it agrees, this says so.
-LUMPED_WALL = pytest.mark.xfail(strict=True, raises=AssertionError,
-                                reason="issue 50 point 1: the wall's friction is lumped at "
-                                "a few points per section, not per cell")
+# On main (2285752) the package lumps the wall at ``string.damping_points`` junctions per
+# section, and the drop from static to dynamic friction at a few coarse points releases the
+# string otherwise than the wall does (issue 50, point 1): break-away 15 % (deviated) and 20 %
+# (tangent) late (docs/string.md's table). Strict: the day it agrees, this says so.
+NOT_PER_CELL = pytest.mark.xfail(strict=True, raises=AssertionError,
+                                 reason="issue 50 point 1: the package's wall friction does "
+                                 "not yet act per cell as the solver's does")
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("name", [pytest.param(name, marks=LUMPED_WALL)
+@pytest.mark.parametrize("name", [pytest.param(name, marks=NOT_PER_CELL)
                                   for name in sorted(fv_cases.CASES)])
 def test_drill_sim_startup_agrees_with_the_independent_solver(name: str,
                                                               tmp_path: Path) -> None:
