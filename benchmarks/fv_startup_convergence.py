@@ -63,7 +63,7 @@ def table(name: str, seconds: float, cells: list[int], against_cells: int) -> st
     make, rpm, ramp_s, default_s = fv_cases.CASES[name]
     seconds = seconds or default_s
     preset = make()
-    case = fv.case_from_preset(preset)
+    case = fv.case_from_preset(preset, fv_cases.package_has_bend_term())
     cutoff_hz = 2.0 * fv.torsional_modes_hz(case)[-1]
     columns, walls = {}, {}
     for n in cells:
@@ -76,7 +76,8 @@ def table(name: str, seconds: float, cells: list[int], against_cells: int) -> st
     package_s = time.perf_counter() - start
     ref = columns.get(against_cells, columns[cells[-1]])
     head = " | ".join(f"solver {n} cells" for n in cells)
-    lines = [f"{name}: {rpm:g} rpm in {ramp_s:g} s, {seconds:g} s "
+    lines = [f"{name}: {rpm:g} rpm in {ramp_s:g} s, {seconds:g} s, bend term "
+             f"{'on' if case.bend_term else 'off'} "
              f"(cut-off {cutoff_hz:.4f} Hz; package's {package['cutoff_hz']})",
              f"| figure | {head} | drill_sim startup | package vs {against_cells} cells |",
              "|---" * (len(cells) + 3) + "|"]

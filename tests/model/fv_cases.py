@@ -25,6 +25,9 @@
 from __future__ import annotations
 
 import copy
+import functools
+import subprocess
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -53,6 +56,17 @@ def tangent() -> dict[str, Any]:
     raw["top_drive"] = {"mode": "speed", "inertia_kg_m2": 2900.0, "kp_nm_s": 38000.0,
                         "ki_nm": 100000.0, "max_torque_nm": 50000.0}
     return raw
+
+
+@functools.cache
+def package_has_bend_term() -> bool:
+    """Whether the ``drill_sim`` under test presses the string on the wall with the bend's
+    tension x curvature too (docs/string.md, "The normal force: weight and bend"; main from
+    97de425, with ``drill_sim torque-drag``), so that the solver takes the same normal
+    force. Asked as a user would: does the command have ``torque-drag``."""
+    done = subprocess.run([sys.executable, "-m", "drill_sim_ros.cli", "torque-drag", "--help"],
+                          capture_output=True, timeout=120)
+    return done.returncode == 0
 
 
 # name: (preset mapping, rpm, ramp s, seconds)

@@ -110,7 +110,8 @@ class Case:
     """Everything the start-up needs, SI: sections top to bottom, the bit's inertia, the
     survey (md m, inclination deg), mud density, side friction (mu_s, mu_d, band rad/s) and
     the drive (J kg m^2, kp N m s, ki N m, torque limit N m, motor lag s, rate limit N m/s;
-    inf: none)."""
+    inf: none); ``bend_term``: the normal force carries tension x build rate
+    (:func:`normal_force_n_per_m`)."""
 
     sections: tuple[Section, ...]
     bit_inertia_kg_m2: float
@@ -126,11 +127,13 @@ class Case:
     max_torque_nm: float
     motor_lag_s: float = 0.0
     max_torque_rate_nm_s: float = math.inf
+    bend_term: bool = False
 
 
-def case_from_preset(source: str | Path | dict[str, Any]) -> Case:
+def case_from_preset(source: str | Path | dict[str, Any], bend_term: bool = False) -> Case:
     """The :class:`Case` of a physical preset with a distributed string and a well (a YAML
-    path or its mapping); the preset's own keys, read with their documented defaults."""
+    path or its mapping); the preset's own keys, read with their documented defaults. A
+    survey in one vertical plane only (azimuth, where given, the same at every station)."""
     raw = yaml.safe_load(Path(source).read_text()) if not isinstance(source, dict) else source
     phys, string, well, drive = raw["physical"], raw["string"], raw["well"], raw["top_drive"]
     rho = float(phys.get("density_kg_m3", 7850.0))
@@ -145,6 +148,8 @@ def case_from_preset(source: str | Path | dict[str, Any]) -> Case:
                              float(s.get("torsional_damping_per_s", gt)),
                              float(s.get("axial_damping_per_s", ga)))
                      for s in string["sections"])
+    if len({float(p.get("azimuth_deg", 0.0)) for p in well["survey"]}) > 1:
+        raise NotImplementedError("a survey that turns (azimuth changes): 2-D wells only")
     friction = well.get("side_friction", {})
     mu_s = float(friction.get("static", 0.0))
 
@@ -159,7 +164,7 @@ def case_from_preset(source: str | Path | dict[str, Any]) -> Case:
                 float(friction.get("stick_speed_rad_s", 0.05)),
                 float(drive["inertia_kg_m2"]), float(drive["kp_nm_s"]), float(drive["ki_nm"]),
                 limit("max_torque_nm"), float(drive.get("motor_lag_s", 0.0)),
-                limit("max_torque_rate_nm_s"))
+                limit("max_torque_rate_nm_s"), bend_term)
 
 
 # ---- the well -----------------------------------------------------------------------------
@@ -169,12 +174,44 @@ def inclination_rad(case: Case, md_m: np.ndarray) -> np.ndarray:
     return np.radians(np.interp(md_m, case.survey_md_m, case.survey_inc_deg))
 
 
+def build_rate_rad_m(case: Case, md_m: np.ndarray) -> np.ndarray:
+    """d inc / d md at ``md_m``: the slope of the survey leg holding it (0 past the ends)."""
+    md, inc = np.asarray(case.survey_md_m), np.radians(case.survey_inc_deg)
+    slopes = np.concatenate(([0.0], np.diff(inc) / np.diff(md), [0.0]))
+    return slopes[np.searchsorted(md, md_m, side="right")]
+
+
+def buoyed_weight_n_per_m(case: Case, section: Section) -> float:
+    """w_b = (rho - rho_mud) A g of ``section``."""
+    return (section.density_kg_m3 - case.mud_density_kg_m3) * section.area_m2 * GRAVITY_M_S2
+
+
+def hanging_tension_n(case: Case, md_m: np.ndarray, step_m: float = 0.25) -> np.ndarray:
+    """The static tension of the string hanging off bottom, rotating (no axial drag, no
+    force on the bit): the buoyed weight along the hole's axis of all that lies below
+    ``md_m``, the integral of w_b cos(inc) from ``md_m`` to the bit (trapezoid on
+    ``step_m``)."""
+    edges = np.cumsum([0.0] + [s.length_m for s in case.sections])
+    x = np.arange(0.0, edges[-1] + step_m, step_m).clip(max=edges[-1])
+    w_b = np.array([buoyed_weight_n_per_m(case, s) for s in case.sections])
+    per_m = w_b[np.clip(np.searchsorted(edges, x, side="right") - 1, 0, len(w_b) - 1)] \
+        * np.cos(inclination_rad(case, x))
+    from_top = np.concatenate(([0.0], np.cumsum(0.5 * (per_m[1:] + per_m[:-1]) * np.diff(x))))
+    return np.interp(md_m, x, from_top[-1] - from_top)
+
+
 def normal_force_n_per_m(case: Case, section: Section, md_m: np.ndarray) -> np.ndarray:
     """The wall's normal force per metre on ``section`` at ``md_m``: the buoyed weight's
-    component across the hole, (rho - rho_mud) A g sin(inc). (A bend's tension x curvature
-    term is added here when the well has one.)"""
-    w_b = (section.density_kg_m3 - case.mud_density_kg_m3) * section.area_m2 * GRAVITY_M_S2
-    return w_b * np.sin(inclination_rad(case, md_m))
+    component across the hole, w_b sin(inc), and with ``case.bend_term`` the tension x
+    curvature of a build or drop in the vertical plane, |T dinc/ds - w_b sin(inc)| (soft
+    string, Johancsik, Friesen & Dawson, SPE 11380, 1984, eq. 1, with s down the hole: in a
+    build the tension pulls the string to the high side, against its weight), T the static
+    hanging tension (:func:`hanging_tension_n`), as docs/string.md says the package takes
+    it since the survey work (main 97de425)."""
+    weight = buoyed_weight_n_per_m(case, section) * np.sin(inclination_rad(case, md_m))
+    if not case.bend_term:
+        return weight
+    return np.abs(hanging_tension_n(case, md_m) * build_rate_rad_m(case, md_m) - weight)
 
 
 def half_cell_normal_forces_n(case: Case, section: Section, top_m: float, cells: int,

@@ -12,6 +12,7 @@ cells): ``benchmarks/fv_startup_convergence.py`` and docs/string.md.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import subprocess
@@ -48,8 +49,9 @@ def test_the_solver_meets_the_static_and_sliding_closed_forms() -> None:
     """With mu_s = mu_d the wall lets the bit go once the torque at the top holds the whole
     wall, the integral of r_o mu N (plus Z w_s, the front that carries the drive's speed
     down; 2 rpm here), and a string sliding steadily (30 rpm) takes that integral plus the
-    viscous loss gamma rho J L w at the top: each within 1 %."""
-    case = short_case(0.3, 0.3)
+    viscous loss gamma rho J L w at the top: each within 1 % (the normal force with the
+    build's tension x curvature)."""
+    case = dataclasses.replace(short_case(0.3, 0.3), bend_term=True)
     wall = fv.static_breakaway_torque_nm(case)
     cutoff_hz = 2.0 * fv.torsional_modes_hz(case)[-1]
     slow = fv.startup_figures(fv.run_startup(case, 2.0, 1.0, 30.0, 500), cutoff_hz)
@@ -93,7 +95,7 @@ def test_the_solver_converges_on_its_own() -> None:
     arrival or the next; the full table at 1000 / 2000 / 4000 cells is
     ``benchmarks/fv_startup_convergence.py``'s.)"""
     make, rpm, ramp_s, _ = fv_cases.CASES["tangent"]
-    case = fv.case_from_preset(make())
+    case = fv.case_from_preset(make(), bend_term=True)
     cutoff_hz = 2.0 * fv.torsional_modes_hz(case)[-1]
     coarse, fine = (fv.startup_figures(fv.run_startup(case, rpm, ramp_s, 12.0, n), cutoff_hz)
                     for n in (1000, 2000))
@@ -146,7 +148,7 @@ def test_drill_sim_startup_agrees_with_the_independent_solver(name: str,
     within 0.05, the same cut-off (the same string's third mode)."""
     make, rpm, ramp_s, seconds = fv_cases.CASES[name]
     preset = make()
-    case = fv.case_from_preset(preset)
+    case = fv.case_from_preset(preset, fv_cases.package_has_bend_term())
     package = drill_sim_startup(preset, rpm, ramp_s, seconds, tmp_path)
     cutoff_hz = 2.0 * fv.torsional_modes_hz(case)[-1]
     assert package["cutoff_hz"] == pytest.approx(cutoff_hz, rel=1e-5)   # the same string
@@ -171,7 +173,7 @@ def test_without_the_static_drop_the_package_agrees_within_half_a_per_cent(
     if "damping_points" in preset["string"]:        # the lumped wall: at its finest
         preset["string"].update(damping_points=64, bit_substeps=1)
     package = drill_sim_startup(preset, 30.0, 10.0, 25.0, tmp_path)
-    case = fv.case_from_preset(preset)
+    case = fv.case_from_preset(preset, fv_cases.package_has_bend_term())
     reference = fv.startup_figures(fv.run_startup(case, 30.0, 10.0, 25.0, 1000),
                                    package["cutoff_hz"])
     for key in FIGURES[:-1]:
