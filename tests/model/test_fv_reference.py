@@ -129,18 +129,8 @@ def mismatches(package: dict, reference: dict) -> list[str]:
     return out
 
 
-# On main (2285752) the package lumps the wall at ``string.damping_points`` junctions per
-# section, and the drop from static to dynamic friction at a few coarse points releases the
-# string otherwise than the wall does (issue 50, point 1): break-away 15 % (deviated) and 20 %
-# (tangent) late (docs/string.md's table). Strict: the day it agrees, this says so.
-NOT_PER_CELL = pytest.mark.xfail(strict=True, raises=AssertionError,
-                                 reason="issue 50 point 1: the package's wall friction does "
-                                 "not yet act per cell as the solver's does")
-
-
 @pytest.mark.slow
-@pytest.mark.parametrize("name", [pytest.param(name, marks=NOT_PER_CELL)
-                                  for name in sorted(fv_cases.CASES)])
+@pytest.mark.parametrize("name", sorted(fv_cases.CASES))
 def test_drill_sim_startup_agrees_with_the_independent_solver(name: str,
                                                               tmp_path: Path) -> None:
     """The shipped deviated preset and the long tangent (:mod:`tests.model.fv_cases`): the
