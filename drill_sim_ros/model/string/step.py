@@ -173,37 +173,7 @@ def drive_line(wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray, lo: int
     b_top, a_bottom = arriving(wave, wave_i, lo, hi)
     a_top = b_top + 2.0 * wave_f[W_Z, lo] * w_top
     b_bottom = (a_bottom - 2.0 * wave_f[W_Z, hi - 1] * w_bottom) * echo
-    if one_step_parts(wave_i, lo, hi):
-        scatter_cells(wave, wave_i, wave_f, lo, hi, a_top, b_bottom)
-    else:
-        scatter(wave, wave_i, wave_f, lo, hi, a_top, b_bottom)
-
-
-@njit(cache=True, inline="always")
-def one_step_parts(wave_i: np.ndarray, lo: int, hi: int) -> bool:
-    """Whether every part of the line ``lo .. hi`` spans one step (a walled string's cells,
-    :func:`.lines.wall_cells`): its buffer is then 2 slots a part."""
-    return (wave_i[W_OFF, hi - 1] + 2 * wave_i[W_LEN, hi - 1] - wave_i[W_OFF, lo]
-            == 2 * (hi - lo))
-
-
-@njit(cache=True, inline="always")
-def scatter_cells(wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray, lo: int,
-                  hi: int, a_top: float, b_bottom: float) -> None:
-    """:func:`scatter` of a line whose parts all span one step: part j holds its a at slot
-    base + 2 j and its b beside it, and the slots never move (the same arithmetic in the
-    same order, without the slot bookkeeping: about half a walled string's step)."""
-    base = wave_i[W_OFF, lo] - 2 * lo
-    a_in = wave[base + 2 * lo]
-    wave[base + 2 * lo] = a_top
-    for j in range(lo, hi - 1):
-        b_in = wave[base + 2 * j + 3]
-        w = junction_speed(wave_f, j, a_in, b_in, wave_i[W_PAIR, j])
-        wave[base + 2 * j + 1] = a_in - 2.0 * wave_f[W_Z, j] * w
-        a_next = wave[base + 2 * j + 2]
-        wave[base + 2 * j + 2] = b_in + 2.0 * wave_f[W_Z, j + 1] * w
-        a_in = a_next
-    wave[base + 2 * hi - 1] = b_bottom
+    scatter(wave, wave_i, wave_f, lo, hi, a_top, b_bottom)
 
 
 @njit(cache=True, inline="always")
@@ -223,22 +193,30 @@ def scatter(wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray, lo: int, h
     Indexes the layout arrays in place: row views would cost reference counting every step
     (about a tenth of the distributed string's step, measured). The junctions' law is
     :func:`junction_speed`; the other line's junction beside junction j is W_PAIR (the one
-    nearest in depth, :func:`junction_pairs`)."""
+    nearest in depth, :func:`.lines.junction_pairs`). A line whose parts all span one step
+    (a walled string's cells, :func:`.lines.wall_cells`) holds part j's a at slot base + 2 j
+    and its b beside it, and its slots never move: the same arithmetic without the slot
+    bookkeeping (about a third of a walled string's step, measured)."""
+    base = wave_i[W_OFF, lo] - 2 * lo        # every part one step: 2 slots a part
+    cells = wave_i[W_OFF, hi - 1] + 2 * wave_i[W_LEN, hi - 1] - base == 2 * hi
     a_slot = wave_i[W_OFF, lo] + wave_i[W_POS, lo]
     a_in = wave[a_slot]                      # arriving at the bottom of part lo
     wave[a_slot] = a_top
     for j in range(lo, hi - 1):
-        b_slot = wave_i[W_OFF, j + 1] + wave_i[W_LEN, j + 1] + wave_i[W_POS, j + 1]
+        if cells:
+            b_slot, out_slot, a_slot = base + 2 * j + 3, base + 2 * j + 1, base + 2 * j + 2
+        else:
+            b_slot = wave_i[W_OFF, j + 1] + wave_i[W_LEN, j + 1] + wave_i[W_POS, j + 1]
+            out_slot = wave_i[W_OFF, j] + wave_i[W_LEN, j] + wave_i[W_POS, j]
+            a_slot = wave_i[W_OFF, j + 1] + wave_i[W_POS, j + 1]
         b_in = wave[b_slot]                  # arriving at the top of part j + 1
         w = junction_speed(wave_f, j, a_in, b_in, wave_i[W_PAIR, j])
-        wave[wave_i[W_OFF, j] + wave_i[W_LEN, j] + wave_i[W_POS, j]] = \
-            a_in - 2.0 * wave_f[W_Z, j] * w
-        a_slot = wave_i[W_OFF, j + 1] + wave_i[W_POS, j + 1]
+        wave[out_slot] = a_in - 2.0 * wave_f[W_Z, j] * w
         a_next = wave[a_slot]
         wave[a_slot] = b_in + 2.0 * wave_f[W_Z, j + 1] * w
         a_in = a_next
     wave[wave_i[W_OFF, hi - 1] + wave_i[W_LEN, hi - 1] + wave_i[W_POS, hi - 1]] = b_bottom
-    for j in range(lo, hi):
+    for j in range(lo, hi):                  # (a cell's slot stays 0)
         pos = wave_i[W_POS, j] + 1
         wave_i[W_POS, j] = pos if pos < wave_i[W_LEN, j] else 0
 
