@@ -1,0 +1,174 @@
+"""``drill_sim startup`` against the independent finite-volume solver (issue 50, point 2).
+
+The solver (:mod:`tests.model.fv_reference`) shares no code with the package: its own
+sections, well, drive, ends, modes, low-pass and figures, written from the equations and
+the documented definitions. It first meets closed forms of its own (the static break-away
+torque, the sliding torque) and the package's string modes; then the package, run as a
+user runs it (a subprocess printing its JSON), must give the start-up figures of the
+solver at 2000 cells on two cases (:mod:`tests.model.fv_cases`): within 3 %, the stick
+fraction within 0.05 (the issue's bar). The solver's own convergence (1000 / 2000 / 4000
+cells): ``benchmarks/fv_startup_convergence.py`` and docs/string.md.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from tests.model import fv_cases
+from tests.model import fv_reference as fv
+
+CELLS = 2000
+FIGURES = ("breakaway_s", "breakaway_turns", "breakaway_torque_nm", "first_slip_s",
+           "peak_motor_torque_nm", "period_s")
+REL, STICK_ABS = 0.03, 0.05
+RAD_S_PER_RPM = 2.0 * math.pi / 60.0
+
+
+def short_case(mu_static: float, mu_dynamic: float) -> fv.Case:
+    """1000 m of 5-in pipe on 100 m of collars, vertical to 100 m, built to 60 deg at 500 m,
+    no mud; the field drive without its motor lag."""
+    steel = {"density_kg_m3": 7850.0, "shear_modulus_pa": 79.3e9,
+             "youngs_modulus_pa": 206e9, "torsional_damping_per_s": 0.42,
+             "axial_damping_per_s": 0.68}
+    sections = (fv.Section(0.0635, 0.0543, 1000.0, **steel),
+                fv.Section(0.0857, 0.0357, 100.0, **steel))
+    return fv.Case(sections, 0.3, (0.0, 100.0, 500.0, 1100.0), (0.0, 0.0, 60.0, 60.0), 0.0,
+                   mu_static, mu_dynamic, 0.05, 2900.0, 23200.0, 46400.0, 50000.0)
+
+
+def test_the_solver_meets_the_static_and_sliding_closed_forms() -> None:
+    """With mu_s = mu_d the wall lets the bit go once the torque at the top holds the whole
+    wall, the integral of r_o mu N (plus Z w_s, the front that carries the drive's speed
+    down; 2 rpm here), and a string sliding steadily (30 rpm) takes that integral plus the
+    viscous loss gamma rho J L w at the top: each within 1 % (the normal force with the
+    build's tension x curvature)."""
+    case = dataclasses.replace(short_case(0.3, 0.3), bend_term=True)
+    wall = fv.static_breakaway_torque_nm(case)
+    cutoff_hz = 2.0 * fv.torsional_modes_hz(case)[-1]
+    slow = fv.startup_figures(fv.run_startup(case, 2.0, 1.0, 30.0, 500), cutoff_hz)
+    front = case.sections[0].polar_moment_m4 * math.sqrt(79.3e9 * 7850.0) * 2.0 \
+        * RAD_S_PER_RPM
+    assert slow["breakaway_torque_nm"] == pytest.approx(wall + front, rel=0.01)
+    run = fv.run_startup(case, 30.0, 5.0, 30.0, 500)
+    viscous = sum(s.torsional_damping_per_s * s.density_kg_m3 * s.polar_moment_m4
+                  * s.length_m for s in case.sections) * 30.0 * RAD_S_PER_RPM
+    late = run.t_s > 20.0
+    assert run.motor_torque_nm[late].mean() == pytest.approx(wall + viscous, rel=0.01)
+
+
+def test_the_solver_s_contact_holds_and_shares_the_sliding_force() -> None:
+    """One face law, three states: a push within the static capacity holds the face still
+    and passes the torque jump; beyond it the face slides with the push less the capacity
+    over Z_up + Z_down; and with the axial slip equal to the rotation's, the torsional line
+    feels only 1/sqrt(2) of the sliding force (the force along the slip velocity)."""
+    case = short_case(0.3, 0.3)
+    line = fv.build_line(case, [20, 2], 1e-4, axial=False)
+    cap = line.cap_s[:-1]
+    for scale, other in ((0.5, None), (3.0, None), (3.0, "equal")):
+        line.t = -np.cumsum(np.concatenate(([0.0], scale * cap)))
+        line.w_face[:] = 1.0                         # sliding last step (band 0.05 rad/s)
+        push = line.t[:-1] - line.t[1:]
+        slip = np.abs(push * line.inv_zsum * line.arm[:-1])
+        other_slip = None if other is None else np.append(slip, 0.0)
+        w_star, t_up, t_down = fv.wall_faces(line, line.inv_zsum, 1e-4, other_slip)
+        share = 1.0 if other is None else 1.0 / math.sqrt(2.0)
+        expected = np.maximum(push - share * cap, 0.0) * line.inv_zsum
+        np.testing.assert_allclose(w_star, expected, rtol=1e-12, atol=1e-15)
+        held = w_star == 0.0
+        assert held.all() == (scale < 1.0)
+        np.testing.assert_allclose((t_up - t_down)[held], push[held], rtol=1e-12)
+
+
+def test_the_solver_converges_on_its_own() -> None:
+    """The long tangent's first 12 s (break-away at about 4 s, first slip at 5.7 s) at 1000
+    and 2000 cells: every figure of the break-away within 1 %. (On a short string the
+    break-away can jump by a wave's transit between resolutions: the bit leaves on one wave
+    arrival or the next; the full table at 1000 / 2000 / 4000 cells is
+    ``benchmarks/fv_startup_convergence.py``'s.)"""
+    make, rpm, ramp_s, _ = fv_cases.CASES["tangent"]
+    case = fv.case_from_preset(make(), bend_term=True)
+    cutoff_hz = 2.0 * fv.torsional_modes_hz(case)[-1]
+    coarse, fine = (fv.startup_figures(fv.run_startup(case, rpm, ramp_s, 12.0, n), cutoff_hz)
+                    for n in (1000, 2000))
+    for key in ("breakaway_s", "breakaway_turns", "breakaway_torque_nm", "first_slip_s",
+                "peak_motor_torque_nm"):
+        assert fine[key] == pytest.approx(coarse[key], rel=0.01), key
+
+
+def drill_sim_startup(preset: dict, rpm: float, ramp_s: float, seconds: float,
+                      tmp_path: Path) -> dict:
+    """``drill_sim startup --json`` on ``preset`` (written to a YAML file), as a user runs it."""
+    path = tmp_path / "case.yaml"
+    path.write_text(yaml.safe_dump(preset))
+    done = subprocess.run([sys.executable, "-m", "drill_sim_ros.cli", "startup", "--params",
+                           str(path), "--rpm", str(rpm), "--ramp-s", str(ramp_s),
+                           "--seconds", str(seconds), "--json"],
+                          capture_output=True, text=True, timeout=600, check=True)
+    return json.loads(done.stdout.strip().splitlines()[-1])
+
+
+def mismatches(package: dict, reference: dict) -> list[str]:
+    """The figures outside the issue's bars, each as 'key package reference'."""
+    out = []
+    for key in FIGURES:
+        ours, ref = package[key], reference[key]
+        if (ours is None) != (ref is None) or (ref is not None
+                                               and abs(ours - ref) > REL * abs(ref)):
+            out.append(f"{key} {ours} {ref}")
+    if abs(package["stick_fraction"] - reference["stick_fraction"]) > STICK_ABS:
+        out.append(f"stick_fraction {package['stick_fraction']} {reference['stick_fraction']}")
+    return out
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", sorted(fv_cases.CASES))
+def test_drill_sim_startup_agrees_with_the_independent_solver(name: str,
+                                                              tmp_path: Path) -> None:
+    """The shipped deviated preset and the long tangent (:mod:`tests.model.fv_cases`): the
+    package's start-up figures within 3 % of the solver's at 2000 cells, the stick fraction
+    within 0.05, the same cut-off (the same string's third mode)."""
+    if name == "deviated" and fv_cases.package_has_bend_term():
+        pytest.skip("with the bend term the solver's own break-away on the deviated preset "
+                    "jumps between wave arrivals (18.4, 21.4, 19.6 s at 1000, 2000, 4000 "
+                    "cells, measured 2026-12-06): no resolution-independent value to meet")
+    make, rpm, ramp_s, seconds = fv_cases.CASES[name]
+    preset = make()
+    case = fv.case_from_preset(preset, fv_cases.package_has_bend_term())
+    package = drill_sim_startup(preset, rpm, ramp_s, seconds, tmp_path)
+    cutoff_hz = 2.0 * fv.torsional_modes_hz(case)[-1]
+    assert package["cutoff_hz"] == pytest.approx(cutoff_hz, rel=1e-5)   # the same string
+    reference = fv.startup_figures(fv.run_startup(case, rpm, ramp_s, seconds, CELLS),
+                                   cutoff_hz)
+    assert reference["stick_slip"]                     # the cases stick and slip off bottom
+    assert not mismatches(package, reference), mismatches(package, reference)
+
+
+@pytest.mark.slow
+def test_without_the_static_drop_the_package_agrees_within_half_a_per_cent(
+        tmp_path: Path) -> None:
+    """The deviated case with mu_s = mu_d (0.425): no drop from static to dynamic, so no
+    cascade of released elements, and the package's wall (lumped: at 64 points per section,
+    one wave step per bit step; per cell: the preset's cells) carries the same physics as
+    the solver's cells: the sections, the
+    buoyed normal force, the drive with its lag and rate limit, the free bit and the
+    figures. Every break-away figure within 0.5 % (measured 2026-12-06 with the wall lumped at
+    64 points per section and one wave step per bit step: within 0.02 %)."""
+    preset = fv_cases.deviated()
+    preset["well"]["side_friction"]["static"] = preset["well"]["side_friction"]["dynamic"]
+    if "damping_points" in preset["string"]:        # the lumped wall: at its finest
+        preset["string"].update(damping_points=64, bit_substeps=1)
+    package = drill_sim_startup(preset, 30.0, 10.0, 25.0, tmp_path)
+    case = fv.case_from_preset(preset, fv_cases.package_has_bend_term())
+    reference = fv.startup_figures(fv.run_startup(case, 30.0, 10.0, 25.0, 1000),
+                                   package["cutoff_hz"])
+    for key in FIGURES[:-1]:
+        assert package[key] == pytest.approx(reference[key], rel=0.005), key
