@@ -571,9 +571,10 @@ class Simulator:
         """The physics guard: the wall's friction only takes energy. Each junction's work
         (W_WORK) grows by limit |w| dtau or c w^2 dtau, never negative for a wall that
         presses on the string; a negative one means the string creates energy there (a
-        negative normal force: a string lighter than the mud). Then the simulator faults
-        (:class:`EnergyFault`) naming the junction, its depth and the time, instead of
-        returning numbers."""
+        negative friction limit: a normal force below zero, which the soft-string norm never
+        gives, so a bug upstream; a string lighter than the mud is refused at load). Then
+"        the simulator faults (:class:`EnergyFault`) naming the junction, its depth and the
+        time, instead of returning numbers."""
         work = self._wall_work
         if work is None or work.min() >= 0.0:
             return
@@ -589,8 +590,8 @@ class Simulator:
         self.fault = (f"energy fault at t = {self.tau * sc.time_s:.6g} s (tau = {self.tau:.6g})"
                       f": the wall at the {'axial' if axial else 'torsional'} line's junction "
                       f"{local} ({depth_m:.1f} m below the top) gave the string "
-                      f"{-joules:.4g} J (its friction can only take energy: is the string "
-                      "lighter than the mud?)")
+                      f"{-joules:.4g} J (its friction can only take energy: a negative normal "
+                      "force or friction limit there)")
         raise EnergyFault(self.fault)
 
     @property

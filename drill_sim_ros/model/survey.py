@@ -28,7 +28,7 @@ from typing import Any
 
 import numpy as np
 
-from drill_sim_ros.model.checks import as_number
+from drill_sim_ros.model.checks import as_number, shown
 from drill_sim_ros.model.errors import ParameterError
 
 COLUMNS = ("md_m", "inclination_deg", "azimuth_deg")
@@ -156,7 +156,7 @@ def _value(row: dict[str, Any], column: str, label: str) -> float:
     x = math.nan if number is None else float(number)
     if not (math.isfinite(x) and low <= x <= high):
         what = "not a number" if number is None or math.isnan(x) else "out of range"
-        raise ParameterError(f"{label} = {row[column]!r} is {what}; allowed [{low:g}, "
+        raise ParameterError(f"{label} = {shown(row[column])} is {what}; allowed [{low:g}, "
                              f"{high:g}]")
     return x
 

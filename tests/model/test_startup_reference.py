@@ -76,11 +76,6 @@ def both(rpm: float, ramp_s: float, seconds: float) -> tuple[dict, dict]:
     return startup_scores(ours), startup_scores(reference_run(rpm, ramp_s, seconds, ours))
 
 
-@pytest.mark.xfail(strict=True, reason="with the bend term (2026-12-06) the lumped wall "
-                   "friction's break-away turns at 64 points a section are 4.257 against "
-                   "the reference's 4.014-4.140 (16 and 32 points: 4.174, 3.958, inside): "
-                   "the lumping's non-convergence of issue 50, items 1-2; the mean motor "
-                   "torque agrees to 0.05 %")
 def test_the_break_away_matches_the_reference_within_a_few_per_cent() -> None:
     """60 rpm in 10 s: the string breaks free as the torque front reaches the collars. The
     bit leaves on one of two wave arrivals (about 8.7 s, 3.75 turns, 9.9 kN m, or about
