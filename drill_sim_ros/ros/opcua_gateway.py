@@ -55,7 +55,8 @@ from drill_sim_ros.ros.parameters import init_ros
 from drill_sim_ros.ros.sim_link import SIM_PARAMETERS, SimLink, sim_values
 
 NODE_NAME = "opcua_gateway"
-USAGE = """usage: opcua_gateway [--export-nodeset FILE] [--ros-args -p endpoint:=... ...]
+USAGE = """usage: opcua_gateway [--ros-args -p endpoint:=opc.tcp://127.0.0.1:4840/drill_sim/ ...]
+       opcua_gateway --export-nodeset FILE [--ros-args ...]
 
 sim_node's surface and commands as an OPC UA server, for a PLC's controller in the loop
 (docs/hil.md). Its settings are ROS parameters (-p "rigs:=[/rig1, /rig2]" serves the
@@ -71,16 +72,16 @@ PROGRESS_S = 5.0                  # a line while the gateway waits for sim_node 
 @dataclass(frozen=True)
 class Setting:
     """One of the gateway's (read-only) ROS parameters; ``default`` None: an unset string
-    array; ``seconds``: a duration of 0.1 ... 3600 s."""
+    array; ``bounded``: a value of 0.1 ... 3600 (a duration in s, or the safe ramp)."""
 
     name: str
     default: Any
     description: str
-    seconds: bool = False
+    bounded: bool = False
 
     def descriptor(self) -> ParameterDescriptor:
         desc = ParameterDescriptor(description=self.description, read_only=True)
-        if self.seconds:
+        if self.bounded:
             desc.floating_point_range = [FloatingPointRange(from_value=MIN_SECONDS,
                                                             to_value=MAX_SECONDS, step=0.0)]
         return desc
@@ -102,17 +103,17 @@ SETTINGS = (
             "or Rig in /"),
     Setting("sim_node", topics.NODE_NAME, "sim_node's node name, in each rig's namespace"),
     Setting("sim_wait_s", 120.0, "how long to wait at start for each sim_node's parameters, "
-            "asking again until all are declared (a line every 5 s) [s]", seconds=True),
+            "asking again until all are declared (a line every 5 s) [s]", bounded=True),
     Setting("step_timeout_s", 0.5, "Step returns BadTimeout after this many wall seconds "
             "without the sample; the session's other requests wait behind it, so keep it below "
-            "the client's own timeouts (asyncua's watchdog: 1 s) [s]", seconds=True),
+            "the client's own timeouts (asyncua's watchdog: 1 s) [s]", bounded=True),
     Setting("heartbeat_timeout_s", 2.0, "the owner of the setpoints that writes nothing (nor "
             "calls Step) for this long loses them; in free run the drive then stops safely "
-            "(HeartbeatLost, Reset to go on) [s]", seconds=True),
+            "(HeartbeatLost, Reset to go on) [s]", bounded=True),
     Setting("sim_timeout_s", 2.0, "a command unanswered (in free run: no sample) for this "
-            "long makes Status SimLost [s]", seconds=True),
+            "long makes Status SimLost [s]", bounded=True),
     Setting("safe_ramp_rad_s2", 2.0, "the safe stop's ramp of the speed setpoint to 0 "
-            "[rad/s per s of simulated time]", seconds=True),
+            "[rad/s per s of simulated time]", bounded=True),
     Setting("security.certificate", "", "the server's certificate, DER or PEM, with the URI "
             "urn:drill_sim_ros:opcua_gateway ('' = not secured: loopback only)"),
     Setting("security.private_key", "", "the certificate's private key, PEM"),

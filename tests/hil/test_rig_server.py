@@ -7,6 +7,12 @@ objects whose simulators are stand-ins, and a real asyncua client (issue 33).
   it refuses is BadInvalidState, one it never answers BadTimeout, both counted.
 - The EURanges, Lockstep and DriveMode follow the stand-in's settings; a sample older than the
   latest (a restarted simulator) starts the handshake over from CommandCounter.
+- Issue 53: 300 rev/min as a PLC computes it is in range; an array to a scalar is a counted
+  BadTypeMismatch with no ERROR logged; a second session is refused BadUserAccessDenied and a
+  stale setpoint BadInvalidState; Step's wait is bounded and Status honest (SimLost), a
+  restart at t = 0 resyncs; a silent or closed owner in free run ramps the drive to rest
+  (torque mode: switched to speed first, Faulted if refused) until Reset, in lockstep only
+  loses the setpoints; the server's names and timestamps; the NodeSet2 export round-trips.
 """
 
 from __future__ import annotations
@@ -527,3 +533,36 @@ async def export_and_import(path: Path) -> None:
 
 def test_the_exported_nodeset_imports_into_a_fresh_server(tmp_path: Path) -> None:
     run(export_and_import(tmp_path / "rig.xml"))
+
+
+async def safe_stop_in_torque_mode(refuse: bool) -> None:
+    async with serving(heartbeat_timeout_s=0.2, safe_ramp_rad_s2=RAMP_RAD_S2) as (
+            rigs, stand_ins, client):
+        rig, stand_in = rigs["north"], stand_ins["north"]
+        await rig.follow(replace(FREE_RUN, drive_mode="torque"))
+        await rig.sample_in(SAMPLE | {"DriveSpeed": 3.0}, 0)
+        north = await view(client, "north")
+        await client.write_values([north.nodes["TorqueCommand"], north.nodes["CommandCounter"]],
+                                  [ua.Variant(1000.0, DOUBLE), ua.Variant(1, UINT32)])
+        stand_in.refuse_with = "refused for the test" if refuse else None
+        await client.disconnect()                   # the torque-mode owner goes
+        async with second_client(client) as other_session:
+            other = await view(other_session, "north")
+            await wait_for(other, "Status", 5 if refuse else HEARTBEAT_LOST)     # Faulted
+            assert stand_in.switches == ["speed"]
+            if refuse:
+                assert "speed mode" in await other.value("StatusText")
+                await method(other, "Reset")
+                assert await other.value("Status") == WAITING_FOR_CLIENT
+                return
+            sent = len(stand_in.commands)
+            await feed(rig, 0, 150)                  # 3 rad/s at 2 rad/s^2: at rest in 1.5 s
+            speeds = [c.speed_rad_s for c, _ in stand_in.commands[sent:]]
+            assert speeds[0] == 3.0 - RAMP_RAD_S2 * 0.01 and speeds[-1] == 0.0
+            assert await other.value("DriveMode") == "speed"
+
+
+@pytest.mark.parametrize("refuse", [False, True])
+def test_in_torque_mode_the_safe_stop_switches_to_speed_and_ramps_from_the_drive_speed(
+        refuse: bool) -> None:
+    run(safe_stop_in_torque_mode(refuse))
