@@ -1,0 +1,325 @@
+"""Fitting preset parameters to start-ups: replays on Dask, a cache, scipy's least squares.
+
+An *evaluation* replays one start-up with one parameter vector (:func:`simulate`, a Dask
+task, about as long as ``drill_sim startup`` takes) and turns it into the start-up's
+weighted residuals (:mod:`fit.objective`). The fit works in the parameters scaled to their
+bounds (u = (x - low) / (high - low), in [0, 1]):
+
+1. a global start: the preset's values and ``STARTS_PER_PARAMETER`` x n points of a
+   seeded Latin hypercube over the bounds (scipy.stats.qmc), evaluated in parallel; the
+   best is the start of
+   the replay's sensitivity to the speed's noise is measured there
+   (:meth:`Evaluator.measure_sensitivity`, fit.objective) and joins the weights;
+2. ``scipy.optimize.least_squares`` (trust-region reflective, within the bounds), whose
+   Jacobian is forward differences of ``JACOBIAN_STEP`` in u, evaluated in parallel;
+3. the 95 % intervals from the Jacobian at the optimum: cov = s^2 (J^T J)^-1 with s^2 the
+   residuals' mean square over their degrees of freedom (at least 1: a misfit within the
+   noise does not shrink them), times Student's t; the correlations from the same matrix.
+
+Every evaluation is appended to a cache file (JSON lines keyed by a hash of the preset, the
+start-up's samples and the parameter vector); a fit started again with the same inputs
+reads them back instead of recomputing (the optimiser's path is deterministic), so an
+interrupted fit resumes where it stopped.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from drill_sim_ros.fit.log import SurfaceLog
+from drill_sim_ros.fit.objective import Target
+from drill_sim_ros.fit.params import FitParameter, with_values
+from drill_sim_ros.model.errors import DrillSimError
+from drill_sim_ros.model.presets import preset_from_dict
+from drill_sim_ros.model.replay import replay_speed
+
+STARTS_PER_PARAMETER = 16
+JACOBIAN_STEP = 0.01          # in u (a share of each parameter's bounds)
+MAX_ITERATIONS = 40           # least squares' evaluations of the residuals (not the Jacobian's)
+TOLERANCE = 1e-4              # least squares' ftol and xtol
+PENALTY = 1e3                 # each residual of a vector the preset refuses (dynamic > static)
+SENSITIVITY_REPLAYS = 8       # replays with fresh speed noise (Evaluator.measure_sensitivity)
+CORRELATED = 0.95             # |correlation| above this: the log cannot tell the two apart
+Z95 = 0.975
+
+
+def simulate(data: dict[str, Any], values: dict[str, float], t_s: np.ndarray,
+             speed_rad_s: np.ndarray, speed_noise: tuple[int, float] | None = None
+             ) -> tuple[np.ndarray, np.ndarray] | str:
+    """One replay (a Dask task): the string torque at the top N m and the bit speed rad/s at
+    the log's times, or the one-line reason the preset with ``values`` is refused.
+    ``speed_noise`` (seed, std rad/s): white noise added to the speed it follows."""
+    if speed_noise is not None:
+        seed, std = speed_noise
+        speed_rad_s = speed_rad_s + std * np.random.default_rng(seed).standard_normal(
+            speed_rad_s.size)
+    try:
+        preset = preset_from_dict("fit", with_values(data, values))
+        run = replay_speed(preset, t_s, speed_rad_s)
+    except DrillSimError as exc:
+        return str(exc)
+    return run.surface_torque_nm, run.bit_rpm * (math.pi / 30.0)
+
+
+@dataclass(frozen=True)
+class Evaluation:
+    """A parameter vector's residuals over all start-ups (``refused``: why the preset refused
+    it, the residuals then ``PENALTY``)."""
+
+    x: np.ndarray
+    residuals: np.ndarray
+    refused: str | None = None
+
+    @property
+    def misfit(self) -> float:
+        """The residuals' root mean square."""
+        return float(np.sqrt(np.mean(self.residuals**2)))
+
+
+class Evaluator:
+    """Evaluations of parameter vectors over start-ups, cached and run on a Dask client
+    (None: in this process)."""
+
+    def __init__(self, data: dict[str, Any], params: Sequence[FitParameter],
+                 targets: Sequence[Target], client: Any = None, cache: Path | None = None,
+                 progress: Callable[[str], None] | None = None) -> None:
+        self.data, self.params, self.targets = data, list(params), list(targets)
+        self.client, self.cache, self.progress = client, cache, progress
+        self.done: dict[str, list[float] | str] = {}
+        self.computed = self.reused = 0
+        self.best = math.inf
+        self.started = time.perf_counter()
+        self._keys = [f"{s}#{self._segment_key(t.log)}" for s, t in enumerate(self.targets)]
+        self.sigma = [t.noise_sigma for t in self.targets]
+        if cache is not None and cache.exists():
+            self._load(cache)
+
+    # ---- cache ----------------------------------------------------------------------
+    def _segment_key(self, log: SurfaceLog) -> str:
+        h = hashlib.sha256(json.dumps(self.data, sort_keys=True, default=str).encode())
+        for array in (log.t_s, log.speed_rad_s, log.torque_nm):
+            h.update(np.ascontiguousarray(array, dtype=np.float64).tobytes())
+        h.update(",".join(p.path for p in self.params).encode())
+        return h.hexdigest()[:24]
+
+    def _key(self, segment: int, x: np.ndarray) -> str:
+        return f"{self._keys[segment]}:{','.join(repr(float(v)) for v in x)}"
+
+    def _load(self, path: Path) -> None:
+        for line in path.read_text().splitlines():
+            try:
+                row = json.loads(line)
+                self.done[row["key"]] = row["value"]
+            except (ValueError, KeyError, TypeError):
+                continue             # a line cut by an interruption
+
+    def _store(self, key: str, value: list[float] | str) -> None:
+        self.done[key] = value
+        if self.cache is not None:
+            with self.cache.open("a") as f:
+                f.write(json.dumps({"key": key, "value": value}) + "\n")
+
+    # ---- evaluating -----------------------------------------------------------------
+    def values_of(self, x: np.ndarray) -> dict[str, float]:
+        return {p.path: float(v) for p, v in zip(self.params, x, strict=True)}
+
+    def evaluate(self, xs: Sequence[np.ndarray]) -> list[Evaluation]:
+        """The evaluations of the vectors ``xs`` (parameter values), in parallel."""
+        jobs = [(i, s) for i in range(len(xs)) for s in range(len(self.targets))
+                if self._key(s, xs[i]) not in self.done]
+        self.reused += len(xs) * len(self.targets) - len(jobs)
+        self._run(xs, jobs)
+        return [self._evaluation(x) for x in xs]
+
+    def _run(self, xs: Sequence[np.ndarray], jobs: list[tuple[int, int]]) -> None:
+        if not jobs:
+            return
+        def args(job: tuple[int, int]) -> tuple[Any, ...]:
+            log = self.targets[job[1]].log
+            return self.data, self.values_of(xs[job[0]]), log.t_s, log.speed_rad_s
+        if self.client is None:
+            for job in jobs:
+                self._take(xs, job, simulate(*args(job)))
+            return
+        from distributed import as_completed
+        futures = {self.client.submit(simulate, *args(job), pure=False): job for job in jobs}
+        for future in as_completed(futures):
+            self._take(xs, futures[future], future.result())
+
+    def _take(self, xs: Sequence[np.ndarray], job: tuple[int, int],
+              result: tuple[np.ndarray, np.ndarray] | str) -> None:
+        x, segment = xs[job[0]], job[1]
+        if isinstance(result, str):
+            value: list[float] | str = result
+        else:
+            value = self.targets[segment].raw(*result).tolist()
+            self.best = min(self.best, self._residuals(segment, value).__pow__(2).mean() ** 0.5)
+        self.computed += 1
+        self._store(self._key(segment, x), value)
+        if self.progress is not None:
+            self.progress(f"fit: {self.computed} replays ({self.reused} from the cache), "
+                          f"{time.perf_counter() - self.started:6.1f} s, best start-up "
+                          f"misfit {self.best:.4g}")
+
+    def _evaluation(self, x: np.ndarray) -> Evaluation:
+        parts, refused = [], None
+        for s, target in enumerate(self.targets):
+            value = self.done[self._key(s, x)]
+            if isinstance(value, str):
+                refused = value
+                parts.append(np.full(_size(target), PENALTY))
+            else:
+                parts.append(self._residuals(s, value))
+        return Evaluation(np.asarray(x, dtype=float), np.concatenate(parts), refused)
+
+    def _residuals(self, segment: int, raw: list[float]) -> np.ndarray:
+        target = self.targets[segment]
+        return (np.asarray(raw) - target.logged) / self.sigma[segment]
+
+    def measure_sensitivity(self, x: np.ndarray) -> None:
+        """Add to each compared value's uncertainty the scatter of ``SENSITIVITY_REPLAYS``
+        replays at ``x`` that follow the logged speed with fresh noise of its own size
+        (fit.objective's module doc)."""
+        from drill_sim_ros.fit.objective import noise_std
+        keys, jobs = [], []
+        for s, target in enumerate(self.targets):
+            std = noise_std(target.log.speed_rad_s)
+            for r in range(SENSITIVITY_REPLAYS):
+                key = f"{self._key(s, x)}:speed-noise:{r}"
+                keys.append((s, key))
+                if key not in self.done:
+                    jobs.append((key, (self.data, self.values_of(x), target.log.t_s,
+                                       target.log.speed_rad_s, (r, std))))
+        for key, value in zip([k for k, _ in jobs], self._map([a for _, a in jobs]),
+                              strict=True):
+            self._store(key, value if isinstance(value, str)
+                        else self.targets[int(key.split("#")[0])].raw(*value).tolist())
+        for s, target in enumerate(self.targets):
+            raws = [self.done[key] for seg, key in keys if seg == s]
+            raws = np.array([r for r in raws if not isinstance(r, str)])
+            if raws.shape[0] >= 2:
+                scatter = np.std(raws, axis=0, ddof=1)
+                self.sigma[s] = np.sqrt(target.noise_sigma**2 + scatter**2)
+
+    def _map(self, arguments: list[tuple[Any, ...]]) -> list[Any]:
+        """:func:`simulate` over ``arguments``, in parallel on the client."""
+        if self.client is None:
+            return [simulate(*a) for a in arguments]
+        futures = [self.client.submit(simulate, *a, pure=False) for a in arguments]
+        return self.client.gather(futures)
+
+
+def _size(target: Target) -> int:
+    """The number of residuals of ``target`` (what a refused vector fills)."""
+    n = target.torque.transient.size + target.torque.used.size
+    if target.bit is not None:
+        n += target.bit.transient.size + target.bit.used.size
+    return n
+
+
+# ---- the fit --------------------------------------------------------------------------
+@dataclass(frozen=True)
+class FitResult:
+    """The fitted values, their 95 % intervals and correlations, the misfits before and
+    after, the optimiser's counts, and warnings (one line each)."""
+
+    params: tuple[FitParameter, ...]
+    x: np.ndarray
+    low95: np.ndarray
+    high95: np.ndarray
+    correlation: np.ndarray
+    misfit_before: float
+    misfit_after: float
+    evaluations: int
+    replays: int
+    reused: int
+    seconds: float
+    warnings: tuple[str, ...]
+
+
+def fit(evaluator: Evaluator, seed: int = 0) -> FitResult:
+    """Fit ``evaluator``'s parameters (module doc)."""
+    from scipy.optimize import least_squares
+    from scipy.stats import qmc
+    params = evaluator.params
+    low = np.array([p.low for p in params])
+    span = np.array([p.high for p in params]) - low
+    x0 = np.array([p.initial for p in params])
+
+    def x_of(u: np.ndarray) -> np.ndarray:
+        return low + span * np.clip(u, 0.0, 1.0)
+
+    starts = qmc.LatinHypercube(d=len(params), seed=seed).random(
+        STARTS_PER_PARAMETER * len(params))
+    first = evaluator.evaluate([x0, *[x_of(u) for u in starts]])
+    start = min(first, key=lambda e: e.misfit)
+    evaluator.measure_sensitivity(start.x)
+    before = evaluator.evaluate([x0])[0]
+    count = [len(first)]
+
+    def fun(u: np.ndarray) -> np.ndarray:
+        count[0] += 1
+        return evaluator.evaluate([x_of(u)])[0].residuals
+
+    def jac(u: np.ndarray) -> np.ndarray:
+        steps = [_step(u, i) for i in range(u.size)]
+        points = [x_of(u), *[x_of(u + h) for h in steps]]
+        evals = evaluator.evaluate(points)
+        count[0] += len(points) - 1
+        columns = [(e.residuals - evals[0].residuals) / h.sum()
+                   for e, h in zip(evals[1:], steps, strict=True)]
+        return np.column_stack(columns)
+
+    result = least_squares(fun, (start.x - low) / span, jac=jac, bounds=(0.0, 1.0),
+                           method="trf", ftol=TOLERANCE, xtol=TOLERANCE,
+                           max_nfev=MAX_ITERATIONS)
+    best = evaluator.evaluate([x_of(result.x)])[0]
+    jacobian = jac(result.x)
+    low95, high95, corr, warnings = _intervals(params, best, jacobian, span)
+    return FitResult(tuple(params), best.x, low95, high95, corr, before.misfit, best.misfit,
+                     count[0], evaluator.computed, evaluator.reused,
+                     time.perf_counter() - evaluator.started, tuple(warnings))
+
+
+def _step(u: np.ndarray, i: int) -> np.ndarray:
+    """The forward step of parameter ``i`` (backward at the upper bound)."""
+    h = np.zeros_like(u)
+    h[i] = JACOBIAN_STEP if u[i] + JACOBIAN_STEP <= 1.0 else -JACOBIAN_STEP
+    return h
+
+
+def _intervals(params: Sequence[FitParameter], best: Evaluation, jacobian: np.ndarray,
+               span: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[str]]:
+    """The 95 % intervals and correlations from the Jacobian (module doc), with warnings."""
+    from scipy.stats import t as student
+    m, n = jacobian.shape
+    dof = max(1, m - n)
+    s2 = max(1.0, float(np.sum(best.residuals**2)) / dof)
+    cov_u = s2 * np.linalg.pinv(jacobian.T @ jacobian)
+    cov = cov_u * np.outer(span, span)
+    sd = np.sqrt(np.maximum(np.diag(cov), 0.0))
+    half = student.ppf(Z95, dof) * sd
+    with np.errstate(invalid="ignore", divide="ignore"):
+        corr = cov / np.outer(sd, sd)
+    warnings = []
+    for i, p in enumerate(params):
+        if not np.any(jacobian[:, i]):
+            warnings.append(f"the log does not constrain {p.path} (the misfit does not move "
+                            "with it)")
+        for j in range(i + 1, n):
+            if abs(corr[i, j]) > CORRELATED:
+                warnings.append(f"the log cannot tell {p.path} and {params[j].path} apart "
+                                f"(correlation {corr[i, j]:+.3f}): fix one, or add a log "
+                                "that moves them differently")
+    if best.refused:
+        warnings.append(f"the preset refused the fitted values: {best.refused}")
+    return best.x - half, best.x + half, corr, warnings
