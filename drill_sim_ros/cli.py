@@ -24,7 +24,7 @@ from dataclasses import dataclass, fields, replace
 from pathlib import Path
 from typing import Any, TextIO
 
-from drill_sim_ros import closed_loop_cli, stability_cli, startup_cli, string_cli
+from drill_sim_ros import closed_loop_cli, fit_cli, stability_cli, startup_cli, string_cli
 from drill_sim_ros.archive.output import open_output
 from drill_sim_ros.model import analysis, telemetry
 from drill_sim_ros.model import kernel as k
@@ -146,6 +146,7 @@ def build_parser() -> argparse.ArgumentParser:
     string_cli.add_parsers(sub)
     stability_cli.add_parser(sub)
     startup_cli.add_parser(sub)
+    fit_cli.add_parser(sub)
     suite_cli.add_parser(sub)
     return parser
 
@@ -464,7 +465,8 @@ def main(argv: Sequence[str] | None = None) -> int:
                 "figures": study_cli.cmd_figures, "modes": string_cli.cmd_modes,
                 "reflection": string_cli.cmd_reflection,
                 "stability": stability_cli.cmd_stability,
-                "startup": startup_cli.cmd_startup}[args.command](args)
+                "startup": startup_cli.cmd_startup,
+                "fit": fit_cli.cmd_fit}[args.command](args)
     except DrillSimError as exc:
         print(f"drill_sim: error: {' '.join(str(exc).splitlines())}", file=sys.stderr)
         return 2

@@ -210,6 +210,15 @@ class Evaluator:
                 scatter = np.std(raws, axis=0, ddof=1)
                 self.sigma[s] = np.sqrt(target.noise_sigma**2 + scatter**2)
 
+    def map_runs(self, values: dict[str, float]) -> list[tuple[np.ndarray, np.ndarray]]:
+        """Each start-up replayed with ``values``: (string torque N m, bit speed rad/s)."""
+        runs = self._map([(self.data, values, t.log.t_s, t.log.speed_rad_s)
+                          for t in self.targets])
+        for run in runs:
+            if isinstance(run, str):
+                raise DrillSimError(f"the fitted values are refused: {run}")
+        return runs
+
     def _map(self, arguments: list[tuple[Any, ...]]) -> list[Any]:
         """:func:`simulate` over ``arguments``, in parallel on the client."""
         if self.client is None:

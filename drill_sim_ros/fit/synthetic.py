@@ -44,3 +44,12 @@ def synthetic_log(preset: Preset, rpm: float, ramp_s: float, seconds: float,
                       speed_rad_s=measured[:, 0], torque_nm=measured[:, 2],
                       torque_kind="string",
                       bit_speed_rad_s=None)
+
+
+def write_csv(log: SurfaceLog, path: str) -> None:
+    """``log`` as a CSV that ``drill_sim fit --log`` reads: time_s, surface_rpm and
+    string_torque_knm (or motor_torque_knm)."""
+    torque = f"{log.torque_kind}_torque_knm"
+    table = np.column_stack((log.t_s, log.speed_rad_s * RPM_PER_RAD_S, log.torque_nm / 1e3))
+    np.savetxt(path, table, delimiter=",", header=f"time_s,surface_rpm,{torque}",
+               comments="", fmt="%.6g")
