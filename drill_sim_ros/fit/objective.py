@@ -14,8 +14,8 @@ of a start-up has two parts, each residual divided by its own uncertainty:
    from the log's second differences: :func:`noise_std`). The winding up, the break-away
    and the first slip are deterministic: they are compared sample by sample.
 2. **The cycle, drift-free**, over the rest of the start-up: its period (the first peak of
-   the torque's autocorrelation, :func:`period_s`), mean, standard deviation and the 10, 25, 50, 75 and
-   90 % quantiles of the low-passed torque: none of them moves when the cycle drifts in
+   the torque's autocorrelation, :func:`period_s`), mean, standard deviation and the 10,
+   25, 50, 75 and 90 % quantiles of the low-passed torque: none of them moves when the cycle drifts in
    phase, which a stick-slip limit cycle does after a few periods (its slips are
    sensitive to the smallest difference). Each is divided by how much it scatters in the
    log: the feature over blocks of one period each, their standard deviation over the
@@ -49,7 +49,7 @@ from drill_sim_ros.model.string import analytic_modes_hz
 DROP_SHARE = 0.2          # the first slip: the torque this share of its range below its peak
 SLIP_MARGIN_S = 1.0       # the transient runs this long after the first slip
 QUANTILES = (0.10, 0.25, 0.50, 0.75, 0.90)
-FEATURES = ("period_s", "mean_nm", "std_nm") + tuple(f"q{round(100 * q)}_nm" for q in QUANTILES)
+FEATURES = ("period_s", "mean_nm", "std_nm", *tuple(f"q{round(100 * q)}_nm" for q in QUANTILES))
 LONE_BLOCK_SHARE = 0.05   # a feature's uncertainty when the log has under two cycles
 MIN_CYCLE_S = 1.0         # a cycle window shorter than this is not compared
 
