@@ -15,8 +15,8 @@ of a start-up has two parts, each residual divided by its own uncertainty:
    and the first slip are deterministic: they are compared sample by sample.
 2. **The cycle, drift-free**, over the rest of the start-up: its period (the first peak of
    the torque's autocorrelation, :func:`period_s`), mean, standard deviation and the 10,
-   25, 50, 75 and 90 % quantiles of the low-passed torque: none of them moves when the cycle drifts in
-   phase, which a stick-slip limit cycle does after a few periods (its slips are
+   25, 50, 75 and 90 % quantiles of the low-passed torque: none of them moves when the
+   cycle drifts in phase, which a stick-slip limit cycle does after a few periods (its slips are
    sensitive to the smallest difference). Each is divided by how much it scatters in the
    log: the feature over blocks of one period each, their standard deviation over the
    square root of their count (at least the noise's share; with fewer than two blocks,
