@@ -1,25 +1,30 @@
 """Fitting preset parameters to start-ups: replays on Dask, a cache, scipy's least squares.
 
-An *evaluation* replays one start-up with one parameter vector (:func:`simulate`, a Dask
-task, about as long as ``drill_sim startup`` takes) and turns it into the start-up's
-weighted residuals (:mod:`fit.objective`). The fit works in the parameters scaled to their
-bounds (u = (x - low) / (high - low), in [0, 1]):
+A *replay* runs one start-up with one parameter vector (:func:`simulate`, a Dask task,
+about as long as ``drill_sim startup`` takes). An *evaluation* of a parameter vector
+averages the compared values (:mod:`fit.objective`) of ``REPLAYS_PER_POINT`` replays of
+each start-up, each following the logged speed with white noise of the speed's own size
+added, seeded 0, 1, ... at every vector (common random numbers): a replay's first slip
+moves with the smallest change of the speed it follows, and the average over the same
+draws makes the misfit a smoother function of the parameters, which the optimiser's
+differences can follow. The misfit is the weighted residuals of that average. The fit works
+in the parameters scaled to their bounds (u = (x - low) / (high - low), in [0, 1]):
 
 1. a global start: the preset's values and ``STARTS_PER_PARAMETER`` x n points of a
-   seeded Latin hypercube over the bounds (scipy.stats.qmc), evaluated in parallel; the
-   best is the start of
-   the replay's sensitivity to the speed's noise is measured there
+   seeded Latin hypercube over the bounds (scipy.stats.qmc), evaluated in parallel; at the
+   best, the replay's sensitivity to the speed's noise is measured
    (:meth:`Evaluator.measure_sensitivity`, fit.objective) and joins the weights;
-2. ``scipy.optimize.least_squares`` (trust-region reflective, within the bounds), whose
-   Jacobian is forward differences of ``JACOBIAN_STEP`` in u, evaluated in parallel;
+2. ``scipy.optimize.least_squares`` (trust-region reflective, within the bounds) from
+   there, its Jacobian forward differences of ``JACOBIAN_STEP`` in u, evaluated in
+   parallel;
 3. the 95 % intervals from the Jacobian at the optimum: cov = s^2 (J^T J)^-1 with s^2 the
    residuals' mean square over their degrees of freedom (at least 1: a misfit within the
    noise does not shrink them), times Student's t; the correlations from the same matrix.
 
-Every evaluation is appended to a cache file (JSON lines keyed by a hash of the preset, the
-start-up's samples and the parameter vector); a fit started again with the same inputs
-reads them back instead of recomputing (the optimiser's path is deterministic), so an
-interrupted fit resumes where it stopped.
+Every replay is appended to a cache file as it finishes (JSON lines keyed by a hash of the
+preset, the start-up's samples and the parameter vector); a fit started again with the same
+inputs reads them back instead of recomputing (the optimiser's path is deterministic), so
+an interrupted fit resumes where it stopped.
 """
 
 from __future__ import annotations
@@ -36,7 +41,7 @@ from typing import Any
 import numpy as np
 
 from drill_sim_ros.fit.log import SurfaceLog
-from drill_sim_ros.fit.objective import Target
+from drill_sim_ros.fit.objective import Target, noise_std
 from drill_sim_ros.fit.params import FitParameter, with_values
 from drill_sim_ros.model.errors import DrillSimError
 from drill_sim_ros.model.presets import preset_from_dict
@@ -48,6 +53,8 @@ MAX_ITERATIONS = 40           # least squares' evaluations of the residuals (not
 TOLERANCE = 1e-4              # least squares' ftol and xtol
 PENALTY = 1e3                 # each residual of a vector the preset refuses (dynamic > static)
 SENSITIVITY_REPLAYS = 8       # replays with fresh speed noise (Evaluator.measure_sensitivity)
+SENSITIVITY_SEED = 1000       # their seeds from here (the averaged replays' from 0)
+REPLAYS_PER_POINT = 4         # replays averaged per parameter vector (common seeds)
 CORRELATED = 0.95             # |correlation| above this: the log cannot tell the two apart
 Z95 = 0.975
 
@@ -100,6 +107,7 @@ class Evaluator:
         self.started = time.perf_counter()
         self._keys = [f"{s}#{self._segment_key(t.log)}" for s, t in enumerate(self.targets)]
         self.sigma = [t.noise_sigma for t in self.targets]
+        self.speed_noise = [noise_std(t.log.speed_rad_s) for t in self.targets]
         if cache is not None and cache.exists():
             self._load(cache)
 
@@ -134,54 +142,52 @@ class Evaluator:
 
     def evaluate(self, xs: Sequence[np.ndarray]) -> list[Evaluation]:
         """The evaluations of the vectors ``xs`` (parameter values), in parallel."""
-        jobs = [(i, s) for i in range(len(xs)) for s in range(len(self.targets))
-                if self._key(s, xs[i]) not in self.done]
-        self.reused += len(xs) * len(self.targets) - len(jobs)
-        self._run(xs, jobs)
+        wanted = [(i, s, r) for i in range(len(xs)) for s in range(len(self.targets))
+                  for r in range(REPLAYS_PER_POINT)]
+        jobs = [job for job in wanted if self._job_key(xs, job) not in self.done]
+        self.reused += len(wanted) - len(jobs)
+        keys = [self._job_key(xs, job) for job in jobs]
+        self._map([self._args(xs, j) for j in jobs],
+                  lambda i, result: self._take(keys[i], jobs[i][1], result))
         return [self._evaluation(x) for x in xs]
 
-    def _run(self, xs: Sequence[np.ndarray], jobs: list[tuple[int, int]]) -> None:
-        if not jobs:
-            return
-        def args(job: tuple[int, int]) -> tuple[Any, ...]:
-            log = self.targets[job[1]].log
-            return self.data, self.values_of(xs[job[0]]), log.t_s, log.speed_rad_s
-        if self.client is None:
-            for job in jobs:
-                self._take(xs, job, simulate(*args(job)))
-            return
-        from distributed import as_completed
-        futures = {self.client.submit(simulate, *args(job), pure=False): job for job in jobs}
-        for future in as_completed(futures):
-            self._take(xs, futures[future], future.result())
+    def _job_key(self, xs: Sequence[np.ndarray], job: tuple[int, int, int]) -> str:
+        return f"{self._key(job[1], xs[job[0]])}:r{job[2]}"
 
-    def _take(self, xs: Sequence[np.ndarray], job: tuple[int, int],
-              result: tuple[np.ndarray, np.ndarray] | str) -> None:
-        x, segment = xs[job[0]], job[1]
-        if isinstance(result, str):
-            value: list[float] | str = result
-        else:
-            value = self.targets[segment].raw(*result).tolist()
-            self.best = min(self.best, self._residuals(segment, value).__pow__(2).mean() ** 0.5)
+    def _args(self, xs: Sequence[np.ndarray], job: tuple[int, int, int],
+              seed_offset: int = 0) -> tuple[Any, ...]:
+        """:func:`simulate`'s arguments: start-up ``job[1]`` at ``xs[job[0]]``, the logged
+        speed with noise of its own size seeded ``job[2] + seed_offset``."""
+        log = self.targets[job[1]].log
+        return (self.data, self.values_of(xs[job[0]]), log.t_s, log.speed_rad_s,
+                (job[2] + seed_offset, self.speed_noise[job[1]]))
+
+    def _take(self, key: str, segment: int, result: tuple[np.ndarray, np.ndarray] | str
+              ) -> None:
+        value = result if isinstance(result, str) else \
+            self.targets[segment].raw(*result).tolist()
         self.computed += 1
-        self._store(self._key(segment, x), value)
+        self._store(key, value)
         if self.progress is not None:
             self.progress(f"fit: {self.computed} replays ({self.reused} from the cache), "
-                          f"{time.perf_counter() - self.started:6.1f} s, best start-up "
-                          f"misfit {self.best:.4g}")
+                          f"{time.perf_counter() - self.started:6.1f} s, best misfit "
+                          f"{self.best:.4g}")
 
     def _evaluation(self, x: np.ndarray) -> Evaluation:
         parts, refused = [], None
         for s, target in enumerate(self.targets):
-            value = self.done[self._key(s, x)]
-            if isinstance(value, str):
-                refused = value
+            raws = [self.done[f"{self._key(s, x)}:r{r}"] for r in range(REPLAYS_PER_POINT)]
+            bad = [r for r in raws if isinstance(r, str)]
+            if bad:
+                refused = bad[0]
                 parts.append(np.full(_size(target), PENALTY))
             else:
-                parts.append(self._residuals(s, value))
-        return Evaluation(np.asarray(x, dtype=float), np.concatenate(parts), refused)
+                parts.append(self._residuals(s, np.mean(np.array(raws), axis=0)))
+        evaluation = Evaluation(np.asarray(x, dtype=float), np.concatenate(parts), refused)
+        self.best = min(self.best, evaluation.misfit)
+        return evaluation
 
-    def _residuals(self, segment: int, raw: list[float]) -> np.ndarray:
+    def _residuals(self, segment: int, raw: np.ndarray) -> np.ndarray:
         target = self.targets[segment]
         return (np.asarray(raw) - target.logged) / self.sigma[segment]
 
@@ -189,25 +195,16 @@ class Evaluator:
         """Add to each compared value's uncertainty the scatter of ``SENSITIVITY_REPLAYS``
         replays at ``x`` that follow the logged speed with fresh noise of its own size
         (fit.objective's module doc)."""
-        from drill_sim_ros.fit.objective import noise_std
-        keys, jobs = [], []
+        jobs = [(0, s, r) for s in range(len(self.targets)) for r in range(SENSITIVITY_REPLAYS)]
+        keys = [f"{self._key(s, x)}:sensitivity{r}" for _, s, r in jobs]
+        todo = [(key, job) for key, job in zip(keys, jobs, strict=True) if key not in self.done]
+        self._map([self._args([x], job, SENSITIVITY_SEED) for _, job in todo],
+                  lambda i, result: self._take(todo[i][0], todo[i][1][1], result))
         for s, target in enumerate(self.targets):
-            std = noise_std(target.log.speed_rad_s)
-            for r in range(SENSITIVITY_REPLAYS):
-                key = f"{self._key(s, x)}:speed-noise:{r}"
-                keys.append((s, key))
-                if key not in self.done:
-                    jobs.append((key, (self.data, self.values_of(x), target.log.t_s,
-                                       target.log.speed_rad_s, (r, std))))
-        for key, value in zip([k for k, _ in jobs], self._map([a for _, a in jobs]),
-                              strict=True):
-            self._store(key, value if isinstance(value, str)
-                        else self.targets[int(key.split("#")[0])].raw(*value).tolist())
-        for s, target in enumerate(self.targets):
-            raws = [self.done[key] for seg, key in keys if seg == s]
-            raws = np.array([r for r in raws if not isinstance(r, str)])
-            if raws.shape[0] >= 2:
-                scatter = np.std(raws, axis=0, ddof=1)
+            raws = [self.done[key] for key, job in zip(keys, jobs, strict=True) if job[1] == s]
+            raws = [r for r in raws if not isinstance(r, str)]
+            if len(raws) >= 2:
+                scatter = np.std(np.array(raws), axis=0, ddof=1)
                 self.sigma[s] = np.sqrt(target.noise_sigma**2 + scatter**2)
 
     def map_runs(self, values: dict[str, float]) -> list[tuple[np.ndarray, np.ndarray]]:
@@ -219,17 +216,31 @@ class Evaluator:
                 raise DrillSimError(f"the fitted values are refused: {run}")
         return runs
 
-    def _map(self, arguments: list[tuple[Any, ...]]) -> list[Any]:
-        """:func:`simulate` over ``arguments``, in parallel on the client."""
+    def _map(self, arguments: list[tuple[Any, ...]],
+             on_result: Callable[[int, Any], None] | None = None) -> list[Any]:
+        """:func:`simulate` over ``arguments``, in parallel on the client (None: here);
+        ``on_result(index, result)`` as each finishes (what the cache is written from)."""
+        results: list[Any] = [None] * len(arguments)
+
+        def take(index: int, result: Any) -> None:
+            results[index] = result
+            if on_result is not None:
+                on_result(index, result)
         if self.client is None:
-            return [simulate(*a) for a in arguments]
-        futures = [self.client.submit(simulate, *a, pure=False) for a in arguments]
-        return self.client.gather(futures)
+            for i, a in enumerate(arguments):
+                take(i, simulate(*a))
+            return results
+        from distributed import as_completed
+        futures = {self.client.submit(simulate, *a, pure=False): i
+                   for i, a in enumerate(arguments)}
+        for future in as_completed(futures):
+            take(futures[future], future.result())
+        return results
 
 
 def _size(target: Target) -> int:
     """The number of residuals of ``target`` (what a refused vector fills)."""
-    n = target.torque.transient.size + target.torque.used.size
+    n = target.torque.transient.size + target.torque.used.size + target.breakaway.size
     if target.bit is not None:
         n += target.bit.transient.size + target.bit.used.size
     return n

@@ -7,20 +7,21 @@ torque sub's string torque as simulated, or the motor torque as the string torqu
 drive's inertia times the logged speed's (low-passed) rate of change. The residual vector
 of a start-up has two parts, each residual divided by its own uncertainty:
 
-1. **The transient, in time**: from the start to ``SLIP_MARGIN_S`` after the first slip
-   seen at the surface (the low-passed logged torque first falls more than ``DROP_SHARE``
-   of its peak below its running maximum), at the cut-off's Nyquist rate (every
+1. **The transient, in time**: from the start to the first slip seen at the surface (the
+   low-passed logged torque first falls more than ``DROP_SHARE`` of its range below its
+   running maximum, :func:`first_slip_index`), at the cut-off's Nyquist rate (every
    1 / (2 f_c) s), divided by the logged torque's noise there, sigma sqrt(2 f_c dt) (sigma
-   from the log's second differences: :func:`noise_std`). The winding up, the break-away
-   and the first slip are deterministic: they are compared sample by sample.
-2. **The cycle, drift-free**, over the rest of the start-up: its period (the first peak of
-   the torque's autocorrelation, :func:`period_s`), mean, standard deviation and the 10,
-   25, 50, 75 and 90 % quantiles of the low-passed torque: none of them moves when the
-   cycle drifts in phase, which a stick-slip limit cycle does after a few periods (its slips are
-   sensitive to the smallest difference). Each is divided by how much it scatters in the
-   log: the feature over blocks of one period each, their standard deviation over the
-   square root of their count (at least the noise's share; with fewer than two blocks,
-   ``LONE_BLOCK_SHARE`` of the feature's scale).
+   from the log's second differences: :func:`noise_std`): the winding up, sample by
+   sample; then the break-away: the first slip's time (uncertainty: a sample) and the peak
+   torque before it (the torque's noise).
+2. **The cycle, drift-free**, from ``SLIP_MARGIN_S`` after the first slip to the end: its
+   period (the first peak of the torque's autocorrelation, :func:`period_s`), mean,
+   standard deviation and the 10, 25, 50, 75 and 90 % quantiles of the low-passed torque:
+   none of them moves when the cycle drifts in phase, which a stick-slip limit cycle does
+   after a few periods (its slips are sensitive to the smallest difference). Each is
+   divided by how much it scatters in the log: the feature over blocks of one period each,
+   their standard deviation over the square root of their count (at least the noise's
+   share; with fewer than two blocks, ``LONE_BLOCK_SHARE`` of the feature's scale).
 
 The log's noise is not all the uncertainty: the replay follows the *logged* speed, noise
 and all, and the wall's junctions let go at times that are sensitive to it, so a replay with
@@ -131,12 +132,13 @@ class Target:
     drive_inertia_kg_m2: float
     torque: Part
     bit: Part | None
+    breakaway: np.ndarray          # the logged first slip's time s and peak torque N m
+    breakaway_sigma: np.ndarray
 
     @property
     def first_slip_s(self) -> float:
-        """The end of the transient (the first slip plus its margin), s from the start."""
-        t = self.log.t_s
-        return float(t[self.torque.cycle.start - 1] - t[0]) if self.torque.cycle.start else 0.0
+        """The end of the transient (the logged first slip), s from the start."""
+        return float(self.breakaway[0])
 
     def model_torque(self, string_torque_nm: np.ndarray) -> np.ndarray:
         """The simulated counterpart of the logged torque, low-passed (module doc)."""
@@ -151,7 +153,9 @@ class Target:
             bit_speed_rad_s: np.ndarray | None = None) -> np.ndarray:
         """What a replay gives for the compared values (the transient's samples, the cycle's
         features; torque, then bit speed), unweighted, shape (n_residuals,)."""
-        out = [_part_raw(self.torque, self.model_torque(string_torque_nm), self.log.sample_s)]
+        torque = self.model_torque(string_torque_nm)
+        out = [_part_raw(self.torque, torque, self.log.sample_s),
+               breakaway_features(torque, self.log.sample_s)]
         if self.bit is not None and bit_speed_rad_s is not None:
             out.append(_part_raw(self.bit, lowpass(bit_speed_rad_s, self.log.sample_s,
                                                     self.cutoff_hz), self.log.sample_s))
@@ -160,15 +164,15 @@ class Target:
     @property
     def logged(self) -> np.ndarray:
         """The logged counterpart of :meth:`raw`."""
-        return np.concatenate([np.concatenate((p.logged_transient, p.features[p.used]))
-                               for p in self.parts])
+        parts = [np.concatenate((p.logged_transient, p.features[p.used])) for p in self.parts]
+        return np.concatenate([parts[0], self.breakaway, *parts[1:]])
 
     @property
     def noise_sigma(self) -> np.ndarray:
         """The log's own uncertainty of each compared value (module doc)."""
-        return np.concatenate([np.concatenate((np.full(p.transient.size, p.transient_sigma),
-                                               p.feature_sigma[p.used]))
-                               for p in self.parts])
+        parts = [np.concatenate((np.full(p.transient.size, p.transient_sigma),
+                                 p.feature_sigma[p.used])) for p in self.parts]
+        return np.concatenate([parts[0], self.breakaway_sigma, *parts[1:]])
 
     @property
     def parts(self) -> list[Part]:
@@ -187,23 +191,33 @@ def make_target(log: SurfaceLog, preset: Preset) -> Target:
     dt = log.sample_s
     fc = min(cutoff_hz(preset), 0.5 / dt)
     torque_lp = lowpass(log.torque_nm, dt, fc)
+    n = log.t_s.size
     slip = first_slip_index(torque_lp)
-    end = log.t_s.size if slip is None else min(log.t_s.size,
-                                                slip + round(SLIP_MARGIN_S / dt))
+    ends = (n, n) if slip is None else (slip, min(n, slip + round(SLIP_MARGIN_S / dt)))
     every = max(1, math.floor(0.5 / (fc * dt)))
     lp_share = min(1.0, math.sqrt(2.0 * fc * dt))
-    torque = _part(log.torque_nm, torque_lp, end, every, lp_share, dt, FEATURES)
+    torque = _part(log.torque_nm, torque_lp, ends, every, lp_share, dt, FEATURES)
     bit = None
     if log.bit_speed_rad_s is not None:
-        bit = _part(log.bit_speed_rad_s, lowpass(log.bit_speed_rad_s, dt, fc), end, every,
+        bit = _part(log.bit_speed_rad_s, lowpass(log.bit_speed_rad_s, dt, fc), ends, every,
                     lp_share, dt, ("mean_nm", "std_nm"))
     return Target(log=log, cutoff_hz=fc, drive_inertia_kg_m2=preset.drive.inertia_kg_m2,
-                  torque=torque, bit=bit)
+                  torque=torque, bit=bit, breakaway=breakaway_features(torque_lp, dt),
+                  breakaway_sigma=np.array([dt, torque.transient_sigma]))
 
 
-def _part(raw: np.ndarray, lp: np.ndarray, end: int, every: int, lp_share: float,
-          sample_s: float, names: tuple[str, ...]) -> Part:
-    transient = np.arange(0, end, every)
+def breakaway_features(torque_lp: np.ndarray, sample_s: float) -> np.ndarray:
+    """The first slip's time from the start, s, and the peak torque before it, N m
+    (:func:`first_slip_index`; never: the record's length and its maximum)."""
+    slip = first_slip_index(torque_lp)
+    end = torque_lp.size if slip is None else slip
+    return np.array([end * sample_s, float(np.max(torque_lp[:max(1, end)]))])
+
+
+def _part(raw: np.ndarray, lp: np.ndarray, ends: tuple[int, int], every: int,
+          lp_share: float, sample_s: float, names: tuple[str, ...]) -> Part:
+    """The transient up to ``ends[0]``, the cycle from ``ends[1]`` (module doc)."""
+    transient, end = np.arange(0, ends[0], every), ends[1]
     noise = max(noise_std(raw) * lp_share, 1e-9 * max(1.0, float(np.max(np.abs(lp)))))
     cycle = slice(end, lp.size)
     if (lp.size - end) * sample_s < MIN_CYCLE_S:
