@@ -25,7 +25,13 @@ from drill_sim_ros.fit.params import DEFAULT_BOUNDS, parse_fit, with_values
 from drill_sim_ros.model.errors import DrillSimError
 from drill_sim_ros.model.presets import preset_from_dict, preset_path
 from drill_sim_ros.model.validate_input import read_preset_file
-from drill_sim_ros.plot_file import add_plot_arguments, commit_plot, plot_into
+from drill_sim_ros.plot_file import (
+    add_plot_arguments,
+    commit_output,
+    commit_plot,
+    output_into,
+    plot_into,
+)
 from drill_sim_ros.terminal import StatusLine
 
 
@@ -47,7 +53,8 @@ def add_parser(sub: Any) -> None:
                    "the log has both (default: the torque sub's string torque)")
     p.add_argument("--each", action="store_true", help="fit each start-up on its own and "
                    "report the spread (default: all jointly)")
-    p.add_argument("--out", type=Path, help="write the preset with the fitted values here")
+    p.add_argument("--out", type=Path, help="write the preset with the fitted values here "
+                   "(.yaml; with --each their mean over the start-ups)")
     p.add_argument("--cache", type=Path, help="the evaluations' cache (default: beside "
                    "--out as OUT.fit-cache.jsonl; none without --out): a fit run again "
                    "resumes from it")
@@ -80,17 +87,19 @@ def cmd_fit(args: Any) -> int:
     segments = [log.part(a, b) for a, b in find_startups(log)]
     targets = [make_target(seg, preset) for seg in segments]
     cache = args.cache or (args.out.with_suffix(".fit-cache.jsonl") if args.out else None)
-    with plot_into(args.plot, args.overwrite) as plot_tmp:
+    with plot_into(args.plot, args.overwrite) as plot_tmp, \
+            output_into(args.out, args.overwrite, "--out", (".yaml", ".yml")) as out_tmp:
         report = _run(args, data, params, targets, cache)
+        results = report.pop("_results")
         if plot_tmp is not None:
             from drill_sim_ros.fit.plot import plot_fit
-            plot_fit(plot_tmp, data, params, targets, report["_results"])
+            plot_fit(plot_tmp, data, params, targets, results)
             commit_plot(plot_tmp, args.plot, args.overwrite)
             print(f"wrote {args.plot}", file=sys.stderr)
-    results = report.pop("_results")
-    if args.out is not None:
-        _write_preset(args.out, data, results[0] if not args.each else None, report, args)
-        print(f"wrote {args.out}", file=sys.stderr)
+        if out_tmp is not None:
+            _write_preset(out_tmp, data, report, args)
+            commit_output(out_tmp, args.out, args.overwrite, "--out")
+            print(f"wrote {args.out}", file=sys.stderr)
     if not args.json:
         print(_summary(report))
     print(json.dumps(report))
@@ -201,13 +210,12 @@ def _summary(report: dict[str, Any]) -> str:
     return "\n".join(lines)
 
 
-def _write_preset(out: Path, data: dict[str, Any], result: Any, report: dict[str, Any],
-                  args: Any) -> None:
-    if result is None:
-        values = {p: s["mean"] for p, s in report.get("spread", {}).items()} or \
-            {p: v["value"] for p, v in report["fits"][0]["values"].items()}
-    else:
-        values = {p: v["value"] for p, v in report["fits"][0]["values"].items()}
+def _write_preset(out: Path, data: dict[str, Any], report: dict[str, Any], args: Any
+                  ) -> None:
+    """The preset with the fitted values (with --each: their mean over the start-ups) and
+    a comment naming the log, the date and the intervals."""
+    values = {p: s["mean"] for p, s in report.get("spread", {}).items()} or \
+        {p: v["value"] for p, v in report["fits"][0]["values"].items()}
     fitted = with_values(data, values)
     fitted["description"] = (str(data.get("description", "")).strip() +
                              f" Calibrated by drill_sim fit to {args.log}.")

@@ -19,7 +19,12 @@ in the parameters scaled to their bounds (u = (x - low) / (high - low), in [0, 1
    parallel;
 3. the 95 % intervals from the Jacobian at the optimum: cov = s^2 (J^T J)^-1 with s^2 the
    residuals' mean square over their degrees of freedom (at least 1: a misfit within the
-   noise does not shrink them), times Student's t; the correlations from the same matrix.
+   noise does not shrink them), plus the covariance of the shifts J^+ dr_k that the
+   sensitivity replays' deviations dr_k from their mean would make (the residuals of one
+   log are correlated, the slips moving many samples together, which the first term
+   ignores), times 1 + 1 / ``REPLAYS_PER_POINT`` (the averaged replays' own scatter);
+   Student's t with the replays' degrees of freedom; the correlations from the same
+   matrix.
 
 Every replay is appended to a cache file as it finishes (JSON lines keyed by a hash of the
 preset, the start-up's samples and the parameter vector); a fit started again with the same
@@ -108,6 +113,7 @@ class Evaluator:
         self._keys = [f"{s}#{self._segment_key(t.log)}" for s, t in enumerate(self.targets)]
         self.sigma = [t.noise_sigma for t in self.targets]
         self.speed_noise = [noise_std(t.log.speed_rad_s) for t in self.targets]
+        self.sensitivity: list[np.ndarray | None] = [None] * len(self.targets)
         if cache is not None and cache.exists():
             self._load(cache)
 
@@ -204,8 +210,18 @@ class Evaluator:
             raws = [self.done[key] for key, job in zip(keys, jobs, strict=True) if job[1] == s]
             raws = [r for r in raws if not isinstance(r, str)]
             if len(raws) >= 2:
+                self.sensitivity[s] = np.array(raws)
                 scatter = np.std(np.array(raws), axis=0, ddof=1)
                 self.sigma[s] = np.sqrt(target.noise_sigma**2 + scatter**2)
+
+    def sensitivity_scatter(self) -> np.ndarray:
+        """The sensitivity replays' deviations from their mean over the weights, each row a
+        replay, the start-ups' residuals side by side: how far the compared values of one
+        log stray from the replays' expectation (empty when not measured)."""
+        if any(raws is None for raws in self.sensitivity):
+            return np.zeros((0, 0))
+        return np.hstack([(raws - raws.mean(axis=0)) / sigma
+                          for raws, sigma in zip(self.sensitivity, self.sigma, strict=True)])
 
     def map_runs(self, values: dict[str, float]) -> list[tuple[np.ndarray, np.ndarray]]:
         """Each start-up replayed with ``values``: (string torque N m, bit speed rad/s)."""
@@ -280,10 +296,10 @@ def fit(evaluator: Evaluator, seed: int = 0) -> FitResult:
 
     starts = qmc.LatinHypercube(d=len(params), seed=seed).random(
         STARTS_PER_PARAMETER * len(params))
-    first = evaluator.evaluate([x0, *[x_of(u) for u in starts]])
+    points = [x0, *[x_of(u) for u in starts]]
+    evaluator.measure_sensitivity(min(evaluator.evaluate(points), key=lambda e: e.misfit).x)
+    first = evaluator.evaluate(points)                  # weighted anew (from the cache)
     start = min(first, key=lambda e: e.misfit)
-    evaluator.measure_sensitivity(start.x)
-    before = evaluator.evaluate([x0])[0]
     count = [len(first)]
 
     def fun(u: np.ndarray) -> np.ndarray:
@@ -302,10 +318,12 @@ def fit(evaluator: Evaluator, seed: int = 0) -> FitResult:
     result = least_squares(fun, (start.x - low) / span, jac=jac, bounds=(0.0, 1.0),
                            method="trf", ftol=TOLERANCE, xtol=TOLERANCE,
                            max_nfev=MAX_ITERATIONS)
-    best = evaluator.evaluate([x_of(result.x)])[0]
+    best = min(evaluator.evaluate([x_of(result.x)])[0], start, key=lambda e: e.misfit)
+    result.x = (best.x - low) / span
     jacobian = jac(result.x)
-    low95, high95, corr, warnings = _intervals(params, best, jacobian, span)
-    return FitResult(tuple(params), best.x, low95, high95, corr, before.misfit, best.misfit,
+    low95, high95, corr, warnings = _intervals(params, best, jacobian, span,
+                                               evaluator.sensitivity_scatter())
+    return FitResult(tuple(params), best.x, low95, high95, corr, first[0].misfit, best.misfit,
                      count[0], evaluator.computed, evaluator.reused,
                      time.perf_counter() - evaluator.started, tuple(warnings))
 
@@ -318,13 +336,21 @@ def _step(u: np.ndarray, i: int) -> np.ndarray:
 
 
 def _intervals(params: Sequence[FitParameter], best: Evaluation, jacobian: np.ndarray,
-               span: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[str]]:
-    """The 95 % intervals and correlations from the Jacobian (module doc), with warnings."""
+               span: np.ndarray, scatter: np.ndarray
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[str]]:
+    """The 95 % intervals and correlations from the Jacobian (module doc), with warnings;
+    ``scatter`` (replays, residuals): the sensitivity replays' weighted deviations from
+    their mean (:meth:`Evaluator.sensitivity_scatter`)."""
     from scipy.stats import t as student
     m, n = jacobian.shape
     dof = max(1, m - n)
     s2 = max(1.0, float(np.sum(best.residuals**2)) / dof)
     cov_u = s2 * np.linalg.pinv(jacobian.T @ jacobian)
+    if scatter.shape[0] >= 2:                 # the replays' own scatter, carried through
+        shifts = scatter @ np.linalg.pinv(jacobian).T     # (replays, n): du of each
+        cov_u = cov_u + (1.0 + 1.0 / REPLAYS_PER_POINT) * np.cov(shifts, rowvar=False,
+                                                                  ddof=1).reshape(n, n)
+        dof = min(dof, scatter.shape[0] - 1)
     cov = cov_u * np.outer(span, span)
     sd = np.sqrt(np.maximum(np.diag(cov), 0.0))
     half = student.ppf(Z95, dof) * sd

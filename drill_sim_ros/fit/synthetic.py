@@ -11,7 +11,7 @@ from drill_sim_ros.control.scenario import load_scenario, scenario_path
 from drill_sim_ros.fit.log import SurfaceLog
 from drill_sim_ros.model.measurement import SIGNALS, RigSensors, SignalSpec
 from drill_sim_ros.model.presets import Preset
-from drill_sim_ros.model.startup import RPM_PER_RAD_S, run_startup
+from drill_sim_ros.model.startup import RPM_PER_RAD_S, StartupRun, run_startup
 
 SENSOR_SCENARIO = "noisy_delayed_sensors"
 
@@ -28,8 +28,16 @@ def scenario_sensors(seed: int, scenario: str = SENSOR_SCENARIO) -> RigSensors:
 def synthetic_log(preset: Preset, rpm: float, ramp_s: float, seconds: float,
                   sensors: RigSensors, rest_s: float = 1.0) -> SurfaceLog:
     """A start-up of ``preset`` at rest for ``rest_s`` then ramped to ``rpm`` in ``ramp_s``,
-    ``seconds`` long in all, as ``sensors`` measure it (string torque kind)."""
-    run = run_startup(preset, rpm, ramp_s, seconds - rest_s)
+    ``seconds`` long in all, as ``sensors`` measure it (:func:`measured_log`)."""
+    return measured_log(run_startup(preset, rpm, ramp_s, seconds - rest_s), sensors, rest_s,
+                        f"synthetic start-up of {preset.name}")
+
+
+def measured_log(run: StartupRun, sensors: RigSensors, rest_s: float, source: str
+                 ) -> SurfaceLog:
+    """The start-up ``run`` (from rest at t = 0) after ``rest_s`` at rest (the samples of
+    t = 0 repeated: the string still, untwisted), its drive speed, motor, string torque
+    measured by ``sensors``; the torque of the log is the string torque (a torque sub)."""
     dt = float(np.median(np.diff(run.t_s)))
     lead = max(1, round(rest_s / dt))
     t_s = np.concatenate((np.arange(lead) * dt, run.t_s + lead * dt))
@@ -40,10 +48,8 @@ def synthetic_log(preset: Preset, rpm: float, ramp_s: float, seconds: float,
                              rest_then(run.motor_torque_nm),
                              rest_then(run.surface_torque_nm), np.zeros(t_s.size)))
     measured = sensors.measure(truth)
-    return SurfaceLog(source=f"synthetic start-up of {preset.name}", t_s=t_s,
-                      speed_rad_s=measured[:, 0], torque_nm=measured[:, 2],
-                      torque_kind="string",
-                      bit_speed_rad_s=None)
+    return SurfaceLog(source=source, t_s=t_s, speed_rad_s=measured[:, 0],
+                      torque_nm=measured[:, 2], torque_kind="string")
 
 
 def write_csv(log: SurfaceLog, path: str) -> None:
