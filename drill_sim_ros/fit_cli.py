@@ -150,7 +150,7 @@ def _report(args: Any, params: list, targets: list[Target], groups: list[list[Ta
         for target, run in zip(group, runs, strict=True):
             logged = _logged_lp(target)
             cycles.append({"start_s": float(target.log.t_s[0]),
-                           "first_slip_s": target.first_slip_s,
+                           "first_slip_s": (target.first_slip_s or 0.0),
                            "recorded": _cycle(target, logged),
                            "fitted": _cycle(target, target.model_torque(run[0]))})
         fits.append({

@@ -12,11 +12,13 @@ in the parameters scaled to their bounds (u = (x - low) / (high - low), in [0, 1
 
 1. a global start: the preset's values and ``STARTS_PER_PARAMETER`` x n points of a
    seeded Latin hypercube over the bounds (scipy.stats.qmc), evaluated in parallel; at the
-   best, the replay's sensitivity to the speed's noise is measured
-   (:meth:`Evaluator.measure_sensitivity`, fit.objective) and joins the weights;
-2. ``scipy.optimize.least_squares`` (trust-region reflective, within the bounds) from
-   there, its Jacobian forward differences of ``JACOBIAN_STEP`` in u, evaluated in
-   parallel;
+   preset's values and at the best, the replay's sensitivity to the speed's noise is
+   measured (:meth:`Evaluator.measure_sensitivity`, fit.objective) and joins the weights;
+2. ``scipy.optimize.least_squares`` (trust-region reflective, within the bounds) from each
+   of the ``LOCAL_STARTS`` best, its Jacobian forward differences of ``JACOBIAN_STEP`` in
+   u, evaluated in parallel; the sensitivity measured again at the best optimum (it
+   depends on the parameters: the weights keep the largest scatter seen), and least
+   squares again from the best point so far under those weights (``PASSES`` in all);
 3. the 95 % intervals from the Jacobian at the optimum: cov = s^2 (J^T J)^-1 with s^2 the
    residuals' mean square over their degrees of freedom (at least 1: a misfit within the
    noise does not shrink them), plus the covariance of the shifts J^+ dr_k that the
@@ -60,6 +62,8 @@ PENALTY = 1e3                 # each residual of a vector the preset refuses (dy
 SENSITIVITY_REPLAYS = 8       # replays with fresh speed noise (Evaluator.measure_sensitivity)
 SENSITIVITY_SEED = 1000       # their seeds from here (the averaged replays' from 0)
 REPLAYS_PER_POINT = 4         # replays averaged per parameter vector (common seeds)
+PASSES = 2                    # least-squares passes, the weights measured anew after each
+LOCAL_STARTS = 3              # the first pass starts from the best this many points
 CORRELATED = 0.95             # |correlation| above this: the log cannot tell the two apart
 Z95 = 0.975
 
@@ -200,7 +204,8 @@ class Evaluator:
     def measure_sensitivity(self, x: np.ndarray) -> None:
         """Add to each compared value's uncertainty the scatter of ``SENSITIVITY_REPLAYS``
         replays at ``x`` that follow the logged speed with fresh noise of its own size
-        (fit.objective's module doc)."""
+        (fit.objective's module doc); measured at several points, the largest holds (the
+        scatter depends on the parameters)."""
         jobs = [(0, s, r) for s in range(len(self.targets)) for r in range(SENSITIVITY_REPLAYS)]
         keys = [f"{self._key(s, x)}:sensitivity{r}" for _, s, r in jobs]
         todo = [(key, job) for key, job in zip(keys, jobs, strict=True) if key not in self.done]
@@ -212,7 +217,8 @@ class Evaluator:
             if len(raws) >= 2:
                 self.sensitivity[s] = np.array(raws)
                 scatter = np.std(np.array(raws), axis=0, ddof=1)
-                self.sigma[s] = np.sqrt(target.noise_sigma**2 + scatter**2)
+                self.sigma[s] = np.sqrt(np.maximum(self.sigma[s]**2,
+                                                   target.noise_sigma**2 + scatter**2))
 
     def sensitivity_scatter(self) -> np.ndarray:
         """The sensitivity replays' deviations from their mean over the weights, each row a
@@ -297,10 +303,9 @@ def fit(evaluator: Evaluator, seed: int = 0) -> FitResult:
     starts = qmc.LatinHypercube(d=len(params), seed=seed).random(
         STARTS_PER_PARAMETER * len(params))
     points = [x0, *[x_of(u) for u in starts]]
+    evaluator.measure_sensitivity(x0)
     evaluator.measure_sensitivity(min(evaluator.evaluate(points), key=lambda e: e.misfit).x)
-    first = evaluator.evaluate(points)                  # weighted anew (from the cache)
-    start = min(first, key=lambda e: e.misfit)
-    count = [len(first)]
+    count = [len(points)]
 
     def fun(u: np.ndarray) -> np.ndarray:
         count[0] += 1
@@ -315,15 +320,23 @@ def fit(evaluator: Evaluator, seed: int = 0) -> FitResult:
                    for e, h in zip(evals[1:], steps, strict=True)]
         return np.column_stack(columns)
 
-    result = least_squares(fun, (start.x - low) / span, jac=jac, bounds=(0.0, 1.0),
-                           method="trf", ftol=TOLERANCE, xtol=TOLERANCE,
-                           max_nfev=MAX_ITERATIONS)
-    best = min(evaluator.evaluate([x_of(result.x)])[0], start, key=lambda e: e.misfit)
-    result.x = (best.x - low) / span
-    jacobian = jac(result.x)
+    for starts_now in (LOCAL_STARTS, *[1] * (PASSES - 1)):
+        tried = sorted(evaluator.evaluate(points), key=lambda e: e.misfit)  # weighted anew
+        ends = []
+        for start in tried[:starts_now]:
+            result = least_squares(fun, (start.x - low) / span, jac=jac, bounds=(0.0, 1.0),
+                                   method="trf", ftol=TOLERANCE, xtol=TOLERANCE,
+                                   max_nfev=MAX_ITERATIONS)
+            ends.append(evaluator.evaluate([x_of(result.x)])[0])
+        best = min([*ends, tried[0]], key=lambda e: e.misfit)
+        evaluator.measure_sensitivity(best.x)
+        points += [e.x for e in ends]
+    best = min(evaluator.evaluate(points), key=lambda e: e.misfit)
+    before = evaluator.evaluate([x0])[0]
+    jacobian = jac((best.x - low) / span)
     low95, high95, corr, warnings = _intervals(params, best, jacobian, span,
                                                evaluator.sensitivity_scatter())
-    return FitResult(tuple(params), best.x, low95, high95, corr, first[0].misfit, best.misfit,
+    return FitResult(tuple(params), best.x, low95, high95, corr, before.misfit, best.misfit,
                      count[0], evaluator.computed, evaluator.reused,
                      time.perf_counter() - evaluator.started, tuple(warnings))
 

@@ -50,8 +50,8 @@ def plot_fit(path: Path, data: dict[str, Any], params: list, targets: list[Targe
                     label="replay, preset's values")
         ax.plot(t, target.model_torque(run[0]) / 1e3, color="C3", lw=1.0,
                 label="replay, fitted values")
-        ax.axvline(target.first_slip_s, color="0.4", ls=":", lw=0.8)
-        ax.text(target.first_slip_s, ax.get_ylim()[1], " transient | cycle", va="top",
+        ax.axvline((target.first_slip_s or 0.0), color="0.4", ls=":", lw=0.8)
+        ax.text((target.first_slip_s or 0.0), ax.get_ylim()[1], " transient | cycle", va="top",
                 fontsize=8, color="0.3")
         ax.set_ylabel("torque [kN m]")
         ax.set_xlabel("time from the start-up [s]")

@@ -3,15 +3,19 @@ the command end to end on a log made by the simulator."""
 
 from __future__ import annotations
 
+import contextlib
+import io
 import json
+from collections.abc import Iterator
 
 import numpy as np
 import pytest
+import yaml
 
 from drill_sim_ros import cli
 from drill_sim_ros.fit import objective, synthetic
 from drill_sim_ros.fit.log import LogError, find_startups, read_log
-from drill_sim_ros.model.presets import load_preset
+from drill_sim_ros.model.presets import load_preset, preset_path
 from drill_sim_ros.model.replay import replay_speed
 from drill_sim_ros.model.startup import RPM_PER_RAD_S, run_startup
 from drill_sim_ros.model.validate_input import read_preset_file
@@ -97,27 +101,69 @@ def test_noise_std_reads_white_noise_under_a_ramp() -> None:
     assert abs(objective.noise_std(x) - 50.0) < 2.5
 
 
-def test_fit_runs_end_to_end_and_writes_its_preset(log_csv, tmp_path, capsys) -> None:
-    """One parameter on a log of the simulator: a JSON report with the value, its interval,
-    the misfits and both cycles; the preset written names the log; the cache makes a
-    second run replay nothing new."""
-    out = tmp_path / "fitted.yaml"
-    argv = ["fit", "--params", PRESET, "--log", log_csv, "--fit",
-            "string.torsional_damping_per_s", "--in-process", "--json", "--out", str(out)]
-    assert cli.main(argv) == 0
-    report = json.loads(capsys.readouterr().out.strip().splitlines()[-1])
-    fit = report["fits"][0]
-    value = fit["values"]["string.torsional_damping_per_s"]
+@pytest.fixture(scope="module")
+def static_fit(log_csv: str, tmp_path_factory: pytest.TempPathFactory) -> dict:
+    """``drill_sim fit`` of the wall's static coefficient from 15 % below the truth on a
+    log of the simulator (its sensors' noise and quantisation): the truth, the argv, the
+    report, the preset written."""
+    tmp = tmp_path_factory.mktemp("static")
+    data = read_preset_file(preset_path(PRESET))
+    truth = data["well"]["side_friction"]["static"]
+    data["well"]["side_friction"]["static"] = 0.85 * truth
+    start = tmp / "start.yaml"
+    start.write_text(yaml.safe_dump(data))
+    out = tmp / "fitted.yaml"
+    argv = ["fit", "--params", str(start), "--log", log_csv, "--fit",
+            "well.side_friction.static", "--in-process", "--json", "--out", str(out)]
+    with _stdout() as lines:
+        assert cli.main(argv) == 0
+    return {"truth": truth, "argv": argv, "report": json.loads(lines[-1]), "out": out,
+            "log": log_csv}
+
+
+@contextlib.contextmanager
+def _stdout() -> Iterator[list[str]]:
+    """The lines printed to stdout inside the block."""
+    buffer, lines = io.StringIO(), []
+    with contextlib.redirect_stdout(buffer):
+        yield lines
+    lines.extend(buffer.getvalue().strip().splitlines())
+
+
+def test_fit_reports_writes_its_preset_and_resumes(static_fit) -> None:
+    """The report has the value inside its interval, the misfits and both cycles; the
+    preset written names the log and holds the value; run again, the cache replays
+    nothing."""
+    fit = static_fit["report"]["fits"][0]
+    value = fit["values"]["well.side_friction.static"]
     assert value["low95"] <= value["value"] <= value["high95"]
-    assert fit["misfit_after"] <= fit["misfit_before"] + 1e-12
+    assert fit["misfit_after"] <= fit["misfit_before"]
     cycle = fit["startups"][0]
     assert cycle["recorded"]["period_s"] > 0 and cycle["fitted"]["period_s"] > 0
-    text = out.read_text()
-    assert log_csv in text.splitlines()[0]
-    load_preset(str(out))                                  # a valid preset
-    assert read_preset_file(out)["string"]["torsional_damping_per_s"] == pytest.approx(
+    out = static_fit["out"]
+    assert static_fit["log"] in out.read_text().splitlines()[0]
+    assert read_preset_file(out)["well"]["side_friction"]["static"] == pytest.approx(
         value["value"])
-    assert cli.main([*argv, "--overwrite"]) == 0
-    again = json.loads(capsys.readouterr().out.strip().splitlines()[-1])["fits"][0]
+    load_preset(str(out))                                  # a valid preset
+    with _stdout() as lines:
+        assert cli.main([*static_fit["argv"], "--overwrite"]) == 0
+    again = json.loads(lines[-1])["fits"][0]
     assert again["replays"] == 0
     assert again["values"] == fit["values"]
+
+
+def test_fit_moves_the_static_friction_to_within_10_percent(static_fit) -> None:
+    """From 15 % below, the fitted static coefficient lands within 10 % of the truth."""
+    value = static_fit["report"]["fits"][0]["values"]["well.side_friction.static"]
+    assert abs(value["value"] / static_fit["truth"] - 1.0) < 0.10
+
+
+@pytest.mark.xfail(strict=True, reason="issue 51's 5 % and coverage are not met: replays of "
+                   "the logged speed wind the string up differently from the run that made "
+                   "the log (the wall's lumped junctions are sensitive), the fit lands about "
+                   "8 % high with an interval that misses the truth; docs/fit.md")
+def test_fit_recovers_the_static_friction_within_5_percent_inside_its_interval(
+        static_fit) -> None:
+    value = static_fit["report"]["fits"][0]["values"]["well.side_friction.static"]
+    assert abs(value["value"] / static_fit["truth"] - 1.0) < 0.05
+    assert value["low95"] <= static_fit["truth"] <= value["high95"]
