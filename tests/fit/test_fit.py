@@ -167,3 +167,22 @@ def test_fit_recovers_the_static_friction_within_5_percent_inside_its_interval(
     value = static_fit["report"]["fits"][0]["values"]["well.side_friction.static"]
     assert abs(value["value"] / static_fit["truth"] - 1.0) < 0.05
     assert value["low95"] <= static_fit["truth"] <= value["high95"]
+
+
+def test_a_las_log_is_read_by_mnemonic_and_unit(tmp_path) -> None:
+    """A LAS file (written by lasio) with time in s, SURFACE in rpm and STRING_TORQUE in
+    kN.m reads as the same SI log as its numbers."""
+    import lasio
+    las = lasio.LASFile()
+    t = np.arange(0.0, 1.0, 0.01)
+    las.append_curve("TIME", t, unit="s")
+    las.append_curve("SURFACE", np.full(t.size, 30.0), unit="rpm")
+    las.append_curve("STRING_TORQUE", np.full(t.size, 2.5), unit="kN.m")
+    path = tmp_path / "log.las"
+    with path.open("w") as f:
+        las.write(f)
+    log = read_log(path)
+    assert log.torque_kind == "string"
+    assert np.allclose(log.t_s, t)
+    assert np.allclose(log.speed_rad_s, 30.0 / RPM_PER_RAD_S)
+    assert np.allclose(log.torque_nm, 2500.0)
