@@ -36,7 +36,7 @@ from pathlib import Path
 
 import numpy as np
 
-from drill_sim_ros.model.errors import DrillSimError
+from drill_sim_ros.fit.errors import LogError
 
 RAD_S_PER_RPM = 2.0 * math.pi / 60.0
 MAX_GAP_RATIO = 1.5          # a step longer than this times the median: a gap
@@ -60,10 +60,6 @@ OPTIONAL_NAMES = {"hook_load_n": {"hook_load_n": 1.0, "hook_load_kn": 1e3},
                   "wob_n": {"wob_n": 1.0, "wob_kn": 1e3},
                   "bit_speed_rad_s": {"bit_rpm": RAD_S_PER_RPM, "bit_speed_rad_s": 1.0}}
 TORQUE_KINDS = ("string", "motor")
-
-
-class LogError(DrillSimError):
-    """The log cannot be used; the message names the file and what is wrong."""
 
 
 @dataclass(frozen=True)

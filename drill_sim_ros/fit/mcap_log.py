@@ -11,7 +11,7 @@ import numpy as np
 
 from drill_sim_ros import topics
 from drill_sim_ros.archive.reader import ArchiveReader
-from drill_sim_ros.fit.log import LogError
+from drill_sim_ros.fit.errors import LogError
 from drill_sim_ros.viz.mcap_telemetry import channel_decoder
 
 
