@@ -90,6 +90,7 @@ bench: venv
 	$(PY) benchmarks/bench_lockstep.py
 	$(PY) benchmarks/bench_opcua.py
 	$(PY) benchmarks/bench_gym.py
+	$(PY) benchmarks/bench_fit.py
 
 # The paper's figures and the field map (docs/gallery/*.png), computed on a local Dask
 # cluster; FIGURES_CACHE keeps the maps as NetCDF so a re-run resumes them.

@@ -26,6 +26,7 @@ from typing import Any, TextIO
 
 from drill_sim_ros import (
     closed_loop_cli,
+    fit_cli,
     stability_cli,
     startup_cli,
     string_cli,
@@ -155,6 +156,7 @@ def build_parser() -> argparse.ArgumentParser:
     stability_cli.add_parser(sub)
     startup_cli.add_parser(sub)
     torque_drag_cli.add_parser(sub)
+    fit_cli.add_parser(sub)
     suite_cli.add_parser(sub)
     return parser
 
@@ -484,7 +486,8 @@ def _main(args: argparse.Namespace) -> int:
                 "reflection": string_cli.cmd_reflection,
                 "stability": stability_cli.cmd_stability,
                 "startup": startup_cli.cmd_startup,
-                "torque-drag": torque_drag_cli.cmd_torque_drag}[args.command](args)
+                "torque-drag": torque_drag_cli.cmd_torque_drag,
+                "fit": fit_cli.cmd_fit}[args.command](args)
     except DrillSimError as exc:
         print(f"drill_sim: error: {' '.join(str(exc).splitlines())}", file=sys.stderr)
         return 2

@@ -16,7 +16,7 @@ from drill_sim_ros.model.checks import number_in
 from drill_sim_ros.model.consistency import check_stick_band
 from drill_sim_ros.model.defaults import MAX_SURFACE_RPM
 from drill_sim_ros.model.presets import DEFAULT_PRESET, Preset, load_preset
-from drill_sim_ros.plot_file import add_plot_arguments, commit_plot, plot_into
+from drill_sim_ros.plot_file import add_plot_arguments, commit_output, commit_plot, plot_into
 from drill_sim_ros.string_cli import rounded
 from drill_sim_ros.terminal import StatusLine
 
@@ -44,9 +44,16 @@ def add_parser(sub: Any) -> None:
                    f"[0, {startup.MAX_RAMP_S:g}] (0: a step; default 10)")
     p.add_argument("--seconds", type=float, default=60.0, help="length of the run, s of "
                    f"simulated time, in (0, {startup.MAX_SECONDS:g}] (default 60)")
+    p.add_argument("--log-csv", type=Path, help="also write the start-up's surface log "
+                   "as a rig would record it (measured drive speed and torque-sub torque, "
+                   "100 Hz, after 1 s at rest), a CSV that `drill_sim fit --log` reads")
+    p.add_argument("--sensors", default="noisy_delayed_sensors", help="the scenario whose "
+                   "sensors' noise and quantisation measure --log-csv (default "
+                   "noisy_delayed_sensors; their delays left out)")
+    p.add_argument("--seed", type=int, default=0, help="the sensors' noise seed (default 0)")
     p.add_argument("--json", action="store_true", help="print only the JSON line")
     add_plot_arguments(p, "the speeds, torques and twist against time, the break-away "
-                       "marked")
+                       "marked", "--log-csv")
 
 
 def _check_args(args: Any) -> None:
@@ -80,6 +87,8 @@ def _startup(args: Any, preset: Preset, plot_tmp: Path | None) -> int:
     finally:
         line.close()
     scores = _json_ready(startup.startup_scores(run))
+    if args.log_csv is not None:
+        _write_log(args, preset, run)
     if not args.json:
         print(_summary(preset.name, args, scores))
     if plot_tmp is not None:
@@ -90,6 +99,18 @@ def _startup(args: Any, preset: Preset, plot_tmp: Path | None) -> int:
         print(f"wrote {args.plot}", file=sys.stderr)
     print(json.dumps(scores))
     return 0
+
+
+def _write_log(args: Any, preset: Preset, run: startup.StartupRun) -> None:
+    """The run's surface log as a rig records it (fit.synthetic) into ``--log-csv``."""
+    from drill_sim_ros.fit import synthetic
+    from drill_sim_ros.plot_file import output_into
+    log = synthetic.measured_log(run, synthetic.scenario_sensors(args.seed, args.sensors),
+                                 1.0, f"drill_sim startup of {preset.name}")
+    with output_into(args.log_csv, args.overwrite, "--log-csv", (".csv",)) as tmp:
+        synthetic.write_csv(log, str(tmp))
+        commit_output(tmp, args.log_csv, args.overwrite, "--log-csv")
+    print(f"wrote {args.log_csv}", file=sys.stderr)
 
 
 def _json_ready(value: Any) -> Any:

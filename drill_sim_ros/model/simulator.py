@@ -404,6 +404,13 @@ class Simulator:
         self._fill_drive(drive)
         self.set_top_drive_mode(drive.mode)
 
+    def set_speed_ramp(self, rate: float) -> None:
+        """The ramp limit of the drive speed's target, per unit tau (``config.omega_rate``,
+        > 0; inf: none), from the next run. A speed prescribed as a time series sets it with
+        each sample's target (``model.replay``), so the drive goes linearly between them."""
+        self.config = replace(self.config, omega_rate=float(rate))    # validated there
+        self._fill_params("config.omega_rate")
+
     def set_speed_setpoint_rad_s(self, speed_rad_s: float) -> None:
         """Drive speed setpoint in rad/s (kinematic and speed modes), from the next step."""
         self.set_inputs(omega_s=self.scales.omega_from_rad_s(_check_input("speed_rad_s",

@@ -124,10 +124,10 @@ def run_startup(preset: Preset, rpm: float, ramp_s: float, seconds: float,
         if on_progress is not None:
             on_progress(done / total)
     blocks.append(sim.advance(0, every))           # the state at the end
-    return _series(blocks, preset)
+    return startup_series(blocks, preset)
 
 
-def _series(blocks: list[Samples], preset: Preset) -> StartupRun:
+def startup_series(blocks: list[Samples], preset: Preset) -> StartupRun:
     """The blocks' samples in SI (:class:`StartupRun`)."""
     sc = preset.scales
 

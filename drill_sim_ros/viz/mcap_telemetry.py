@@ -29,7 +29,8 @@ class NoTelemetryError(RuntimeError):
     """The recording has no usable /drill/telemetry message."""
 
 
-def _decoder(channel: RecordedChannel) -> Callable[[bytes], Any]:
+def channel_decoder(channel: RecordedChannel) -> Callable[[bytes], Any]:
+    """A decoder of the CDR messages of ``channel``, from its stored schema."""
     schema = Schema(id=channel.channel_id, name=channel.type_name, encoding="ros2msg",
                     data=channel.schema_text.encode("utf-8"))
     return DecoderFactory().decoder_for("cdr", schema)
@@ -47,7 +48,7 @@ def read_telemetry(path: str | Path | ArchiveReader,
     order: np.ndarray | None = None
     seen, decode = 0, None
     for message in reader.messages(lambda topic: topic == topics.TELEMETRY):
-        decode = decode or _decoder(message.channel)
+        decode = decode or channel_decoder(message.channel)
         msg = decode(message.data)
         if order is None:
             order = field_order([d.label for d in msg.layout.dim])
@@ -77,7 +78,7 @@ def read_string_profiles(path: str | Path | ArchiveReader,
     for message in reader.messages(lambda topic: topic in topics.PROFILE_TOPICS):
         channel = message.channel
         if channel.channel_id not in decoders:
-            decoders[channel.channel_id] = _decoder(channel)
+            decoders[channel.channel_id] = channel_decoder(channel)
         messages.append(decoders[channel.channel_id](message.data))
         if len(messages) >= batch_profiles:
             if (batch := string_batch(messages)) is not None:
@@ -92,7 +93,7 @@ def recorded_run_info(path: str | Path) -> dict[str, Any] | None:
     through the damage-tolerant reader."""
     reader = ArchiveReader(path)
     for message in reader.messages(lambda topic: topic == topics.RUN_INFO):
-        return json.loads(_decoder(message.channel)(message.data).data)
+        return json.loads(channel_decoder(message.channel)(message.data).data)
     return None
 
 

@@ -1,0 +1,384 @@
+"""Fitting preset parameters to start-ups: replays on Dask, a cache, scipy's least squares.
+
+A *replay* runs one start-up with one parameter vector (:func:`simulate`, a Dask task,
+about as long as ``drill_sim startup`` takes). An *evaluation* of a parameter vector
+averages the compared values (:mod:`fit.objective`) of ``REPLAYS_PER_POINT`` replays of
+each start-up, each following the logged speed with white noise of the speed's own size
+added, seeded 0, 1, ... at every vector (common random numbers): a replay's first slip
+moves with the smallest change of the speed it follows, and the average over the same
+draws makes the misfit a smoother function of the parameters, which the optimiser's
+differences can follow. The misfit is the weighted residuals of that average. The fit works
+in the parameters scaled to their bounds (u = (x - low) / (high - low), in [0, 1]):
+
+1. a global start: the preset's values and ``STARTS_PER_PARAMETER`` x n points of a
+   seeded Latin hypercube over the bounds (scipy.stats.qmc), evaluated in parallel; at the
+   preset's values and at the best, the replay's sensitivity to the speed's noise is
+   measured (:meth:`Evaluator.measure_sensitivity`, fit.objective) and joins the weights;
+2. ``scipy.optimize.least_squares`` (trust-region reflective, within the bounds) from each
+   of the ``LOCAL_STARTS`` best, its Jacobian forward differences of ``JACOBIAN_STEP`` in
+   u, evaluated in parallel; the sensitivity measured again at the best optimum (it
+   depends on the parameters: the weights keep the largest scatter seen), and least
+   squares again from the best point so far under those weights (``PASSES`` in all);
+3. the 95 % intervals from the Jacobian at the optimum: cov = s^2 (J^T J)^-1 with s^2 the
+   residuals' mean square over their degrees of freedom (at least 1: a misfit within the
+   noise does not shrink them), plus the covariance of the shifts J^+ dr_k that the
+   sensitivity replays' deviations dr_k from their mean would make (the residuals of one
+   log are correlated, the slips moving many samples together, which the first term
+   ignores), times 1 + 1 / ``REPLAYS_PER_POINT`` (the averaged replays' own scatter);
+   Student's t with the replays' degrees of freedom; the correlations from the same
+   matrix.
+
+Every replay is appended to a cache file as it finishes (JSON lines keyed by a hash of the
+preset, the start-up's samples and the parameter vector); a fit started again with the same
+inputs reads them back instead of recomputing (the optimiser's path is deterministic), so
+an interrupted fit resumes where it stopped.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from drill_sim_ros.fit.log import SurfaceLog
+from drill_sim_ros.fit.objective import Target, noise_std
+from drill_sim_ros.fit.params import FitParameter, with_values
+from drill_sim_ros.model.errors import DrillSimError
+from drill_sim_ros.model.presets import preset_from_dict
+from drill_sim_ros.model.replay import replay_speed
+
+STARTS_PER_PARAMETER = 16
+JACOBIAN_STEP = 0.01          # in u (a share of each parameter's bounds)
+MAX_ITERATIONS = 40           # least squares' evaluations of the residuals (not the Jacobian's)
+TOLERANCE = 1e-4              # least squares' ftol and xtol
+PENALTY = 1e3                 # each residual of a vector the preset refuses (dynamic > static)
+SENSITIVITY_REPLAYS = 8       # replays with fresh speed noise (Evaluator.measure_sensitivity)
+SENSITIVITY_SEED = 1000       # their seeds from here (the averaged replays' from 0)
+REPLAYS_PER_POINT = 4         # replays averaged per parameter vector (common seeds)
+PASSES = 2                    # least-squares passes, the weights measured anew after each
+LOCAL_STARTS = 3              # the first pass starts from the best this many points
+CORRELATED = 0.95             # |correlation| above this: the log cannot tell the two apart
+Z95 = 0.975
+
+
+def simulate(data: dict[str, Any], values: dict[str, float], t_s: np.ndarray,
+             speed_rad_s: np.ndarray, speed_noise: tuple[int, float] | None = None
+             ) -> tuple[np.ndarray, np.ndarray] | str:
+    """One replay (a Dask task): the string torque at the top N m and the bit speed rad/s at
+    the log's times, or the one-line reason the preset with ``values`` is refused.
+    ``speed_noise`` (seed, std rad/s): white noise added to the speed it follows."""
+    if speed_noise is not None:
+        seed, std = speed_noise
+        speed_rad_s = speed_rad_s + std * np.random.default_rng(seed).standard_normal(
+            speed_rad_s.size)
+    try:
+        preset = preset_from_dict("fit", with_values(data, values))
+        run = replay_speed(preset, t_s, speed_rad_s)
+    except DrillSimError as exc:
+        return str(exc)
+    return run.surface_torque_nm, run.bit_rpm * (math.pi / 30.0)
+
+
+@dataclass(frozen=True)
+class Evaluation:
+    """A parameter vector's residuals over all start-ups (``refused``: why the preset refused
+    it, the residuals then ``PENALTY``)."""
+
+    x: np.ndarray
+    residuals: np.ndarray
+    refused: str | None = None
+
+    @property
+    def misfit(self) -> float:
+        """The residuals' root mean square."""
+        return float(np.sqrt(np.mean(self.residuals**2)))
+
+
+class Evaluator:
+    """Evaluations of parameter vectors over start-ups, cached and run on a Dask client
+    (None: in this process)."""
+
+    def __init__(self, data: dict[str, Any], params: Sequence[FitParameter],
+                 targets: Sequence[Target], client: Any = None, cache: Path | None = None,
+                 progress: Callable[[str], None] | None = None) -> None:
+        self.data, self.params, self.targets = data, list(params), list(targets)
+        self.client, self.cache, self.progress = client, cache, progress
+        self.done: dict[str, list[float] | str] = {}
+        self.computed = self.reused = 0
+        self.best = math.inf
+        self.started = time.perf_counter()
+        self._keys = [f"{s}#{self._segment_key(t.log)}" for s, t in enumerate(self.targets)]
+        self.sigma = [t.noise_sigma for t in self.targets]
+        self.speed_noise = [noise_std(t.log.speed_rad_s) for t in self.targets]
+        self.sensitivity: list[np.ndarray | None] = [None] * len(self.targets)
+        if cache is not None and cache.exists():
+            self._load(cache)
+
+    # ---- cache ----------------------------------------------------------------------
+    def _segment_key(self, log: SurfaceLog) -> str:
+        h = hashlib.sha256(json.dumps(self.data, sort_keys=True, default=str).encode())
+        for array in (log.t_s, log.speed_rad_s, log.torque_nm):
+            h.update(np.ascontiguousarray(array, dtype=np.float64).tobytes())
+        h.update(",".join(p.path for p in self.params).encode())
+        return h.hexdigest()[:24]
+
+    def _key(self, segment: int, x: np.ndarray) -> str:
+        return f"{self._keys[segment]}:{','.join(repr(float(v)) for v in x)}"
+
+    def _load(self, path: Path) -> None:
+        for line in path.read_text().splitlines():
+            try:
+                row = json.loads(line)
+                self.done[row["key"]] = row["value"]
+            except (ValueError, KeyError, TypeError):
+                continue             # a line cut by an interruption
+
+    def _store(self, key: str, value: list[float] | str) -> None:
+        self.done[key] = value
+        if self.cache is not None:
+            with self.cache.open("a") as f:
+                f.write(json.dumps({"key": key, "value": value}) + "\n")
+
+    # ---- evaluating -----------------------------------------------------------------
+    def values_of(self, x: np.ndarray) -> dict[str, float]:
+        return {p.path: float(v) for p, v in zip(self.params, x, strict=True)}
+
+    def evaluate(self, xs: Sequence[np.ndarray]) -> list[Evaluation]:
+        """The evaluations of the vectors ``xs`` (parameter values), in parallel."""
+        wanted = [(i, s, r) for i in range(len(xs)) for s in range(len(self.targets))
+                  for r in range(REPLAYS_PER_POINT)]
+        jobs = [job for job in wanted if self._job_key(xs, job) not in self.done]
+        self.reused += len(wanted) - len(jobs)
+        keys = [self._job_key(xs, job) for job in jobs]
+        self._map([self._args(xs, j) for j in jobs],
+                  lambda i, result: self._take(keys[i], jobs[i][1], result))
+        return [self._evaluation(x) for x in xs]
+
+    def _job_key(self, xs: Sequence[np.ndarray], job: tuple[int, int, int]) -> str:
+        return f"{self._key(job[1], xs[job[0]])}:r{job[2]}"
+
+    def _args(self, xs: Sequence[np.ndarray], job: tuple[int, int, int],
+              seed_offset: int = 0) -> tuple[Any, ...]:
+        """:func:`simulate`'s arguments: start-up ``job[1]`` at ``xs[job[0]]``, the logged
+        speed with noise of its own size seeded ``job[2] + seed_offset``."""
+        log = self.targets[job[1]].log
+        return (self.data, self.values_of(xs[job[0]]), log.t_s, log.speed_rad_s,
+                (job[2] + seed_offset, self.speed_noise[job[1]]))
+
+    def _take(self, key: str, segment: int, result: tuple[np.ndarray, np.ndarray] | str
+              ) -> None:
+        value = result if isinstance(result, str) else \
+            self.targets[segment].raw(*result).tolist()
+        self.computed += 1
+        self._store(key, value)
+        if self.progress is not None:
+            self.progress(f"fit: {self.computed} replays ({self.reused} from the cache), "
+                          f"{time.perf_counter() - self.started:6.1f} s, best misfit "
+                          f"{self.best:.4g}")
+
+    def _evaluation(self, x: np.ndarray) -> Evaluation:
+        parts, refused = [], None
+        for s, target in enumerate(self.targets):
+            raws = [self.done[f"{self._key(s, x)}:r{r}"] for r in range(REPLAYS_PER_POINT)]
+            bad = [r for r in raws if isinstance(r, str)]
+            if bad:
+                refused = bad[0]
+                parts.append(np.full(_size(target), PENALTY))
+            else:
+                parts.append(self._residuals(s, np.mean(np.array(raws), axis=0)))
+        evaluation = Evaluation(np.asarray(x, dtype=float), np.concatenate(parts), refused)
+        self.best = min(self.best, evaluation.misfit)
+        return evaluation
+
+    def _residuals(self, segment: int, raw: np.ndarray) -> np.ndarray:
+        target = self.targets[segment]
+        return (np.asarray(raw) - target.logged) / self.sigma[segment]
+
+    def measure_sensitivity(self, x: np.ndarray) -> None:
+        """Add to each compared value's uncertainty the scatter of ``SENSITIVITY_REPLAYS``
+        replays at ``x`` that follow the logged speed with fresh noise of its own size
+        (fit.objective's module doc); measured at several points, the largest holds (the
+        scatter depends on the parameters)."""
+        jobs = [(0, s, r) for s in range(len(self.targets)) for r in range(SENSITIVITY_REPLAYS)]
+        keys = [f"{self._key(s, x)}:sensitivity{r}" for _, s, r in jobs]
+        todo = [(key, job) for key, job in zip(keys, jobs, strict=True) if key not in self.done]
+        self._map([self._args([x], job, SENSITIVITY_SEED) for _, job in todo],
+                  lambda i, result: self._take(todo[i][0], todo[i][1][1], result))
+        for s, target in enumerate(self.targets):
+            raws = [self.done[key] for key, job in zip(keys, jobs, strict=True) if job[1] == s]
+            raws = [r for r in raws if not isinstance(r, str)]
+            if len(raws) >= 2:
+                self.sensitivity[s] = np.array(raws)
+                scatter = np.std(np.array(raws), axis=0, ddof=1)
+                self.sigma[s] = np.sqrt(np.maximum(self.sigma[s]**2,
+                                                   target.noise_sigma**2 + scatter**2))
+
+    def sensitivity_scatter(self) -> np.ndarray:
+        """The sensitivity replays' deviations from their mean over the weights, each row a
+        replay, the start-ups' residuals side by side: how far the compared values of one
+        log stray from the replays' expectation (empty when not measured)."""
+        if any(raws is None for raws in self.sensitivity):
+            return np.zeros((0, 0))
+        return np.hstack([(raws - raws.mean(axis=0)) / sigma
+                          for raws, sigma in zip(self.sensitivity, self.sigma, strict=True)])
+
+    def map_runs(self, values: dict[str, float]) -> list[tuple[np.ndarray, np.ndarray]]:
+        """Each start-up replayed with ``values``: (string torque N m, bit speed rad/s)."""
+        runs = self._map([(self.data, values, t.log.t_s, t.log.speed_rad_s)
+                          for t in self.targets])
+        for run in runs:
+            if isinstance(run, str):
+                raise DrillSimError(f"the fitted values are refused: {run}")
+        return runs
+
+    def _map(self, arguments: list[tuple[Any, ...]],
+             on_result: Callable[[int, Any], None] | None = None) -> list[Any]:
+        """:func:`simulate` over ``arguments``, in parallel on the client (None: here);
+        ``on_result(index, result)`` as each finishes (what the cache is written from)."""
+        results: list[Any] = [None] * len(arguments)
+
+        def take(index: int, result: Any) -> None:
+            results[index] = result
+            if on_result is not None:
+                on_result(index, result)
+        if self.client is None:
+            for i, a in enumerate(arguments):
+                take(i, simulate(*a))
+            return results
+        from distributed import as_completed
+        futures = {self.client.submit(simulate, *a, pure=False): i
+                   for i, a in enumerate(arguments)}
+        for future in as_completed(futures):
+            take(futures[future], future.result())
+        return results
+
+
+def _size(target: Target) -> int:
+    """The number of residuals of ``target`` (what a refused vector fills)."""
+    n = target.torque.transient.size + target.torque.used.size + target.breakaway.size
+    if target.bit is not None:
+        n += target.bit.transient.size + target.bit.used.size
+    return n
+
+
+# ---- the fit --------------------------------------------------------------------------
+@dataclass(frozen=True)
+class FitResult:
+    """The fitted values, their 95 % intervals and correlations, the misfits before and
+    after, the optimiser's counts, and warnings (one line each)."""
+
+    params: tuple[FitParameter, ...]
+    x: np.ndarray
+    low95: np.ndarray
+    high95: np.ndarray
+    correlation: np.ndarray
+    misfit_before: float
+    misfit_after: float
+    evaluations: int
+    replays: int
+    reused: int
+    seconds: float
+    warnings: tuple[str, ...]
+
+
+def fit(evaluator: Evaluator, seed: int = 0) -> FitResult:
+    """Fit ``evaluator``'s parameters (module doc)."""
+    from scipy.optimize import least_squares
+    from scipy.stats import qmc
+    params = evaluator.params
+    low = np.array([p.low for p in params])
+    span = np.array([p.high for p in params]) - low
+    x0 = np.array([p.initial for p in params])
+
+    def x_of(u: np.ndarray) -> np.ndarray:
+        return low + span * np.clip(u, 0.0, 1.0)
+
+    starts = qmc.LatinHypercube(d=len(params), seed=seed).random(
+        STARTS_PER_PARAMETER * len(params))
+    points = [x0, *[x_of(u) for u in starts]]
+    evaluator.measure_sensitivity(x0)
+    evaluator.measure_sensitivity(min(evaluator.evaluate(points), key=lambda e: e.misfit).x)
+    count = [len(points)]
+
+    def fun(u: np.ndarray) -> np.ndarray:
+        count[0] += 1
+        return evaluator.evaluate([x_of(u)])[0].residuals
+
+    def jac(u: np.ndarray) -> np.ndarray:
+        steps = [_step(u, i) for i in range(u.size)]
+        points = [x_of(u), *[x_of(u + h) for h in steps]]
+        evals = evaluator.evaluate(points)
+        count[0] += len(points) - 1
+        columns = [(e.residuals - evals[0].residuals) / h.sum()
+                   for e, h in zip(evals[1:], steps, strict=True)]
+        return np.column_stack(columns)
+
+    for starts_now in (LOCAL_STARTS, *[1] * (PASSES - 1)):
+        tried = sorted(evaluator.evaluate(points), key=lambda e: e.misfit)  # weighted anew
+        ends = []
+        for start in tried[:starts_now]:
+            result = least_squares(fun, (start.x - low) / span, jac=jac, bounds=(0.0, 1.0),
+                                   method="trf", ftol=TOLERANCE, xtol=TOLERANCE,
+                                   max_nfev=MAX_ITERATIONS)
+            ends.append(evaluator.evaluate([x_of(result.x)])[0])
+        best = min([*ends, tried[0]], key=lambda e: e.misfit)
+        evaluator.measure_sensitivity(best.x)
+        points += [e.x for e in ends]
+    best = min(evaluator.evaluate(points), key=lambda e: e.misfit)
+    before = evaluator.evaluate([x0])[0]
+    jacobian = jac((best.x - low) / span)
+    low95, high95, corr, warnings = _intervals(params, best, jacobian, span,
+                                               evaluator.sensitivity_scatter())
+    return FitResult(tuple(params), best.x, low95, high95, corr, before.misfit, best.misfit,
+                     count[0], evaluator.computed, evaluator.reused,
+                     time.perf_counter() - evaluator.started, tuple(warnings))
+
+
+def _step(u: np.ndarray, i: int) -> np.ndarray:
+    """The forward step of parameter ``i`` (backward at the upper bound)."""
+    h = np.zeros_like(u)
+    h[i] = JACOBIAN_STEP if u[i] + JACOBIAN_STEP <= 1.0 else -JACOBIAN_STEP
+    return h
+
+
+def _intervals(params: Sequence[FitParameter], best: Evaluation, jacobian: np.ndarray,
+               span: np.ndarray, scatter: np.ndarray
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[str]]:
+    """The 95 % intervals and correlations from the Jacobian (module doc), with warnings;
+    ``scatter`` (replays, residuals): the sensitivity replays' weighted deviations from
+    their mean (:meth:`Evaluator.sensitivity_scatter`)."""
+    from scipy.stats import t as student
+    m, n = jacobian.shape
+    dof = max(1, m - n)
+    s2 = max(1.0, float(np.sum(best.residuals**2)) / dof)
+    cov_u = s2 * np.linalg.pinv(jacobian.T @ jacobian)
+    if scatter.shape[0] >= 2:                 # the replays' own scatter, carried through
+        shifts = scatter @ np.linalg.pinv(jacobian).T     # (replays, n): du of each
+        cov_u = cov_u + (1.0 + 1.0 / REPLAYS_PER_POINT) * np.cov(shifts, rowvar=False,
+                                                                  ddof=1).reshape(n, n)
+        dof = min(dof, scatter.shape[0] - 1)
+    cov = cov_u * np.outer(span, span)
+    sd = np.sqrt(np.maximum(np.diag(cov), 0.0))
+    half = student.ppf(Z95, dof) * sd
+    with np.errstate(invalid="ignore", divide="ignore"):
+        corr = cov / np.outer(sd, sd)
+    warnings = []
+    for i, p in enumerate(params):
+        if not np.any(jacobian[:, i]):
+            warnings.append(f"the log does not constrain {p.path} (the misfit does not move "
+                            "with it)")
+        for j in range(i + 1, n):
+            if abs(corr[i, j]) > CORRELATED:
+                warnings.append(f"the log cannot tell {p.path} and {params[j].path} apart "
+                                f"(correlation {corr[i, j]:+.3f}): fix one, or add a log "
+                                "that moves them differently")
+    if best.refused:
+        warnings.append(f"the preset refused the fitted values: {best.refused}")
+    return best.x - half, best.x + half, corr, warnings

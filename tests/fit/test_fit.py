@@ -1,0 +1,188 @@
+"""drill_sim fit: the log's checks, the replay of a logged speed, the drift-free objective,
+the command end to end on a log made by the simulator."""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import json
+from collections.abc import Iterator
+
+import numpy as np
+import pytest
+import yaml
+
+from drill_sim_ros import cli
+from drill_sim_ros.fit import objective, synthetic
+from drill_sim_ros.fit.log import LogError, find_startups, read_log
+from drill_sim_ros.model.presets import load_preset, preset_path
+from drill_sim_ros.model.replay import replay_speed
+from drill_sim_ros.model.startup import RPM_PER_RAD_S, run_startup
+from drill_sim_ros.model.validate_input import read_preset_file
+
+PRESET = "field_8p5in_deviated"
+
+
+@pytest.fixture(scope="module")
+def log_csv(tmp_path_factory: pytest.TempPathFactory) -> str:
+    path = tmp_path_factory.mktemp("fit") / "log.csv"
+    log = synthetic.synthetic_log(load_preset(PRESET), 30.0, 10.0, 60.0,
+                                  synthetic.scenario_sensors(1))
+    synthetic.write_csv(log, str(path))
+    return str(path)
+
+
+def _write(path, header: str, rows: list[list[float]]) -> str:
+    path.write_text(header + "\n" + "\n".join(",".join(map(str, r)) for r in rows) + "\n")
+    return str(path)
+
+
+@pytest.mark.parametrize(("header", "rows", "words"), [
+    ("time_s,surface_rpm", [[0, 0], [0.01, 0], [0.02, 1]], "no string torque column"),
+    ("time_s,surface_rpm,torque_knm", [[0, 0, 0], [0.02, 0, 0], [0.01, 1, 1]], "unsorted"),
+    ("time_s,surface_rpm,torque_knm", [[0, 0, 0], [0.01, 0, 0], [0.01, 1, 1]], "repeated"),
+    ("time_s,surface_rpm,torque_knm", [[0, 0, 0], [0.01, "nan", 0], [0.02, "nan", 1],
+                                       [0.03, 1, 1]], "NaN or infinite in samples 1 to 2"),
+])
+def test_a_bad_log_is_refused_in_one_line(tmp_path, header, rows, words) -> None:
+    kind = "motor" if "torque_knm" in header else "string"
+    with pytest.raises(LogError, match=words):
+        read_log(_write(tmp_path / "bad.csv", header, rows), kind)
+
+
+def test_a_log_without_a_start_up_is_refused(tmp_path, capsys) -> None:
+    rows = [[0.01 * i, 30.0, 10.0] for i in range(500)]        # turning all along
+    path = _write(tmp_path / "steady.csv", "time_s,surface_rpm,torque_knm", rows)
+    code = cli.main(["fit", "--params", PRESET, "--log", path, "--fit",
+                     "well.side_friction.static", "--in-process"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and "no start-up" in err[0]
+
+
+def test_start_ups_are_found_from_rest_to_turning() -> None:
+    t = np.arange(0.0, 30.0, 0.01)
+    rpm = np.where((t % 15.0) < 3.0, 0.0, np.minimum(30.0, 10.0 * ((t % 15.0) - 3.0)))
+    from drill_sim_ros.fit.log import SurfaceLog
+    log = SurfaceLog("two", t, rpm / RPM_PER_RAD_S, np.zeros_like(t), "motor")
+    spans = find_startups(log)
+    assert len(spans) == 2
+    for (a, b), rise_s in zip(spans, (3.0, 18.0), strict=True):
+        assert t[a] < rise_s < t[b - 1]
+        assert abs(rpm[a]) < 1e-9
+
+
+def test_the_replay_follows_the_logged_speed() -> None:
+    """The drive of a replay goes through every logged speed (it is prescribed), and a
+    replay of a run's own drive speed turns the string as that run did until it first
+    slips: the same torque at the top, within 2 % of its peak."""
+    preset = load_preset(PRESET)
+    run = run_startup(preset, 30.0, 10.0, 15.0)
+    replay = replay_speed(preset, run.t_s, run.drive_rpm / RPM_PER_RAD_S)
+    assert np.allclose(replay.drive_rpm, np.maximum(run.drive_rpm, 0.0), atol=1e-6)
+    peak = np.max(np.abs(run.surface_torque_nm))
+    early = run.t_s < 8.0
+    assert np.max(np.abs(replay.surface_torque_nm - run.surface_torque_nm)[early]) < 0.02 * peak
+
+
+def test_the_cycle_features_do_not_see_a_phase_drift() -> None:
+    """A saw-tooth cycle and the same cycle shifted by a third of its period give the same
+    period (within a sample), mean and std (within 1 %)."""
+    dt, period = 0.01, 7.0
+    t = np.arange(0.0, 42.0, dt)
+    a = objective.cycle_features(np.mod(t, period), dt)
+    b = objective.cycle_features(np.mod(t + period / 3.0, period), dt)
+    assert abs(a[0] - period) < 2 * dt and abs(b[0] - period) < 2 * dt
+    assert np.allclose(a[1:3], b[1:3], rtol=0.01)
+
+
+def test_noise_std_reads_white_noise_under_a_ramp() -> None:
+    rng = np.random.default_rng(3)
+    x = np.linspace(0.0, 1e4, 20_000) + 50.0 * rng.standard_normal(20_000)
+    assert abs(objective.noise_std(x) - 50.0) < 2.5
+
+
+@pytest.fixture(scope="module")
+def static_fit(log_csv: str, tmp_path_factory: pytest.TempPathFactory) -> dict:
+    """``drill_sim fit`` of the wall's static coefficient from 15 % below the truth on a
+    log of the simulator (its sensors' noise and quantisation): the truth, the argv, the
+    report, the preset written."""
+    tmp = tmp_path_factory.mktemp("static")
+    data = read_preset_file(preset_path(PRESET))
+    truth = data["well"]["side_friction"]["static"]
+    data["well"]["side_friction"]["static"] = 0.85 * truth
+    start = tmp / "start.yaml"
+    start.write_text(yaml.safe_dump(data))
+    out = tmp / "fitted.yaml"
+    argv = ["fit", "--params", str(start), "--log", log_csv, "--fit",
+            "well.side_friction.static", "--in-process", "--json", "--out", str(out)]
+    with _stdout() as lines:
+        assert cli.main(argv) == 0
+    return {"truth": truth, "argv": argv, "report": json.loads(lines[-1]), "out": out,
+            "log": log_csv}
+
+
+@contextlib.contextmanager
+def _stdout() -> Iterator[list[str]]:
+    """The lines printed to stdout inside the block."""
+    buffer, lines = io.StringIO(), []
+    with contextlib.redirect_stdout(buffer):
+        yield lines
+    lines.extend(buffer.getvalue().strip().splitlines())
+
+
+def test_fit_reports_writes_its_preset_and_resumes(static_fit) -> None:
+    """The report has the value inside its interval, the misfits and both cycles; the
+    preset written names the log and holds the value; run again, the cache replays
+    nothing."""
+    fit = static_fit["report"]["fits"][0]
+    value = fit["values"]["well.side_friction.static"]
+    assert value["low95"] <= value["value"] <= value["high95"]
+    assert fit["misfit_after"] <= fit["misfit_before"]
+    cycle = fit["startups"][0]
+    assert cycle["recorded"]["period_s"] > 0 and cycle["fitted"]["period_s"] > 0
+    out = static_fit["out"]
+    assert static_fit["log"] in out.read_text().splitlines()[0]
+    assert read_preset_file(out)["well"]["side_friction"]["static"] == pytest.approx(
+        value["value"])
+    load_preset(str(out))                                  # a valid preset
+    with _stdout() as lines:
+        assert cli.main([*static_fit["argv"], "--overwrite"]) == 0
+    again = json.loads(lines[-1])["fits"][0]
+    assert again["replays"] == 0
+    assert again["values"] == fit["values"]
+
+
+def test_fit_moves_the_static_friction_to_within_10_percent(static_fit) -> None:
+    """From 15 % below, the fitted static coefficient lands within 10 % of the truth."""
+    value = static_fit["report"]["fits"][0]["values"]["well.side_friction.static"]
+    assert abs(value["value"] / static_fit["truth"] - 1.0) < 0.10
+
+
+@pytest.mark.xfail(strict=True, reason="issue 51's 5 % and coverage are not met: replays of "
+                   "the logged speed wind the string up differently from the run that made "
+                   "the log (the wall's lumped junctions are sensitive), the fit lands about "
+                   "8 % high with an interval that misses the truth; docs/fit.md")
+def test_fit_recovers_the_static_friction_within_5_percent_inside_its_interval(
+        static_fit) -> None:
+    value = static_fit["report"]["fits"][0]["values"]["well.side_friction.static"]
+    assert abs(value["value"] / static_fit["truth"] - 1.0) < 0.05
+    assert value["low95"] <= static_fit["truth"] <= value["high95"]
+
+
+def test_a_las_log_is_read_by_mnemonic_and_unit(tmp_path) -> None:
+    """A LAS file (written by lasio) with time in s, SURFACE in rpm and STRING_TORQUE in
+    kN.m reads as the same SI log as its numbers."""
+    import lasio
+    las = lasio.LASFile()
+    t = np.arange(0.0, 1.0, 0.01)
+    las.append_curve("TIME", t, unit="s")
+    las.append_curve("SURFACE", np.full(t.size, 30.0), unit="rpm")
+    las.append_curve("STRING_TORQUE", np.full(t.size, 2.5), unit="kN.m")
+    path = tmp_path / "log.las"
+    with path.open("w") as f:
+        las.write(f)
+    log = read_log(path)
+    assert log.torque_kind == "string"
+    assert np.allclose(log.t_s, t)
+    assert np.allclose(log.speed_rad_s, 30.0 / RPM_PER_RAD_S)
+    assert np.allclose(log.torque_nm, 2500.0)
