@@ -20,7 +20,6 @@ NAMESPACE_URI = "urn:drill_sim_ros"
 DEFAULT_ENDPOINT = "opc.tcp://127.0.0.1:4840/drill_sim/"
 DEFAULT_RIG = "Rig"
 UNECE_URI = "http://www.opcfoundation.org/UA/units/un/cefact"
-DRIVE_MODES = ("speed", "torque")
 # The source timestamp of a value is its simulated time, counted from this instant (UTC).
 SIM_EPOCH_TEXT = "1970-01-01T00:00:00Z"
 
@@ -36,6 +35,18 @@ class RigStatus(IntEnum):
     Faulted = 5             # the safe stop could not be made; Reset to go on
 
 
+class DriveModeEnum(IntEnum):
+    """The rig object's ``DriveMode`` (an enumeration): what a command carries. The names are
+    sim_node's ``top_drive.mode`` values (its kinematic mode shows as speed)."""
+
+    speed = 0               # SpeedSetpoint
+    torque = 1              # TorqueCommand
+
+
+DRIVE_MODE_MEANINGS = {
+    DriveModeEnum.speed: "a command carries SpeedSetpoint (the drive's speed loop)",
+    DriveModeEnum.torque: "a command carries TorqueCommand (the motor torque, no speed loop)",
+}
 STATUS_MEANINGS = {
     RigStatus.WaitingForSim: "no sample from sim_node yet (at start, or after it started "
     "again)",
@@ -47,6 +58,13 @@ STATUS_MEANINGS = {
     RigStatus.SimLost: "a command unanswered, or no sample in free run, for sim_timeout_s",
     RigStatus.Faulted: "the safe stop could not be made (sim_node refused or did not answer "
     "the switch to speed mode); writes are refused until Reset",
+}
+
+# The enumeration DataTypes of the address space: each one's Description and its values'.
+ENUMERATIONS: dict[type[IntEnum], tuple[str, dict[IntEnum, str]]] = {
+    RigStatus: ("what the rig does or waits for (the variable Status)", STATUS_MEANINGS),
+    DriveModeEnum: ("what a command carries, and sim_node's top_drive.mode (the variable "
+                    "DriveMode)", DRIVE_MODE_MEANINGS),
 }
 
 
@@ -81,6 +99,7 @@ class Variable:
     unit: Unit | None = None
     source: tuple[str, int] | None = None
     limit: str = ""
+    enumeration: type[IntEnum] | None = None     # its DataType (Int32 values, EnumStrings)
 
 
 VARIABLES = (
@@ -102,9 +121,10 @@ VARIABLES = (
              NEWTON_METRE, limit="top_drive.max_torque_nm"),
     Variable("WobSetpoint", "Double", True, "applied WOB setpoint", NEWTON,
              limit="limits.max_wob_n"),
-    Variable("DriveMode", "String", True, "what a command carries: speed (SpeedSetpoint) or "
-             "torque (TorqueCommand); a new value switches sim_node's top_drive.mode first, "
-             "and shows sim_node's own switches (its kinematic mode shows as speed)"),
+    Variable("DriveMode", "Int32", True, "DriveModeEnum: what a command carries, speed (0, "
+             "SpeedSetpoint) or torque (1, TorqueCommand); a new value switches sim_node's "
+             "top_drive.mode first, and shows sim_node's own switches (its kinematic mode "
+             "shows as speed)", enumeration=DriveModeEnum),
     Variable("CommandCounter", "UInt32", True, "the client's handshake: SampleCounter + 1 "
              "sends the setpoints as the next period's command"),
     Variable("SampleCounter", "UInt32", False, "the gateway's handshake: set to "
@@ -115,7 +135,7 @@ VARIABLES = (
              "(this counter, a setpoint, CommandCounter) or Step within heartbeat_timeout_s "
              "keeps its ownership (and, in free run, the drive) alive"),
     Variable("Status", "Int32", False, "RigStatus: WaitingForSim, Running, WaitingForClient, "
-             "HeartbeatLost, SimLost, Faulted (EnumStrings)"),
+             "HeartbeatLost, SimLost, Faulted (EnumStrings)", enumeration=RigStatus),
     Variable("StatusText", "String", False, "what the gateway does or waits for, and why, one "
              "line"),
     Variable("ControlPeriod", "Double", False, "sim_node's sample period (1/publish_rate_hz): "
@@ -193,8 +213,8 @@ def _range_text(variable: Variable) -> str:
         return f"±`{variable.limit}`"
     if variable.limit:
         return f"0 … `{variable.limit}`" + (" (in rad/s)" if variable.unit is RAD_S else "")
-    if variable.name == "DriveMode":
-        return " or ".join(DRIVE_MODES)
+    if variable.enumeration is not None:
+        return ", ".join(f"{member.value} {member.name}" for member in variable.enumeration)
     return ""
 
 
@@ -205,7 +225,8 @@ def markdown_table() -> str:
     for v in VARIABLES:
         unit = f"{v.unit.symbol} (`{v.unit.code}`)" if v.unit else "–"
         access = "read/write" if v.writable else "read"
-        lines.append(f"| `{v.name}` | {v.type_name} | {access} | {unit} | "
+        kind = f"{v.enumeration.__name__} (Int32)" if v.enumeration else v.type_name
+        lines.append(f"| `{v.name}` | {kind} | {access} | {unit} | "
                      f"{_range_text(v) or '–'} | {v.meaning} |")
     for name, meaning in METHOD_MEANINGS.items():
         lines.append(f"| `{name}()` | method | call | – | – | {meaning} |")

@@ -1,20 +1,20 @@
 """The asyncua nodes of a rig object (issue 53): values as Variants, the standard properties
 (EngineeringUnits, EURange), Descriptions, the variable types a PLC project expects
-(AnalogItemType, AnalogUnitType), the ``RigStatus`` enumeration with its EnumStrings, and the
-subtree that ``--export-nodeset`` writes."""
+(AnalogItemType, AnalogUnitType), the enumerations (``RigStatus``, ``DriveModeEnum``) with
+their EnumStrings, and the subtree that ``--export-nodeset`` writes."""
 
 from __future__ import annotations
 
 from datetime import datetime, timedelta, timezone
+from enum import IntEnum
 from typing import Any
 
 from asyncua import Server, ua
 from asyncua.common.structures104 import new_enum, new_enum_field
 
 from drill_sim_ros.hil.address_space import (
-    STATUS_MEANINGS,
+    ENUMERATIONS,
     UNECE_URI,
-    RigStatus,
     Variable,
     unece_unit_id,
 )
@@ -50,13 +50,19 @@ async def add_property(node: Any, name: str, value: ua.Variant, data_type: int) 
                                    datatype=ua.NodeId(data_type))
 
 
-async def status_enumeration(server: Server, index: int) -> ua.NodeId:
-    """The DataType ``RigStatus`` (an Enumeration, with EnumStrings) in namespace ``index``."""
-    fields = [new_enum_field(status.name, STATUS_MEANINGS[status]) for status in RigStatus]
-    data_type = await new_enum(server, index, "RigStatus", fields)
-    await data_type.add_property(ua.NodeId("RigStatus.EnumStrings", index),
+async def enumeration(server: Server, index: int, members: type[IntEnum]) -> ua.NodeId:
+    """The Enumeration DataType ``members`` (BrowseName and NodeId its class name, in namespace
+    ``index``), with its Description, its EnumDefinition and EnumStrings, as
+    :data:`~.address_space.ENUMERATIONS` describes it."""
+    description, meanings = ENUMERATIONS[members]
+    name = members.__name__
+    fields = [new_enum_field(member.name, meanings[member]) for member in members]
+    data_type = await new_enum(server, ua.NodeId(name, index), ua.QualifiedName(name, index),
+                               fields)
+    await describe(data_type, description)
+    await data_type.add_property(ua.NodeId(f"{name}.EnumStrings", index),
                                  ua.QualifiedName("EnumStrings", 0), ua.Variant(
-        [ua.LocalizedText(status.name) for status in RigStatus],
+        [ua.LocalizedText(member.name) for member in members],
         ua.VariantType.LocalizedText), datatype=ua.NodeId(ua.ObjectIds.LocalizedText))
     return data_type.nodeid
 

@@ -38,6 +38,7 @@ import weakref
 from collections.abc import Awaitable, Callable, Sequence
 from dataclasses import dataclass
 from datetime import datetime, timezone
+from enum import IntEnum
 from typing import Any
 
 from asyncua import Server, ua
@@ -46,7 +47,7 @@ from asyncua.common.callback import CallbackType
 from drill_sim_ros.control.command import Command
 from drill_sim_ros.hil import sessions
 from drill_sim_ros.hil.address_space import (
-    DRIVE_MODES,
+    ENUMERATIONS,
     METHOD_MEANINGS,
     NAMESPACE_URI,
     RESET_METHOD,
@@ -55,6 +56,7 @@ from drill_sim_ros.hil.address_space import (
     STEP_METHOD,
     VARIABLE_BY_NAME,
     VARIABLES,
+    DriveModeEnum,
     RigStatus,
     Variable,
     exact_setting,
@@ -65,11 +67,11 @@ from drill_sim_ros.hil.address_space import (
 from drill_sim_ros.hil.nodes import (
     add_property,
     describe,
+    enumeration,
     eu_information,
     range_variant,
     retype,
     sim_timestamp,
-    status_enumeration,
     subtree,
     variant,
 )
@@ -86,8 +88,9 @@ MODE_SWITCH_TIMEOUT_S = 5.0
 SUPERVISE_PERIOD_S = 0.05
 PRODUCT_NAME = "drill_sim_ros OPC UA gateway"
 ASYNCUA_SERVER_LOGGER = "asyncua.server.server"   # logs a failed start's traceback
-# switch_mode(mode): None once the simulator drives in ``mode``, else its reason for refusing
-# (TimeoutError, or any OSError, if it does not answer)
+# switch_mode(mode), ``mode`` a DriveModeEnum name (sim_node's top_drive.mode): None once the
+# simulator drives in ``mode``, else its reason for refusing (TimeoutError, or any OSError, if
+# it does not answer)
 SwitchMode = Callable[[str], Awaitable[str | None]]
 
 
@@ -102,7 +105,7 @@ class RigSettings:
     max_wob_n: float
     speed_rad_s: float
     wob_n: float
-    drive_mode: str
+    drive_mode: DriveModeEnum
     lockstep: bool
     control_period_s: float
 
@@ -111,7 +114,7 @@ class RigSettings:
         """The settings of sim_node's parameters (``SIM_PARAMETERS`` of
         :mod:`drill_sim_ros.ros.sim_link`), in SI without a unit round trip's last-digit drift
         (:func:`exact_setting`, :func:`rad_s_of_rpm`); sim_node's kinematic mode, which takes
-        speed setpoints too, shows as ``speed``."""
+        speed setpoints too, shows as ``DriveModeEnum.speed``."""
         torque_nm = limit_of_setting(sim["top_drive.max_torque_nm"])     # 0: no limit (inf)
         return cls(
             max_speed_rad_s=rad_s_of_rpm(sim["limits.max_surface_rpm"]),
@@ -119,7 +122,8 @@ class RigSettings:
             max_wob_n=exact_setting(sim["limits.max_wob_n"]),
             speed_rad_s=rad_s_of_rpm(sim["model.surface_rpm"]),
             wob_n=sim["model.applied_wob_n"],
-            drive_mode="torque" if sim["top_drive.mode"] == "torque" else "speed",
+            drive_mode=DriveModeEnum.torque if sim["top_drive.mode"] == "torque"
+            else DriveModeEnum.speed,
             lockstep=bool(sim["lockstep"]) and sim["lockstep_trigger"] == "command",
             control_period_s=1.0 / sim["publish_rate_hz"])
 
@@ -130,7 +134,7 @@ class RigSettings:
 
     def initial(self, name: str) -> Any:
         return {"SpeedSetpoint": self.speed_rad_s, "TorqueCommand": 0.0,
-                "WobSetpoint": self.wob_n, "DriveMode": self.drive_mode,
+                "WobSetpoint": self.wob_n, "DriveMode": int(self.drive_mode),
                 "Lockstep": self.lockstep, "Status": int(RigStatus.WaitingForSim),
                 "StatusText": STATUS_MEANINGS[RigStatus.WaitingForSim],
                 "ControlPeriod": self.control_period_s}.get(
@@ -168,7 +172,7 @@ class Rig:
         self.nodes: dict[str, Any] = {}
         self._ranges: dict[str, Any] = {}               # EURange property nodes by variable
         self._server: Server | None = None
-        self._status_type: ua.NodeId | None = None
+        self._enumerations: dict[type[IntEnum], ua.NodeId] = {}
         self.nodes_of_object: Any = None                # the rig object, once built
         self.values: dict[str, Any] = {v.name: settings.initial(v.name) for v in VARIABLES}
         self._in_force = {"SpeedSetpoint": settings.speed_rad_s, "WobSetpoint": settings.wob_n,
@@ -190,11 +194,11 @@ class Rig:
         self._refused_kinds: dict[tuple[str, int], int] = {}
 
     # -- the address space ----------------------------------------------------------------
-    async def build(self, server: Server, index: int, status_type: ua.NodeId
-                    ) -> dict[ua.NodeId, str]:
-        """Add the rig object under Objects (``Status`` of the enumeration ``status_type``);
-        its writable variables' names by NodeId."""
-        self._server, self._status_type = server, status_type
+    async def build(self, server: Server, index: int,
+                    enumerations: dict[type[IntEnum], ua.NodeId]) -> dict[ua.NodeId, str]:
+        """Add the rig object under Objects (``Status`` and ``DriveMode`` of their enumeration
+        DataTypes, ``enumerations``); its writable variables' names by NodeId."""
+        self._server, self._enumerations = server, enumerations
         rig = await server.nodes.objects.add_object(ua.NodeId(self.name, index),
                                                     ua.QualifiedName(self.name, index))
         for variable in VARIABLES:
@@ -218,8 +222,7 @@ class Rig:
         node = await rig.add_variable(ua.NodeId(node_id(self.name, variable.name), index),
                                       ua.QualifiedName(variable.name, index),
                                       variant(variable, self.values[variable.name]),
-                                      datatype=self._status_type if variable.name == "Status"
-                                      else None)
+                                      datatype=self._enumerations.get(variable.enumeration))
         if variable.writable:
             await node.set_writable()
         await describe(node, variable.meaning)
@@ -291,7 +294,7 @@ class Rig:
         if settings.control_period_s != self.values["ControlPeriod"]:
             await self._set("ControlPeriod", settings.control_period_s)
         if settings.drive_mode != self.values["DriveMode"]:
-            await self._set("DriveMode", settings.drive_mode)
+            await self._set("DriveMode", int(settings.drive_mode))
             self._in_force = _unset_setpoints()        # the new mode's setpoint goes next
         if settings != old:
             _log.info("%s follows its sim_node: %s", self.name, settings)
@@ -315,8 +318,9 @@ class Rig:
             return Bad.BadInvalidState, value
         if name == "Heartbeat":
             return None, value
-        if name == "DriveMode":
-            return (None if value in DRIVE_MODES else Bad.BadOutOfRange), value
+        if variable.enumeration is not None:
+            known = value in {member.value for member in variable.enumeration}
+            return (None if known else Bad.BadOutOfRange), value
         if name == "CommandCounter":
             return self._check_counter(value), value
         inside = within(value, *self.settings.eu_range(name))
@@ -383,7 +387,7 @@ class Rig:
         if mode == self.values["DriveMode"] or self._switch_mode is None:
             return
         try:
-            reason = await asyncio.wait_for(self._switch_mode(mode),
+            reason = await asyncio.wait_for(self._switch_mode(DriveModeEnum(mode).name),
                                             self.timing.mode_switch_timeout_s)
         except (TimeoutError, OSError) as exc:
             await self.refuse("DriveMode", Bad.BadTimeout, mode, f"sim_node: {exc!r}")
@@ -405,7 +409,8 @@ class Rig:
     def _command(self, values: dict[str, Any], counter: int) -> None:
         """Send the setpoints of ``values`` as the command counted ``counter``: the drive
         mode's setpoint and the WOB, each only if it differs from the one in force."""
-        chosen = "SpeedSetpoint" if values["DriveMode"] == "speed" else "TorqueCommand"
+        chosen = ("SpeedSetpoint" if values["DriveMode"] == DriveModeEnum.speed
+                  else "TorqueCommand")
         changed = {name: values[name] for name in (chosen, "WobSetpoint")
                    if values[name] != self._in_force[name]}
         self._in_force.update(changed)
@@ -549,15 +554,15 @@ class Rig:
         """Start the ramp to zero speed, from the setpoint in force (speed mode) or from the
         measured speed once sim_node has switched to speed mode (torque mode)."""
         start = self.values["SpeedSetpoint"]
-        if self.values["DriveMode"] != "speed":
+        if self.values["DriveMode"] != DriveModeEnum.speed:
             try:
-                await self.switch_drive({"DriveMode": "speed"})
+                await self.switch_drive({"DriveMode": int(DriveModeEnum.speed)})
             except ua.UaStatusCodeError as exc:
                 self.latched = (RigStatus.Faulted, "heartbeat lost, and sim_node did not switch "
                                 f"to speed mode for the safe stop ({exc}); Reset to go on")
                 _log.error("%s: %s", self.name, self.latched[1])
                 return
-            await self._set("DriveMode", "speed")
+            await self._set("DriveMode", int(DriveModeEnum.speed))
             start = self.values["DriveSpeed"]
         self._ramp = (max(0.0, min(start, self.settings.max_speed_rad_s)), self.latest_ns)
 
@@ -618,7 +623,7 @@ class RigServer:
         self.endpoint, self.rigs = endpoint, tuple(rigs)
         self._writable: dict[ua.NodeId, tuple[Rig, str]] = {}
         self._supervisor: asyncio.Task[None] | None = None
-        self.status_type: ua.NodeId | None = None
+        self.enumerations: dict[type[IntEnum], ua.NodeId] = {}
 
     async def start(self) -> None:
         await self.build()
@@ -636,15 +641,18 @@ class RigServer:
         self.server.set_force_server_timestamp(True)
         await self._secure()
         index = await self.server.register_namespace(NAMESPACE_URI)
-        self.status_type = await status_enumeration(self.server, index)
+        self.enumerations = {members: await enumeration(self.server, index, members)
+                             for members in ENUMERATIONS}
         for rig in self.rigs:
-            for nodeid, name in (await rig.build(self.server, index, self.status_type)).items():
+            for nodeid, name in (await rig.build(self.server, index, self.enumerations)).items():
                 self._writable[nodeid] = (rig, name)
 
     async def export_nodeset(self, path: str) -> None:
-        """The rigs' address space (namespace :data:`NAMESPACE_URI`: the RigStatus DataType,
+        """The rigs' address space (namespace :data:`NAMESPACE_URI`: the enumeration DataTypes,
         the rig objects, their variables, properties and methods) as a NodeSet2 XML file."""
-        nodes = await subtree(self.server.get_node(self.status_type))
+        nodes = []
+        for data_type in self.enumerations.values():
+            nodes += await subtree(self.server.get_node(data_type))
         for rig in self.rigs:
             nodes += await subtree(rig.nodes_of_object)
         await self.server.export_xml(nodes, path, export_values=True)

@@ -287,7 +287,7 @@ async def serve(node: GatewayNode, settings: list[RigSettings]) -> None:
     for link, rig in zip(node.links, rigs, strict=True):
         node.get_logger().info(f"serving {rig.name} ({link.sim_node}) at {node.endpoint} "
                                f"(lockstep {rig.settings.lockstep}, drive mode "
-                               f"{rig.settings.drive_mode})")
+                               f"{rig.settings.drive_mode.name})")
     try:
         while rclpy.ok():
             try:

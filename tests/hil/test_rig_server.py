@@ -31,13 +31,16 @@ import pytest
 from asyncua import Client, Server, ua
 
 from drill_sim_ros.control.command import Command
-from drill_sim_ros.hil.address_space import VARIABLE_BY_NAME, VARIABLES, RigStatus
+from drill_sim_ros.hil.address_space import VARIABLE_BY_NAME, VARIABLES, DriveModeEnum, RigStatus
 from drill_sim_ros.hil.rig_server import Rig, RigServer, RigSettings, RigTiming
 from drill_sim_ros.hil.security import APPLICATION_URI
 
 DOUBLE, UINT32, STRING = ua.VariantType.Double, ua.VariantType.UInt32, ua.VariantType.String
+INT32 = ua.VariantType.Int32
+SPEED, TORQUE = 0, 1                     # DriveModeEnum's values (docs/hil.md)
 SETTINGS = RigSettings(max_speed_rad_s=30.0, max_torque_nm=50_000.0, max_wob_n=1e6,
-                       speed_rad_s=4.0, wob_n=60_000.0, drive_mode="speed", lockstep=True,
+                       speed_rad_s=4.0, wob_n=60_000.0, drive_mode=DriveModeEnum.speed,
+                       lockstep=True,
                        control_period_s=0.01)
 SAMPLE = {"DriveSpeed": 4.0, "MotorTorque": 1.0, "QuillTorque": 2.0, "HookLoad": 3.0,
           "WobEstimate": 5.0, "BitDepth": 0.0, "Rop": 0.0, "SimTime": 0.0}
@@ -158,29 +161,53 @@ async def switch_the_drive() -> None:
         await client.write_values(
             [north.nodes["DriveMode"], north.nodes["TorqueCommand"],
              north.nodes["CommandCounter"]],
-            [ua.Variant("torque", STRING), ua.Variant(-1234.5, DOUBLE), ua.Variant(1, UINT32)])
+            [ua.Variant(TORQUE, INT32), ua.Variant(-1234.5, DOUBLE), ua.Variant(1, UINT32)])
         assert stand_in.switches == ["torque"]
         (command, _), = stand_in.commands
         assert (command.motor_torque_nm, command.speed_rad_s) == (-1234.5, None)
         assert command.wob_n == SETTINGS.wob_n      # nothing known in force after a switch
-        await north.nodes["DriveMode"].write_value(ua.Variant("torque", STRING))
+        await north.nodes["DriveMode"].write_value(ua.Variant(TORQUE, INT32))
         assert stand_in.switches == ["torque"]      # the mode it has: no switch
-        for wrong in ("kinematic", "Speed", ""):
+        for wrong in (2, -1, 2**31 - 1):
             with pytest.raises(ua.uaerrors.BadOutOfRange):
-                await north.nodes["DriveMode"].write_value(ua.Variant(wrong, STRING))
-        with pytest.raises(ua.uaerrors.BadTypeMismatch):
-            await north.nodes["DriveMode"].write_value(ua.Variant(1, ua.VariantType.Int32))
+                await north.nodes["DriveMode"].write_value(ua.Variant(wrong, INT32))
+        for wrong_type in (ua.Variant("torque", STRING), ua.Variant(1, UINT32)):
+            with pytest.raises(ua.uaerrors.BadTypeMismatch):
+                await north.nodes["DriveMode"].write_value(wrong_type)
         assert stand_in.switches == ["torque"]
-        assert await north.value("RejectedWrites") == 4
+        assert await north.value("RejectedWrites") == 5
         stand_in.refuse_with = "the drive would be unstable"
         with pytest.raises(ua.uaerrors.BadInvalidState):
-            await north.nodes["DriveMode"].write_value(ua.Variant("speed", STRING))
+            await north.nodes["DriveMode"].write_value(ua.Variant(SPEED, INT32))
         assert (await north.value("DriveMode"), await north.value("RejectedWrites")) == (
-            "torque", 5)
+            TORQUE, 6)
 
 
 def test_drive_mode_switches_the_simulators_drive_and_wrong_modes_are_refused() -> None:
     run(switch_the_drive())
+
+
+async def drive_mode_enumeration() -> None:
+    async with serving() as (rigs, stand_ins, client):
+        await first_samples(rigs)
+        north, stand_in = await view(client, "north"), stand_ins["north"]
+        mode = north.nodes["DriveMode"]
+        type_node = client.get_node(await mode.read_data_type())
+        assert (await type_node.read_browse_name()).Name == "DriveModeEnum"
+        supertype = await type_node.get_parent()       # by HasSubtype: a DataType's parent
+        assert supertype.nodeid == ua.NodeId(ua.ObjectIds.Enumeration)
+        names = await (await type_node.get_child("0:EnumStrings")).read_value()
+        assert [n.Text for n in names] == ["speed", "torque"]
+        description = (await type_node.read_description()).Text
+        assert description not in ("", "DriveModeEnum")
+        assert await mode.read_value() == SPEED
+        await mode.write_value(ua.Variant(TORQUE, INT32))       # 1: torque, by EnumStrings
+        assert stand_in.switches == ["torque"]
+        assert await mode.read_value() == TORQUE
+
+
+def test_drive_mode_is_an_enumeration_and_writing_1_switches_to_torque() -> None:
+    run(drive_mode_enumeration())
 
 
 async def an_unanswered_switch() -> None:
@@ -188,9 +215,9 @@ async def an_unanswered_switch() -> None:
         north = await view(client, "north")
         stand_ins["north"].silent = True
         with pytest.raises(ua.uaerrors.BadTimeout):
-            await north.nodes["DriveMode"].write_value(ua.Variant("torque", STRING))
+            await north.nodes["DriveMode"].write_value(ua.Variant(TORQUE, INT32))
         assert (await north.value("DriveMode"), await north.value("RejectedWrites")) == (
-            "speed", 1)
+            SPEED, 1)
 
 
 def test_a_switch_the_simulator_does_not_answer_is_bad_timeout() -> None:
@@ -205,12 +232,12 @@ async def follow_the_settings() -> None:
         north = await view(client, "north")
         await north.nodes["SpeedSetpoint"].write_value(ua.Variant(20.0, DOUBLE))   # allowed
         await rigs["north"].follow(replace(SETTINGS, max_speed_rad_s=10.0, max_torque_nm=7.0,
-                                           lockstep=False, drive_mode="torque"))
+                                           lockstep=False, drive_mode=DriveModeEnum.torque))
         assert await north.eu_range("SpeedSetpoint") == (0.0, 10.0)
         assert await north.eu_range("TorqueCommand") == (-7.0, 7.0)
         assert await north.eu_range("WobSetpoint") == (0.0, SETTINGS.max_wob_n)
         assert (await north.value("Lockstep"), await north.value("DriveMode")) == (
-            False, "torque")
+            False, TORQUE)
         with pytest.raises(ua.uaerrors.BadOutOfRange):
             await north.nodes["SpeedSetpoint"].write_value(ua.Variant(20.0, DOUBLE))
         await north.nodes["SpeedSetpoint"].write_value(ua.Variant(10.0, DOUBLE))
@@ -293,7 +320,7 @@ async def an_array_to_a_scalar(caplog: pytest.LogCaptureFixture) -> None:
         north = await view(client, "north")
         for name, value in (("SpeedSetpoint", ua.Variant([3.0], DOUBLE)),
                             ("CommandCounter", ua.Variant([1], UINT32)),
-                            ("DriveMode", ua.Variant(["torque"], STRING))):
+                            ("DriveMode", ua.Variant([TORQUE], INT32))):
             with pytest.raises(ua.uaerrors.BadTypeMismatch):
                 await north.nodes[name].write_value(value)
         assert await north.value("RejectedWrites") == 3
@@ -527,6 +554,12 @@ async def export_and_import(path: Path) -> None:
     status_type = fresh.get_node(await nodes["Status"].read_data_type())
     strings = await (await status_type.get_child("0:EnumStrings")).read_value()
     assert [s.Text for s in strings] == [s.name for s in RigStatus]
+    mode_type = fresh.get_node(await nodes["DriveMode"].read_data_type())
+    assert (await mode_type.read_browse_name()).Name == "DriveModeEnum"
+    assert "command carries" in (await mode_type.read_description()).Text
+    strings = await (await mode_type.get_child("0:EnumStrings")).read_value()
+    assert [s.Text for s in strings] == ["speed", "torque"]
+    assert await nodes["DriveMode"].read_value() == SPEED      # the preset's speed mode
     outputs = await (await nodes["Step"].get_child("0:OutputArguments")).read_value()
     assert [a.Name for a in outputs] == ["SampleCounter"]
 
@@ -539,7 +572,7 @@ async def safe_stop_in_torque_mode(refuse: bool) -> None:
     async with serving(heartbeat_timeout_s=0.2, safe_ramp_rad_s2=RAMP_RAD_S2) as (
             rigs, stand_ins, client):
         rig, stand_in = rigs["north"], stand_ins["north"]
-        await rig.follow(replace(FREE_RUN, drive_mode="torque"))
+        await rig.follow(replace(FREE_RUN, drive_mode=DriveModeEnum.torque))
         await rig.sample_in(SAMPLE | {"DriveSpeed": 3.0}, 0)
         north = await view(client, "north")
         await client.write_values([north.nodes["TorqueCommand"], north.nodes["CommandCounter"]],
@@ -559,7 +592,7 @@ async def safe_stop_in_torque_mode(refuse: bool) -> None:
             await feed(rig, 0, 150)                  # 3 rad/s at 2 rad/s^2: at rest in 1.5 s
             speeds = [c.speed_rad_s for c, _ in stand_in.commands[sent:]]
             assert speeds[0] == 3.0 - RAMP_RAD_S2 * 0.01 and speeds[-1] == 0.0
-            assert await other.value("DriveMode") == "speed"
+            assert await other.value("DriveMode") == SPEED
 
 
 @pytest.mark.parametrize("refuse", [False, True])
