@@ -32,7 +32,8 @@ from bench_node import stop  # the sibling script (benchmarks/ is on sys.path wh
 
 BIN = Path(sys.prefix) / "bin"
 START_TIMEOUT_S = 90.0
-DOUBLE, UINT32 = ua.VariantType.Double, ua.VariantType.UInt32
+DOUBLE, UINT32, INT32 = ua.VariantType.Double, ua.VariantType.UInt32, ua.VariantType.Int32
+SPEED_MODE = 0                    # DriveMode (DriveModeEnum): the law gives speed setpoints
 
 
 def speed_rad_s(quill_torque_nm: float) -> float:
@@ -108,6 +109,8 @@ async def by_step(client: Client, periods: int) -> float:
 async def measure(url: str, periods: int) -> dict[str, float]:
     client = await connect(url)
     try:
+        _, _, nodes = await rig_nodes(client)
+        await nodes["DriveMode"].write_value(ua.Variant(SPEED_MODE, INT32))    # not timed
         rates = {"counters, SampleCounter polled": await by_counters(client, periods, None)}
         events = SampleEvents()
         _, _, nodes = await rig_nodes(client)

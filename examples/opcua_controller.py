@@ -4,7 +4,8 @@
     opcua_gateway
     python examples/opcua_controller.py --periods 3000
 
-Each period, like a PLC's cyclic task: read the quill torque of the latest sample, run the
+At start, the drive goes to speed mode (DriveMode, an enumeration: 0 speed, 1 torque). Each
+period, like a PLC's cyclic task: read the quill torque of the latest sample, run the
 law, write the speed setpoint and CommandCounter = SampleCounter + 1 in one request, and poll
 SampleCounter until the gateway says that period's sample is in (docs/hil.md). The law: a PI
 on the string torque that lowers the speed setpoint as the torque rises above its nominal.
@@ -23,6 +24,7 @@ KI_RAD_S2_PER_NM = 5e-5
 PERIOD_S = 0.01                   # sim_node's publish period (publish_rate_hz 100)
 MAX_SPEED_RAD_S = 20.0
 WAITING_FOR_SIM = 0               # the rig's Status (RigStatus) before its first sample
+SPEED_MODE = 0                    # the rig's DriveMode (DriveModeEnum): speed setpoints
 
 
 def pi_step(integral_nm_s: float, string_torque_nm: float) -> tuple[float, float]:
@@ -60,6 +62,8 @@ async def run(endpoint: str, periods: int, rig: str, wait_s: float) -> None:
         v = await rig_variables(client, rig)
         while await v["Status"].read_value() == WAITING_FOR_SIM:   # the first sample is in
             await asyncio.sleep(0.1)
+        # the law gives speed setpoints: the drive in speed mode (nothing happens if it is)
+        await v["DriveMode"].write_value(ua.Variant(SPEED_MODE, ua.VariantType.Int32))
         counter, integral = await v["SampleCounter"].read_value(), 0.0
         for _ in range(periods):
             speed, integral = pi_step(integral, await v["QuillTorque"].read_value())

@@ -220,7 +220,7 @@ def _range_text(variable: Variable) -> str:
 
 def markdown_table() -> str:
     """The address space as the Markdown table of docs/hil.md."""
-    lines = ["| BrowseName | type | access | unit (UNECE) | EURange | meaning |",
+    lines = ["| BrowseName | type | access | unit (UNECE) | EURange or values | meaning |",
              "| --- | --- | --- | --- | --- | --- |"]
     for v in VARIABLES:
         unit = f"{v.unit.symbol} (`{v.unit.code}`)" if v.unit else "–"

@@ -2,13 +2,15 @@
 (issue 53), statement for statement: one call of :meth:`RigHandshake.cycle` is one scan of
 the PLC task. Its inputs are what the task read this scan (one read list) and what its
 write-list instruction reported; its outputs say whether to start the write list this scan.
-Keep the two in step: tests/ros/test_opcua_commissioning.py closes the loop with it against
-the real gateway.
+:class:`RigStatus` and :class:`DriveModeEnum` are the block's ENUM TYPEs, written out as a
+PLC project has them (not taken from the gateway's code). Keep the two in step:
+tests/ros/test_opcua_commissioning.py closes the loop with it against the real gateway.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from enum import IntEnum
 
 # States (the ST block's constants)
 IDLE, WRITING, WAITING, DONE, FAILED = 0, 10, 20, 30, 90
@@ -16,8 +18,28 @@ IDLE, WRITING, WAITING, DONE, FAILED = 0, 10, 20, 30, 90
 WRITE_REFUSED = 0x8001     # the write list came back Bad (RejectedWrites counts it)
 SAMPLE_TIMEOUT = 0x8002    # SampleCounter did not reach CommandCounter in TimeoutCycles
 RIG_NOT_READY = 0x8003     # Status is WaitingForSim, HeartbeatLost, SimLost or Faulted
-RUNNING, WAITING_FOR_CLIENT = 1, 2
 UDINT_MODULUS = 2**32
+
+
+class RigStatus(IntEnum):
+    """TYPE RigStatus (DINT): the values of the gateway's RigStatus EnumStrings."""
+
+    WaitingForSim = 0
+    Running = 1
+    WaitingForClient = 2
+    HeartbeatLost = 3
+    SimLost = 4
+    Faulted = 5
+
+
+class DriveModeEnum(IntEnum):
+    """TYPE DriveModeEnum (DINT): what the write list's DriveMode carries."""
+
+    speed = 0
+    torque = 1
+
+
+READY = (RigStatus.Running, RigStatus.WaitingForClient)
 
 
 @dataclass
@@ -27,12 +49,12 @@ class RigHandshake:
     # VAR_INPUT
     execute: bool = False              # rising edge: send the setpoints with the next count
     sample_counter: int = 0            # Rig.SampleCounter, read this scan
-    status: int = 0                    # Rig.Status (RigStatus), read this scan
+    status: RigStatus = RigStatus.WaitingForSim    # Rig.Status, read this scan
     write_done: bool = False           # the write list's Done, this scan
     write_error: bool = False          # the write list's Error, this scan
     timeout_cycles: int = 100
     # VAR_OUTPUT
-    do_write: bool = False             # start the write list (setpoints, CommandCounter)
+    do_write: bool = False             # start the write list (DriveMode, setpoints, counter)
     command_counter: int = 0
     done: bool = False
     busy: bool = False
@@ -50,7 +72,7 @@ class RigHandshake:
         self.do_write = False
         if self.state in (IDLE, DONE, FAILED):
             if rising:
-                if self.status not in (RUNNING, WAITING_FOR_CLIENT):
+                if self.status not in READY:
                     self._fail(RIG_NOT_READY)
                 else:
                     self.command_counter = (self.sample_counter + 1) % UDINT_MODULUS
@@ -68,7 +90,7 @@ class RigHandshake:
             self.cycles += 1
             if self.sample_counter == self.command_counter:
                 self.state, self.busy, self.done = DONE, False, True
-            elif self.status not in (RUNNING, WAITING_FOR_CLIENT):
+            elif self.status not in READY:
                 self._fail(RIG_NOT_READY)
             elif self.cycles >= self.timeout_cycles:
                 self._fail(SAMPLE_TIMEOUT)

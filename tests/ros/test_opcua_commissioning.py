@@ -30,7 +30,7 @@ from drill_sim_ros.ros.closed_loop import read_telemetry
 from tests.archive.helpers import BIN, running, stop
 from tests.ros.harness import ros_context
 from tests.ros.opcua_pi_law import pi_step
-from tests.ros.plc_handshake import DONE, IDLE, RigHandshake
+from tests.ros.plc_handshake import DONE, IDLE, DriveModeEnum, RigHandshake
 from tests.ros.test_opcua_gateway import (
     DOUBLE,
     HEARTBEAT_LOST,
@@ -51,6 +51,7 @@ from tests.ros.test_opcua_gateway import (
 
 pytestmark = pytest.mark.ros
 RUNNING, WAITING_FOR_CLIENT = 1, 2
+INT32 = ua.VariantType.Int32
 REST_RAD_S = 0.05          # |drive speed| at rest (the speed loop holds a zero setpoint)
 
 
@@ -129,6 +130,10 @@ async def export_nodeset(path: Path) -> None:
     speed = fresh.get_node(ua.NodeId("Rig.SpeedSetpoint", index))
     assert await speed.read_type_definition() == ua.NodeId(ua.ObjectIds.AnalogItemType)
     assert (await (await speed.get_child("0:EURange")).read_value()).High == 10 * math.pi
+    mode_type = fresh.get_node(await fresh.get_node(ua.NodeId("Rig.DriveMode", index))
+                               .read_data_type())
+    names = await (await mode_type.get_child("0:EnumStrings")).read_value()
+    assert [n.Text for n in names] == [m.name for m in DriveModeEnum]
 
 
 async def commission(url: str, sim: subprocess.Popen, tmp_path: Path) -> None:
@@ -211,7 +216,8 @@ PLC_PERIODS = 300
 
 async def plc_task(url: str, periods: int) -> None:
     """A PLC's cyclic task around FB_RigHandshake (its Python mirror): each scan one read list
-    (SampleCounter, Status, QuillTorque), the block, and the write list when it says so."""
+    (SampleCounter, Status, QuillTorque), the block, and the write list (DriveMode speed, the
+    speed setpoint, CommandCounter) when it says so."""
     client, rig = await connect(url)
     fb, integral, written = RigHandshake(), 0.0, 0
     reads = [rig.nodes[name] for name in ("SampleCounter", "Status", "QuillTorque")]
@@ -229,7 +235,8 @@ async def plc_task(url: str, periods: int) -> None:
             if fb.do_write:
                 integral, written = next_integral, written + 1
                 try:
-                    await rig.write(SpeedSetpoint=ua.Variant(speed, DOUBLE),
+                    await rig.write(DriveMode=ua.Variant(int(DriveModeEnum.speed), INT32),
+                                    SpeedSetpoint=ua.Variant(speed, DOUBLE),
                                     CommandCounter=ua.Variant(fb.command_counter, UINT32))
                     write_done = True
                 except ua.UaStatusCodeError:

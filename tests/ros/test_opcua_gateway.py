@@ -165,7 +165,7 @@ async def check_address_space(rig: Rig) -> None:
     torque = await (await rig.nodes["TorqueCommand"].get_child("0:EURange")).read_value()
     assert torque.Low == -torque.High < 0
     assert await rig.value("Lockstep") is True
-    assert await rig.value("DriveMode") == "speed"
+    assert await rig.value("DriveMode") == 0                  # DriveModeEnum speed
     stamp = (await rig.nodes["SimTime"].read_data_value()).SourceTimestamp
     assert stamp.year == 1970 and await rig.value("SimTime") == 0.0
 
@@ -177,7 +177,8 @@ BAD_WRITES = [  # (variable, variant, status code)
     ("TorqueCommand", ua.Variant(-1e30, DOUBLE), ua.uaerrors.BadOutOfRange),
     ("SpeedSetpoint", ua.Variant(1000.0, DOUBLE), ua.uaerrors.BadOutOfRange),
     ("SpeedSetpoint", ua.Variant(3.0, ua.VariantType.Float), ua.uaerrors.BadTypeMismatch),
-    ("DriveMode", ua.Variant("kinematic", ua.VariantType.String), ua.uaerrors.BadOutOfRange),
+    ("DriveMode", ua.Variant(2, ua.VariantType.Int32), ua.uaerrors.BadOutOfRange),
+    ("DriveMode", ua.Variant("speed", ua.VariantType.String), ua.uaerrors.BadTypeMismatch),
     ("CommandCounter", ua.Variant(1, ua.VariantType.Int64), ua.uaerrors.BadTypeMismatch),
     ("CommandCounter", ua.Variant(2, UINT32), ua.uaerrors.BadInvalidState),   # out of turn
     ("SampleCounter", ua.Variant(1, UINT32), ua.uaerrors.BadNotWritable),

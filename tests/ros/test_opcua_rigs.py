@@ -5,10 +5,12 @@ and opcua_gateway as processes over loopback, a real asyncua client (issue 33).
   a PI law closes the loop on both at once (one through the counters, one through ``Step``,
   for different numbers of periods), and each recording equals the in-process bench of its
   length, bit for bit.
-- A DriveMode write switches sim_node's ``top_drive.mode`` (read back over ROS): in torque
-  mode the commanded torque is the motor torque; wrong modes are refused and counted.
-- sim_node's limits and lockstep, changed at runtime or by a restart with other values, show
-  in the EURanges and ``Lockstep``; after the restart the handshake goes on.
+- A DriveMode write (DriveModeEnum: 0 speed, 1 torque) switches sim_node's
+  ``top_drive.mode`` (read back over ROS): in torque mode the commanded torque is the motor
+  torque; values outside the enumeration are refused and counted.
+- sim_node's limits, lockstep and drive mode, changed at runtime or by a restart with other
+  values, show in the EURanges, ``Lockstep`` and ``DriveMode`` (kinematic as speed, 0); after
+  the restart the handshake goes on.
 """
 
 from __future__ import annotations
@@ -54,7 +56,8 @@ from tests.ros.test_opcua_gateway import (
 )
 
 pytestmark = pytest.mark.ros
-STRING = ua.VariantType.String
+STRING, INT32 = ua.VariantType.String, ua.VariantType.Int32
+SPEED, TORQUE = 0, 1                     # DriveModeEnum's values (docs/hil.md)
 ROS_TIMEOUT_S = 10.0
 
 
@@ -183,7 +186,7 @@ async def switch_modes(url: str, sim: SimParameters) -> None:
     try:
         assert await asyncio.to_thread(sim.get, "top_drive.mode") == "speed"
         # the switch and a torque command in one request: the command carries the torque
-        await rig.write(DriveMode=ua.Variant("torque", STRING),
+        await rig.write(DriveMode=ua.Variant(TORQUE, INT32),
                         TorqueCommand=ua.Variant(12345.0, DOUBLE),
                         CommandCounter=ua.Variant(1, UINT32))
         await wait_sample(rig, 1)
@@ -191,7 +194,7 @@ async def switch_modes(url: str, sim: SimParameters) -> None:
         assert await rig.value("MotorTorque") == 12345.0     # no lag, no rate limit
         await check_wrong_modes(rig)
         assert await asyncio.to_thread(sim.get, "top_drive.mode") == "torque"
-        await rig.write(DriveMode=ua.Variant("speed", STRING),
+        await rig.write(DriveMode=ua.Variant(SPEED, INT32),
                         SpeedSetpoint=ua.Variant(8.0, DOUBLE),
                         TorqueCommand=ua.Variant(777.0, DOUBLE))
         assert await asyncio.to_thread(sim.get, "top_drive.mode") == "speed"
@@ -205,13 +208,13 @@ async def switch_modes(url: str, sim: SimParameters) -> None:
 
 
 async def check_wrong_modes(rig: Rig) -> None:
-    for wrong in ("kinematic", "Torque", ""):
+    for wrong in (2, -1):
         with pytest.raises(ua.uaerrors.BadOutOfRange):
-            await rig.write(DriveMode=ua.Variant(wrong, STRING))
+            await rig.write(DriveMode=ua.Variant(wrong, INT32))
     with pytest.raises(ua.uaerrors.BadTypeMismatch):
-        await rig.write(DriveMode=ua.Variant(1, ua.VariantType.Int32))
-    assert await rig.value("RejectedWrites") == 4
-    assert await rig.value("DriveMode") == "torque"
+        await rig.write(DriveMode=ua.Variant("torque", STRING))
+    assert await rig.value("RejectedWrites") == 3
+    assert await rig.value("DriveMode") == TORQUE
 
 
 def test_drive_mode_switches_sim_nodes_drive(tmp_path: Path) -> None:
@@ -247,6 +250,10 @@ async def follow_at_runtime(url: str, sim: SimParameters) -> None:
         await wait_eu_high(rig, "TorqueCommand", 9000.0)
         with pytest.raises(ua.uaerrors.BadOutOfRange):
             await rig.write(SpeedSetpoint=ua.Variant(25.0, DOUBLE))
+        await asyncio.to_thread(sim.set, top_drive__mode="torque")     # sim_node's own switch
+        await wait_until(rig, "DriveMode", lambda mode: mode == TORQUE)
+        await asyncio.to_thread(sim.set, top_drive__mode="kinematic")  # takes speed setpoints
+        await wait_until(rig, "DriveMode", lambda mode: mode == SPEED)
         await asyncio.to_thread(sim.set, lockstep=False)
         await wait_until(rig, "Lockstep", lambda on: on is False)
     finally:
