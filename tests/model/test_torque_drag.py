@@ -193,7 +193,6 @@ def test_the_dynamic_string_turning_steadily_has_the_static_torque(survey: Any) 
     import yaml
     data = yaml.safe_load(SMALL_DEVIATED)
     data["string"]["torsional_damping_per_s"] = 0.42
-    data["string"]["damping_points"] = 16
     if survey is not None:
         data["well"]["survey"] = survey
     preset = preset_from_dict("steady", data)
