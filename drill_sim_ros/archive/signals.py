@@ -1,8 +1,10 @@
 """One way for the command-line tools to stop on SIGINT, SIGTERM and SIGHUP alike.
 
 Outside rclpy (``drill_sim``, ``mcap_reindex``, ``mcap_to_rerun``), :func:`stop_on_signals`
-turns SIGTERM and SIGHUP (a closed terminal) into the KeyboardInterrupt that SIGINT raises, so
-every tool finishes or discards its output the same way on all three. rclpy tools keep
+turns SIGINT, SIGTERM and SIGHUP (a closed terminal) into one KeyboardInterrupt, named by the
+signal, so every tool finishes or discards its output the same way on all three (SIGINT too
+goes through it, so its first step and last resort hold when it lands inside numba's
+compiler). rclpy tools keep
 rclpy's SIGINT and SIGTERM handling and add :func:`interrupt_on_hangup`.
 
 Python ignores an exception raised while a C callback runs (numba's compiler calls some), so
@@ -15,11 +17,12 @@ from __future__ import annotations
 
 import os
 import signal
+import sys
 import threading
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 
-STOP_SIGNALS = (signal.SIGTERM, signal.SIGHUP)
+STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
 INTERRUPTED_STATUS = 130      # as after Ctrl-C
 
 
@@ -43,7 +46,7 @@ def _stopper(on_stop: Callable[[], None] | None,
 @contextmanager
 def stop_on_signals(on_stop: Callable[[], None] | None = None,
                     grace_s: float | None = None) -> Iterator[None]:
-    """Within the block, SIGTERM and SIGHUP raise KeyboardInterrupt (named by the signal),
+    """Within the block, SIGINT, SIGTERM and SIGHUP raise KeyboardInterrupt (named by the signal),
     after ``on_stop()`` and, with ``grace_s``, arming the last resort (module doc). Outside
     the main thread (a test calling a tool in process) nothing changes."""
     if threading.current_thread() is not threading.main_thread():
@@ -51,11 +54,24 @@ def stop_on_signals(on_stop: Callable[[], None] | None = None,
         return
     handler = _stopper(on_stop, grace_s)
     previous = {sig: signal.signal(sig, handler) for sig in STOP_SIGNALS}
+    hook, sys.unraisablehook = sys.unraisablehook, _quiet_stop(sys.unraisablehook)
     try:
         yield
     finally:
         for sig, old in previous.items():
             signal.signal(sig, old)
+        sys.unraisablehook = hook
+
+
+def _quiet_stop(hook: Callable[[object], None]) -> Callable[[object], None]:
+    """``sys.unraisablehook`` that drops the stop's own KeyboardInterrupt where Python could
+    not raise it (a callback, e.g. inside numba's compiler: "Exception ignored in ...", a
+    traceback the user did not cause); the last resort ends the process then. Anything else
+    goes to ``hook``."""
+    def quiet(unraisable: object) -> None:
+        if not isinstance(getattr(unraisable, "exc_value", None), KeyboardInterrupt):
+            hook(unraisable)
+    return quiet
 
 
 def interrupt_on_hangup() -> None:

@@ -43,7 +43,9 @@ class WaveLine:
     (top to bottom) its travel time in tau, impedance, the point damper below it, its length
     in m, and the wall friction at the junction below it: the static and dynamic limits of
     its torque (force), the stick band and the surface slip per unit speed (the rows of
-    ``wave_f``; empty: no wall contact)."""
+    ``wave_f``; empty: no wall contact). ``cells``: every part is one cell of the wave
+    guide's step (a walled string, :func:`wall_cells`), one step of the delay lines at any
+    step the simulator runs (:func:`line_steps`)."""
 
     travel_tau: tuple[float, ...]
     impedance: tuple[float, ...]
@@ -53,6 +55,7 @@ class WaveLine:
     dynamic_below: tuple[float, ...] = ()
     stick_speed: tuple[float, ...] = ()
     slip_per_speed: tuple[float, ...] = ()
+    cells: bool = False
 
 
 def section_parts(lossy: bool, damping_points: int) -> tuple[tuple[float, ...], int]:
@@ -137,7 +140,7 @@ def _walled_line(spec: StringSpec, axial: bool, time_s: float, z_unit: float,
         top_m += s.length_m
     return WaveLine(tuple(travel), tuple(z), tuple(to_junctions(damp)), tuple(length),
                     tuple(to_junctions(fs)), tuple(to_junctions(fd)), tuple(band),
-                    tuple(slip))
+                    tuple(slip), cells=True)
 
 
 def wave_line(spec: StringSpec, axial: bool, time_s: float, z_unit: float,
@@ -175,7 +178,13 @@ def section_part_counts(spec: StringSpec, axial: bool, wave_step_s: float) -> li
 
 def line_steps(line: WaveLine, dtau: float) -> np.ndarray:
     """Whole steps per part: boundaries rounded on the cumulative travel time, so each one
-    lies within half a step of its true place. ParameterError-free: the caller checks >= 1."""
+    lies within half a step of its true place. ParameterError-free: the caller checks >= 1.
+    A line of cells (``line.cells``) is one step a cell: cut for the preset's wave step, a
+    session's slightly shorter step (whole steps a control period) would round a cell that
+    falls a little short of a step to none; one step a cell keeps every junction, and the
+    string's travel time changes by the ratio of the two steps (below 0.1 %)."""
+    if line.cells:
+        return np.ones(len(line.travel_tau), dtype=np.int64)
     edges = np.rint(np.cumsum(line.travel_tau) / dtau).astype(np.int64)
     return np.diff(np.concatenate(([0], edges)))
 
