@@ -179,13 +179,14 @@ def section_part_counts(spec: StringSpec, axial: bool, wave_step_s: float) -> li
 def line_steps(line: WaveLine, dtau: float) -> np.ndarray:
     """Whole steps per part: boundaries rounded on the cumulative travel time, so each one
     lies within half a step of its true place. ParameterError-free: the caller checks >= 1.
-    A line of cells (``line.cells``) is one step a cell: cut for the preset's wave step, a
-    session's slightly shorter step (whole steps a control period) would round a cell that
-    falls a little short of a step to none; one step a cell keeps every junction, and the
-    string's travel time changes by the ratio of the two steps (below 0.1 %)."""
-    if line.cells:
-        return np.ones(len(line.travel_tau), dtype=np.int64)
+    A line of cells (``line.cells``) keeps at least one step a cell: cut for the preset's
+    wave step, a session's slightly shorter step (whole steps a control period) could round
+    a cell that falls a little short of a step to none; its edge then moves one step down
+    (and the next ones as far as needed), which leaves every other line as rounded."""
     edges = np.rint(np.cumsum(line.travel_tau) / dtau).astype(np.int64)
+    if line.cells:
+        edges = np.maximum(edges, np.arange(1, edges.size + 1))
+        edges = np.maximum.accumulate(edges - np.arange(edges.size)) + np.arange(edges.size)
     return np.diff(np.concatenate(([0], edges)))
 
 
