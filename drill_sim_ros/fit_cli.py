@@ -21,8 +21,7 @@ import yaml
 from drill_sim_ros.fit import engine
 from drill_sim_ros.fit.log import TORQUE_KINDS, SurfaceLog, find_startups, read_log
 from drill_sim_ros.fit.objective import Target, make_target
-from drill_sim_ros.fit.params import DEFAULT_BOUNDS, parse_fit, with_values
-from drill_sim_ros.model.errors import DrillSimError
+from drill_sim_ros.fit.params import DEFAULT_BOUNDS, parse_fit, parse_span, with_values
 from drill_sim_ros.model.presets import preset_from_dict, preset_path
 from drill_sim_ros.model.validate_input import read_preset_file
 from drill_sim_ros.plot_file import (
@@ -69,12 +68,8 @@ def add_parser(sub: Any) -> None:
 def _window(log: SurfaceLog, text: str | None) -> SurfaceLog:
     if text is None:
         return log
-    try:
-        t0, t1 = (float(x) for x in text.split(":"))
-    except ValueError:
-        raise DrillSimError(f"--window {text!r}: expected T0:T1 in s") from None
-    if not t0 < t1:
-        raise DrillSimError(f"--window {text!r}: T0 must be below T1")
+    t0, t1 = parse_span(text, f"--window {text!r}: expected T0:T1 in s",
+                        f"--window {text!r}: T0 must be below T1")
     return log.window(t0, t1)
 
 

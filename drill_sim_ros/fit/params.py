@@ -88,15 +88,22 @@ def parse_fit(text: str, data: dict[str, Any]) -> list[FitParameter]:
     return params
 
 
+def parse_span(text: str, malformed: str, unordered: str) -> tuple[float, float]:
+    """``A:B`` as two numbers with A < B (bounds, a window), or DrillSimError with the
+    caller's one-line ``malformed`` or ``unordered`` message."""
+    try:
+        low, high = (float(x) for x in text.split(":"))
+    except ValueError:
+        raise DrillSimError(malformed) from None
+    if not low < high:
+        raise DrillSimError(unordered)
+    return low, high
+
+
 def _bounds(path: str, value: float, text: str) -> tuple[float, float]:
     if text:
-        try:
-            low, high = (float(x) for x in text.split(":"))
-        except ValueError:
-            raise DrillSimError(f"--fit {path}={text}: bounds are LOW:HIGH numbers") from None
-        if not low < high:
-            raise DrillSimError(f"--fit {path}={text}: LOW must be below HIGH")
-        return low, high
+        return parse_span(text, f"--fit {path}={text}: bounds are LOW:HIGH numbers",
+                          f"--fit {path}={text}: LOW must be below HIGH")
     if path in DEFAULT_BOUNDS:
         return DEFAULT_BOUNDS[path]
     if value <= 0.0:
