@@ -8,7 +8,7 @@ bit; the rounding is in the last bit of each command).
 
 * Observation (float64, shape (7,), :data:`OBSERVATION`): what the rig measures at the
   surface and the driller's setpoints, never downhole truth, each divided by a scale of the
-  rig fixed for the episode (:class:`Scales`), so that it is O(1): the drive's measured
+  rig fixed for the episode (:class:`EpisodeScales`), so that it is O(1): the drive's measured
   speed and the operator's speed setpoint by omega_0 (the setpoint at t = 0), the motor
   torque and the string torque at the quill by the steady-drilling bit torque of the
   preset, the hook load by the string's submerged weight, and the applied-WOB estimate and
@@ -80,7 +80,7 @@ _BIT_RPM, _MOTOR, _ROP = F["bit_rpm"], F["motor_torque_nm"], F["rop_m_s"]
 
 
 @dataclass(frozen=True)
-class Scales:
+class EpisodeScales:
     """The rig's own scales, fixed for an episode, that the observation is divided by and
     an action of 1 is multiplied by (SI; module doc)."""
 
@@ -97,7 +97,7 @@ class Scales:
                          self.wob_n, self.speed_rad_s, self.wob_n))
 
 
-def scales_of(bench: Bench) -> Scales:
+def scales_of(bench: Bench) -> EpisodeScales:
     """The scales of the bench's rig and scenario (module doc)."""
     rig, preset, schedule = bench.rig, bench.preset, bench.schedule
     top_rad_s = rig.max_surface_rpm / RPM_PER_RAD_S
@@ -106,7 +106,7 @@ def scales_of(bench: Bench) -> Scales:
     torque_ref = rig.max_torque_nm if math.isfinite(rig.max_torque_nm) else 10.0 * steady_nm
     weight_n, wob_n = bench.session.submerged_weight_n, schedule.wob_at(0.0)
     wob_scale = wob_n if wob_n > 0 else weight_n
-    return Scales(speed_rad_s=speed if speed > 0 else top_rad_s,
+    return EpisodeScales(speed_rad_s=speed if speed > 0 else top_rad_s,
                   torque_nm=steady_nm if steady_nm > 0 else torque_ref,
                   hook_load_n=weight_n if weight_n > 0 else wob_scale, wob_n=wob_scale,
                   action=top_rad_s if bench.scenario.mode == "speed" else torque_ref,
