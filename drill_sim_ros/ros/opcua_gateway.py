@@ -260,7 +260,10 @@ def _connect(link: SimLink, rig: Rig, loop: asyncio.AbstractEventLoop,
              events: asyncio.Queue[Event]) -> None:
     """Hand ``link``'s samples and settings to ``rig`` through ``events`` (in order)."""
     def put(event: Event) -> None:
-        loop.call_soon_threadsafe(events.put_nowait, event)
+        # a sample that arrives while the gateway stops (the loop closed after the executor's
+        # shutdown waited out its timeout) has nowhere to go: drop it, it is not an error
+        with contextlib.suppress(RuntimeError):
+            loop.call_soon_threadsafe(events.put_nowait, event)
 
     link.on_sample = lambda values, time_ns: put(functools.partial(rig.sample_in, values,
                                                                    time_ns))

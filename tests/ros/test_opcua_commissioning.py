@@ -186,7 +186,7 @@ def test_a_slow_first_start_is_waited_for_with_progress_lines(tmp_path: Path) ->
     text = log.read_text()
     assert "waiting for /slow_start/drill_sim's parameters" in text
     assert "it answers, not all declared yet" in text
-    assert "FATAL" not in text and "Traceback" not in text
+    assert "FATAL" not in text and "Traceback" not in text, text
 
 
 @pytest.mark.parametrize("mismatch", ["uri", "key"])
