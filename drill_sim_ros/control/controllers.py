@@ -299,9 +299,9 @@ class SoftDrive(TopDriveController):
             w0 = m.drive_speed_rad_s
             self._virtual = [w0, t_nm - kp_d * (nominal_rad_s - w0), 0.0, t_nm, 0.0, t_nm]
         w_v, i_d, e, u_old, droop_old, t_old = self._virtual
-        err = nominal_rad_s - w_v
-        i_d += ki_d * err * p
-        tau_v = min(max(kp_d * err + i_d, -self.rig.max_torque_nm), self.rig.max_torque_nm)
+        # the virtual PI loop within the drive's torque limit, its integral held while the
+        # limit holds it (the drive's own loop, model.top_drive.speed_loop)
+        tau_v, i_d = speed_loop(nominal_rad_s, w_v, i_d, kp_d, ki_d, self.rig.max_torque_nm, p)
         accel = (tau_v - t_nm) / j_v
         w_v += accel * p
         admittance, keep = self._droop
