@@ -213,7 +213,9 @@ class SoftDrive(TopDriveController):
     """A softer drive emulated through the setpoint (the shared law of ``soft_torque`` and
     ``z_torque``; module doc). The string torque of the torque sub drives a virtual rotor of
     inertia J_v under a virtual PI loop (kp_d, ki_d) on the operator's setpoint:
-    J_v dw_v/dt = kp_d (w_0 - w_v) + I_d - T, dI_d/dt = ki_d (w_0 - w_v). The setpoint sent
+    J_v dw_v/dt = kp_d (w_0 - w_v) + I_d - T, dI_d/dt = ki_d (w_0 - w_v), the loop's torque
+    within the drive's limit and I_d held while the limit holds it (the drive's own
+    ``speed_loop``: a bit held at the limit does not wind it up). The setpoint sent
     is w_v plus the torque the real drive needs to move so, u = T + J dw_v/dt, through the
     inverse of the drive's own PI loop K (kp e + ki int e = u, a first-order filter whose
     steady state is 0), so the real drive under K moves as the virtual one: its admittance
