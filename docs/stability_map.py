@@ -21,8 +21,8 @@ The maps are run (by the command printed) into --maps unless their files are the
 
 Usage: .venv/bin/python docs/stability_map.py [--maps DIR] [--plot docs/img/stability_map.png]
        [--ensemble N]
-       (the three maps: about 5 min on 2 cores; the prediction: about 20 s; the ensemble
-       of 6 at 5 points: about 4 min on 2 cores)
+       (the three maps: about 5 min on 2 cores; the prediction: about 20 s; the re-runs:
+       about 3 min; the ensemble of 6 at the 4 stalled points: about 3 min on 2 cores)
 """
 
 from __future__ import annotations
@@ -185,10 +185,11 @@ def stall_ensemble(points: list[tuple[int, int]], members: int) -> None:
               f"{static_torque_nm(max(depths)) / 1e3:.0f} kN m)")
 
 
-def plot(path: Path, gains: dict[str, np.ndarray],
-         sims: dict[str, tuple[np.ndarray, ...]]) -> None:
+def plot(path: Path, gains: dict[str, np.ndarray], sims: dict[str, tuple[np.ndarray, ...]],
+         stalled: dict[str, list[tuple[int, int]]]) -> None:
     """One panel per controller: the simulated stick fraction (colour; a ring: stick-slip
-    by the rule), the predicted G = 1 contour and the points where they disagree."""
+    by the rule), the predicted G = 1 contour, the points where they disagree and, of
+    those, the ones whose re-run stalled (a square)."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -203,6 +204,11 @@ def plot(path: Path, gains: dict[str, np.ndarray],
         wrong = (gain > 1.0) != sticks
         ax.scatter(xx[wrong], yy[wrong], marker="x", s=60, c="tab:blue",
                    label="prediction disagrees")
+        held = np.zeros(gain.shape, dtype=bool)
+        for i, j in stalled[name]:
+            held[i, j] = True
+        ax.scatter(xx[held], yy[held], marker="s", s=150, facecolors="none",
+                   edgecolors="tab:purple", linewidths=1.5, label="re-run stalled")
         finite = np.minimum(gain, 10.0)       # a bit unstable by itself: G infinite
         levels = ax.contour(x, y, finite.T, levels=[1.0], colors="tab:blue", linewidths=2)
         ax.clabel(levels, fmt="G = 1", fontsize=8)
@@ -271,14 +277,13 @@ def main() -> int:
     print(f"the bit unstable by itself (G infinite): {alone.sum()} points, at "
           + ", ".join(f"{RPM[i]} rpm {WOB_N[j] / 1e3:.0f} kN" for i, j in zip(*np.nonzero(alone),
                                                                      strict=True)))
-    stalled: set[tuple[int, int]] = set()
-    for c in st.CONTROLLERS:
-        stalled.update(report(c, gains[c], sims[c]))
+    stalled = {c: report(c, gains[c], sims[c]) for c in st.CONTROLLERS}
     bit_check()
-    if args.ensemble > 0 and stalled:
-        stall_ensemble(sorted(stalled), args.ensemble)
+    points = sorted(set().union(*stalled.values()))
+    if args.ensemble > 0 and points:
+        stall_ensemble(points, args.ensemble)
     if args.plot is not None:
-        plot(args.plot, gains, sims)
+        plot(args.plot, gains, sims, stalled)
         print(f"wrote {args.plot}", file=sys.stderr)
     return 0
 
