@@ -9,13 +9,20 @@ stick-slip by the scorecard's rule as far as the map records it: stuck 10 % of t
 or more, or a mean SSI of 1 or more. Printed: per controller the agreement share, and the
 points that disagree with their G, stick fraction and SSI, each run again through the
 bench for the scorecard's status (a stall, the bit held while the drive sits at its torque
-limit, is not the first mode's growth) and its shares at the torque limit and off bottom.
+limit, is not the first mode's growth) and its shares at the torque limit and off bottom;
+where it stalls, the depth of cut the bit stuck at and the torque that holds it still
+(RGD07 eq. 30 at rest, :func:`static_torque_nm`). Then, at every point where a re-run
+stalled, --ensemble members per controller (member k: the bit's sigma l x (1 + k 1e-12),
+``scenario.seeded``): how often each drive stalls there, a chance outcome of the bit's
+bounce (docs/string.md).
 
 The maps are run (by the command printed) into --maps unless their files are there already
 (a re-run resumes them).
 
 Usage: .venv/bin/python docs/stability_map.py [--maps DIR] [--plot docs/img/stability_map.png]
-       (the three maps: about 5 min on 2 cores; the prediction: about 20 s)
+       [--ensemble N]
+       (the three maps: about 5 min on 2 cores; the prediction: about 20 s; the re-runs:
+       about 3 min; the ensemble of 6 at the 4 stalled points: about 3 min on 2 cores)
 """
 
 from __future__ import annotations
@@ -23,16 +30,22 @@ from __future__ import annotations
 import argparse
 import subprocess
 import sys
+from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import numpy as np
 
 from drill_sim_ros.control import stability as st
+from drill_sim_ros.control.scenario import Scenario, seeded
 from drill_sim_ros.control.scorecard import SSI_OK, STICK_FRACTION_OK
+from drill_sim_ros.model.bit_rock import MODE_STUCK
+from drill_sim_ros.model.telemetry import TELEMETRY_INDEX
 
 PRESET = "field_8p5in_shale"
 RPM = (20, 35, 50, 65, 80, 100, 140, 180)
 WOB_N = (40000, 60000, 80000, 100000, 120000, 140000, 160000)
+ENSEMBLE = 6        # members per controller at each point where a re-run stalled
+WORKERS = 2
 
 
 def map_command(controller: str, out: Path) -> list[str]:
@@ -64,19 +77,53 @@ def predicted(tops: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
     return out
 
 
-def rerun(controller: str, rpm: float, wob_n: float) -> dict[str, object]:
-    """The map's point again through the bench, scored over the map's window (90-180 s):
-    the scorecard's status (which tells a stall from stick-slip) and what the map lacks."""
+def rerun(controller: str, rpm: float, wob_n: float, member: int = 0) -> dict[str, object]:
+    """The map's point again through the bench (``member`` of its ensemble; 0: the map's
+    own run), scored over the map's window (90-180 s): the scorecard (whose status tells a
+    stall from stick-slip) and, for a stall, ``stall_depth_m``, the depth of cut per
+    revolution the bit stuck at for good (None otherwise)."""
     from drill_sim_ros.control.bench import run_in_process
-    from drill_sim_ros.control.scenario import Scenario
     scenario = Scenario(preset=PRESET, duration_s=180.0, control_rate_hz=100.0,
                         controller=controller, enable_at_s=60.0,
                         schedule=({"t_s": 0.0, "rpm": rpm, "wob_n": wob_n},))
-    return run_in_process(scenario).score(90.0)
+    run = run_in_process(seeded(scenario, member))
+    card = run.score(90.0)
+    return {**card, "stall_depth_m": stall_depth_m(run.rows, card["stall_time_s"])}
 
 
-def report(controller: str, gain: np.ndarray, sim: tuple[np.ndarray, ...]) -> None:
-    """Agreement, then every disagreeing point with its re-run's status."""
+def stall_depth_m(rows: np.ndarray, stall_s: float | None) -> float | None:
+    """The depth of cut (m per revolution) held through the bit's last stick, from the
+    stall's start on (it does not change while the bit is stuck); None without a stall."""
+    if stall_s is None:
+        return None
+    t, mode = rows[:, TELEMETRY_INDEX["sim_time_s"]], rows[:, TELEMETRY_INDEX["mode"]]
+    held = np.nonzero((t >= stall_s) & (mode == MODE_STUCK))[0]
+    return float(rows[held[0], TELEMETRY_INDEX["depth_of_cut_m"]]) if held.size else None
+
+
+def static_torque_nm(depth_m: float) -> float:
+    """The torque a bit stuck at ``depth_m`` of cut per revolution holds before it slips:
+    RGD07 eq. (30) with the wearflat in full contact, T = eps a^2 d / 2 + mu gamma
+    sigma l a^2 / 2 (the preset's law is weakened only while it turns)."""
+    p = st.checked_preset(PRESET).physical
+    a2 = p.bit_radius_m ** 2
+    return 0.5 * a2 * (p.intrinsic_specific_energy_pa * depth_m
+                       + p.mu_gamma * p.contact_stress_times_wearflat_n_per_m)
+
+
+def stall_text(card: dict[str, object]) -> str:
+    """``stalled at t s, d mm: holds T kN m`` for a stalled re-run, else its status."""
+    depth = card["stall_depth_m"]
+    if card["status"] != "stalled" or depth is None:
+        return str(card["status"])
+    return (f"stalled at {card['stall_time_s']:.0f} s, {1e3 * depth:.0f} mm: holds "
+            f"{static_torque_nm(depth) / 1e3:.0f} kN m")
+
+
+def report(controller: str, gain: np.ndarray, sim: tuple[np.ndarray, ...]
+           ) -> list[tuple[int, int]]:
+    """Agreement, then every disagreeing point with its re-run's status; the stalled
+    points' (rpm, WOB) grid indices."""
     sticks, stuck, ssi = sim
     agree = (gain > 1.0) == sticks
     print(f"\n{controller}: agreement {agree.sum()} of {agree.size} "
@@ -85,24 +132,64 @@ def report(controller: str, gain: np.ndarray, sim: tuple[np.ndarray, ...]) -> No
     print("| rpm | WOB kN | G | predicted | stuck | SSI | simulated | re-run: status, "
           "at the torque limit, off bottom |")
     print("|---|---|---|---|---|---|---|---|")
-    stalls = 0
+    stalled = []
     for i, j in zip(*np.nonzero(~agree), strict=True):
         card = rerun(controller, float(RPM[i]), float(WOB_N[j]))
-        stalls += card["status"] == "stalled"
+        if card["status"] == "stalled":
+            stalled.append((int(i), int(j)))
         print(f"| {RPM[i]} | {WOB_N[j] / 1e3:.0f} | {gain[i, j]:.2f} | "
               f"{'grows' if gain[i, j] > 1 else 'decays'} | {stuck[i, j]:.2f} | "
               f"{ssi[i, j]:.2f} | {'stick-slip' if sticks[i, j] else 'ok'} | "
-              f"{card['status']}, {card['saturation_fraction']:.2f}, "
+              f"{stall_text(card)}, {card['saturation_fraction']:.2f}, "
               f"{card['off_bottom_fraction']:.2f} |")
-    kept = agree.size - stalls
-    print(f"{controller}: without the {stalls} stalled points: {agree.sum()} of {kept} "
+    kept = agree.size - len(stalled)
+    print(f"{controller}: without the {len(stalled)} stalled points: {agree.sum()} of {kept} "
           f"({agree.sum() / kept:.0%})")
+    return stalled
 
 
-def plot(path: Path, gains: dict[str, np.ndarray],
-         sims: dict[str, tuple[np.ndarray, ...]]) -> None:
+def _member_status(job: tuple[str, float, float, int]) -> tuple[str, float | None]:
+    card = rerun(*job)
+    return str(card["status"]), card["stall_depth_m"]
+
+
+def stall_ensemble(points: list[tuple[int, int]], members: int) -> None:
+    """At each point, ``members`` runs per controller: how many stall, stick-slip or are
+    ok, and the depths of cut the stalled ones stuck at (each run on its own process,
+    ``WORKERS`` at a time)."""
+    print(f"\nstalls over an ensemble of {members} (member k: sigma l x (1 + k 1e-12)): "
+          "stalled / stick-slip / ok, per controller")
+    print("| rpm | WOB kN | " + " | ".join(st.CONTROLLERS) + " |")
+    print("|---|---|" + "---|" * len(st.CONTROLLERS))
+    jobs = [(c, float(RPM[i]), float(WOB_N[j]), k) for i, j in points
+            for c in st.CONTROLLERS for k in range(members)]
+    with ProcessPoolExecutor(WORKERS) as pool:
+        results = iter(pool.map(_member_status, jobs))
+        totals = {c: 0 for c in st.CONTROLLERS}
+        depths: list[float] = []
+        for i, j in points:
+            cells = []
+            for c in st.CONTROLLERS:
+                runs = [next(results) for _ in range(members)]
+                counts = [sum(s == name for s, _ in runs)
+                          for name in ("stalled", "stick-slip", "ok")]
+                totals[c] += counts[0]
+                depths += [d for s, d in runs if s == "stalled" and d is not None]
+                cells.append(" / ".join(str(n) for n in counts))
+            print(f"| {RPM[i]} | {WOB_N[j] / 1e3:.0f} | " + " | ".join(cells) + " |")
+    print("stalled in all: " + ", ".join(f"{c} {n} of {members * len(points)}"
+                                         for c, n in totals.items()))
+    if depths:
+        print(f"depth of cut at the stalls: {1e3 * min(depths):.0f}-{1e3 * max(depths):.0f} mm "
+              f"(holding {static_torque_nm(min(depths)) / 1e3:.0f}-"
+              f"{static_torque_nm(max(depths)) / 1e3:.0f} kN m)")
+
+
+def plot(path: Path, gains: dict[str, np.ndarray], sims: dict[str, tuple[np.ndarray, ...]],
+         stalled: dict[str, list[tuple[int, int]]]) -> None:
     """One panel per controller: the simulated stick fraction (colour; a ring: stick-slip
-    by the rule), the predicted G = 1 contour and the points where they disagree."""
+    by the rule), the predicted G = 1 contour, the points where they disagree and, of
+    those, the ones whose re-run stalled (a square)."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -117,6 +204,11 @@ def plot(path: Path, gains: dict[str, np.ndarray],
         wrong = (gain > 1.0) != sticks
         ax.scatter(xx[wrong], yy[wrong], marker="x", s=60, c="tab:blue",
                    label="prediction disagrees")
+        held = np.zeros(gain.shape, dtype=bool)
+        for i, j in stalled[name]:
+            held[i, j] = True
+        ax.scatter(xx[held], yy[held], marker="s", s=150, facecolors="none",
+                   edgecolors="tab:purple", linewidths=1.5, label="re-run stalled")
         finite = np.minimum(gain, 10.0)       # a bit unstable by itself: G infinite
         levels = ax.contour(x, y, finite.T, levels=[1.0], colors="tab:blue", linewidths=2)
         ax.clabel(levels, fmt="G = 1", fontsize=8)
@@ -163,6 +255,8 @@ def main() -> int:
     parser.add_argument("--maps", type=Path, default=Path("stability_maps"),
                         help="folder of the map files (run there if absent)")
     parser.add_argument("--plot", type=Path, default=None, help="PNG to write")
+    parser.add_argument("--ensemble", type=int, default=ENSEMBLE,
+                        help="members per controller at each stalled point (0: none)")
     args = parser.parse_args()
     args.maps.mkdir(parents=True, exist_ok=True)
     sims = {}
@@ -183,11 +277,13 @@ def main() -> int:
     print(f"the bit unstable by itself (G infinite): {alone.sum()} points, at "
           + ", ".join(f"{RPM[i]} rpm {WOB_N[j] / 1e3:.0f} kN" for i, j in zip(*np.nonzero(alone),
                                                                      strict=True)))
-    for c in st.CONTROLLERS:
-        report(c, gains[c], sims[c])
+    stalled = {c: report(c, gains[c], sims[c]) for c in st.CONTROLLERS}
     bit_check()
+    points = sorted(set().union(*stalled.values()))
+    if args.ensemble > 0 and points:
+        stall_ensemble(points, args.ensemble)
     if args.plot is not None:
-        plot(args.plot, gains, sims)
+        plot(args.plot, gains, sims, stalled)
         print(f"wrote {args.plot}", file=sys.stderr)
     return 0
 

@@ -213,7 +213,9 @@ class SoftDrive(TopDriveController):
     """A softer drive emulated through the setpoint (the shared law of ``soft_torque`` and
     ``z_torque``; module doc). The string torque of the torque sub drives a virtual rotor of
     inertia J_v under a virtual PI loop (kp_d, ki_d) on the operator's setpoint:
-    J_v dw_v/dt = kp_d (w_0 - w_v) + I_d - T, dI_d/dt = ki_d (w_0 - w_v). The setpoint sent
+    J_v dw_v/dt = kp_d (w_0 - w_v) + I_d - T, dI_d/dt = ki_d (w_0 - w_v), the loop's torque
+    within the drive's limit and I_d held while the limit holds it (the drive's own
+    ``speed_loop``: a bit held at the limit does not wind it up). The setpoint sent
     is w_v plus the torque the real drive needs to move so, u = T + J dw_v/dt, through the
     inverse of the drive's own PI loop K (kp e + ki int e = u, a first-order filter whose
     steady state is 0), so the real drive under K moves as the virtual one: its admittance
@@ -299,9 +301,9 @@ class SoftDrive(TopDriveController):
             w0 = m.drive_speed_rad_s
             self._virtual = [w0, t_nm - kp_d * (nominal_rad_s - w0), 0.0, t_nm, 0.0, t_nm]
         w_v, i_d, e, u_old, droop_old, t_old = self._virtual
-        err = nominal_rad_s - w_v
-        i_d += ki_d * err * p
-        tau_v = min(max(kp_d * err + i_d, -self.rig.max_torque_nm), self.rig.max_torque_nm)
+        # the virtual PI loop within the drive's torque limit, its integral held while the
+        # limit holds it (the drive's own loop, model.top_drive.speed_loop)
+        tau_v, i_d = speed_loop(nominal_rad_s, w_v, i_d, kp_d, ki_d, self.rig.max_torque_nm, p)
         accel = (tau_v - t_nm) / j_v
         w_v += accel * p
         admittance, keep = self._droop

@@ -136,3 +136,26 @@ def test_speed_references_stay_within_the_drive_limits() -> None:
     cmd = ctrl.update(measurement(0.02, 6.0, 0.0, 1e6))  # a huge torque: reference < 0
     assert cmd.speed_rad_s == 0.0
     assert ctrl.clamped_commands == 1
+
+
+@pytest.mark.parametrize("controller", [SoftTorque, ZTorque])
+def test_a_held_bit_does_not_wind_up_the_emulated_loop(controller: type) -> None:
+    """The bit held with the string torque at the drive's limit: the emulated drive's PI
+    loop sits at the limit, and its integral is held there (conditional integration, as the
+    drive's own loop, model.top_drive.speed_loop). So once the bit is free, the speed
+    reference is the same whether the hold lasted 60 s or 120 s; an integral that kept
+    integrating the speed error would hold the reference at the limit for longer the
+    longer the hold, and overspeed the top after the release."""
+    omega0, limit, drilling_nm = RPM0 * 2 * math.pi / 60, RIG.max_torque_nm, 3000.0
+
+    def after_release(hold_s: float) -> np.ndarray:
+        ctrl = controller(RIG, Schedule(RPM0, 60e3), period_s=0.01)
+        refs, t = [], 0.0
+        for torque, lasts_s in ((drilling_nm, 10.0), (limit, hold_s), (drilling_nm, 30.0)):
+            for _ in range(round(lasts_s / 0.01)):
+                t += 0.01
+                refs.append(ctrl.update(measurement(t, omega0, torque, torque)).speed_rad_s)
+        return np.array(refs[-3000:])
+
+    short, long = after_release(60.0), after_release(120.0)
+    assert np.max(np.abs(short - long)) < 1e-3 * omega0
