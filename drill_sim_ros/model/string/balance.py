@@ -57,19 +57,24 @@ def call_tolerance(wave_steps: int) -> float:
 
 @njit(cache=True)
 def line_balance(wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray, lo: int, hi: int,
-                 dtau: float, out: np.ndarray) -> None:
+                 dtau: float, out: np.ndarray) -> int:
     """A line's (parts ``lo .. hi - 1``) balance into ``out`` (B_* slots): the energy it
     holds now, and the work done at its top, at its bottom (the bit), by the wall and by
-    the dampers since the step's sums were last zeroed (Simulator: the start, a reset)."""
+    the dampers since the step's sums were last zeroed (Simulator: the start, a reset).
+    Returns the first (topmost) column whose wall or damper work is below zero, else -1."""
     wall = damper = 0.0
+    first = -1
     for j in range(lo, hi):
         wall += wave_f[W_WORK, j]
         damper += wave_f[W_DAMP, j]
+        if first < 0 and (wave_f[W_WORK, j] < 0.0 or wave_f[W_DAMP, j] < 0.0):
+            first = j
     out[B_STORED] = line_energy(wave, wave_i, wave_f, lo, hi, dtau)
     out[B_TOP] = wave_f[W_TOP, lo] * dtau
     out[B_BIT] = wave_f[W_BIT, hi - 1] * dtau
     out[B_WALL] = wall * dtau
     out[B_DAMPER] = damper * dtau
+    return first
 
 
 @njit(cache=True)
@@ -79,15 +84,6 @@ def mark_lines(wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray, parts_t
     :func:`check_lines` starts from."""
     line_balance(wave, wave_i, wave_f, 0, parts_t, dtau, mark[0])
     line_balance(wave, wave_i, wave_f, parts_t, wave_i.shape[1], dtau, mark[1])
-
-
-@njit(cache=True)
-def _first_negative(wave_f: np.ndarray, row: int, lo: int, hi: int) -> int:
-    """The first (topmost) column of ``row`` in ``lo .. hi - 1`` below zero, else -1."""
-    for j in range(lo, hi):
-        if wave_f[row, j] < 0.0:
-            return j
-    return -1
 
 
 @njit(cache=True)
@@ -103,11 +99,11 @@ def check_lines(wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray, parts_
     now = np.empty(N_BALANCE)
     for line in range(2):
         lo, hi = (0, parts_t) if line == 0 else (parts_t, wave_i.shape[1])
-        for row, finding in ((W_WORK, BALANCE_WALL), (W_DAMP, BALANCE_DAMPER)):
-            j = _first_negative(wave_f, row, lo, hi)
-            if j >= 0:
-                return finding, line, j, wave_f[row, j] * dtau, 0.0
-        line_balance(wave, wave_i, wave_f, lo, hi, dtau, now)
+        j = line_balance(wave, wave_i, wave_f, lo, hi, dtau, now)
+        if j >= 0 and wave_f[W_WORK, j] < 0.0:
+            return BALANCE_WALL, line, j, wave_f[W_WORK, j] * dtau, 0.0
+        if j >= 0:
+            return BALANCE_DAMPER, line, j, wave_f[W_DAMP, j] * dtau, 0.0
         before = mark[line]
         drift = (now[B_STORED] - before[B_STORED]) - (
             (now[B_TOP] - before[B_TOP]) - (now[B_BIT] - before[B_BIT])
