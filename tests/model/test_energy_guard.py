@@ -22,7 +22,9 @@ from drill_sim_ros.model.errors import EnergyFault, NumericalFault
 from drill_sim_ros.model.presets import Preset, available_presets, load_preset
 from drill_sim_ros.model.session import SessionConfig, SimSession
 from drill_sim_ros.model.simulator import SimConfig, Simulator
+from drill_sim_ros.model.string import lines
 from drill_sim_ros.model.well import Well
+from tests.robust.helpers import one_error_line, run_cli
 
 DEVIATED = "field_8p5in_deviated"
 UNWALLED = "field_8p5in_shale"
@@ -170,3 +172,24 @@ def test_energy_that_no_element_accounts_for_stops_as_a_drift() -> None:
     sim.string_arrays()[0][slot] *= 1.01             # handed out again: a new start
     sim.advance(period)
     assert sim.fault is None
+
+
+def test_the_fault_reaches_a_drill_sim_user_as_one_line(
+        capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch) -> None:
+    """``drill_sim closed-loop`` on a string whose torsional dampers have their sign slipped (in
+    the building of its lines, past the loader): exit 2, one ``error:`` line naming the
+    energy fault, the damper and the line, no traceback (as sim_node logs it: one line,
+    a numerical fault until ~/reset)."""
+    build = lines.wave_line
+
+    def slipped(*args: object, **kwargs: object) -> lines.WaveLine:
+        line = build(*args, **kwargs)
+        axial = args[1] if len(args) > 1 else kwargs["axial"]
+        return line if axial else replace(line, damper_below=tuple(-d for d in
+                                                                   line.damper_below))
+
+    monkeypatch.setattr(lines, "wave_line", slipped)
+    rc, _, err = run_cli(capsys, "closed-loop", "--params", UNWALLED, "--t-end", "1",
+                         "--no-baseline")
+    one_error_line(rc, err, "energy fault at t = ", "the damper at the torsional line's "
+                   "junction 0", "J (a viscous loss can only take energy")
