@@ -13,6 +13,7 @@ from __future__ import annotations
 import argparse
 import tempfile
 import time
+from collections.abc import Callable, Sequence
 from dataclasses import replace
 from pathlib import Path
 
@@ -37,10 +38,29 @@ def kernel_ns_per_step(preset: Preset, steps: int = 400_000) -> float:
     return best
 
 
-def bench_rate(scenario: Scenario) -> float:
-    """Periods per second of the in-process closed loop."""
+def bench_rate(scenario: Scenario, cpu: bool = False) -> float:
+    """Periods per second of the in-process closed loop; ``cpu``: per second of this
+    process's CPU time (what a quiet machine's wall clock would give, as near as a loaded
+    one can tell: the other jobs' time does not count)."""
+    start = time.process_time()
     run = run_in_process(scenario)
-    return scenario.periods / run.wall_s
+    return scenario.periods / (time.process_time() - start if cpu else run.wall_s)
+
+
+def alternated(variants: Sequence[tuple[str, Callable[[], float]]], rounds: int,
+               rate_hz: float = 100.0) -> dict[str, list[float]]:
+    """Periods per second of each variant (a name and a call that runs the bench once and
+    returns its rate), alternated round by round in one process so that all see the same
+    machine; prints each with its real-time factor at ``rate_hz`` periods a simulated
+    second. The timing loop of this script and of bench_energy_guard.py."""
+    rates: dict[str, list[float]] = {name: [] for name, _ in variants}
+    for i in range(rounds):
+        for name, run in variants:
+            rate = run()
+            rates[name].append(rate)
+            print(f"round {i + 1}, bench {name}: {rate:,.0f} periods/s "
+                  f"({rate / rate_hz:.0f}x real time)", flush=True)
+    return rates
 
 
 def main() -> None:
@@ -60,11 +80,8 @@ def main() -> None:
     vertical_path = Path(tempfile.mkdtemp(prefix="bench_well_")) / "vertical.yaml"
     vertical_path.write_text(yaml.safe_dump(data))
     plain = scenario.with_(preset=str(vertical_path))
-    for i in range(args.rounds):
-        for name, sc in (("with the well", scenario), ("without it", plain)):
-            rate = bench_rate(sc)
-            print(f"round {i + 1}, bench {name}: {rate:,.0f} periods/s "
-                  f"({rate / 100:.0f}x real time)", flush=True)
+    alternated((("with the well", lambda: bench_rate(scenario)),
+                ("without it", lambda: bench_rate(plain))), args.rounds)
 
 
 if __name__ == "__main__":

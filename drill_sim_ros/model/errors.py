@@ -14,8 +14,9 @@ class NumericalFault(DrillSimError, FloatingPointError):
 
 
 class EnergyFault(NumericalFault):
-    """The string created energy (the physics guard, Simulator._check_wall_energy); the
-    message names the element, its depth and the time. The simulator must be reset."""
+    """The string created energy, or its energy balance drifted (the physics guard,
+    Simulator._check_energy, string.balance); the message names the element (the line, its
+    junction and depth), the time and the energy in J. The simulator must be reset."""
 
 
 class HistoryOverflow(DrillSimError):

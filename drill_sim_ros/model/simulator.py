@@ -117,7 +117,7 @@ class Snapshot:
     wave: np.ndarray | None = None
     wave_pos: np.ndarray | None = None
     layer_index: int = -1
-    junctions: np.ndarray | None = None     # the junctions' state rows (W_LAST, W_WORK)
+    junctions: np.ndarray | None = None     # the junctions' state rows (W_LAST .. W_BIT)
     off_bottom: float = 0.0
 
 
@@ -221,15 +221,14 @@ class Simulator:
     def _wave_layout(self) -> None:
         """The delay lines of a distributed string at this step (none for the lumped one);
         every part must span at least one step."""
-        self._wall_work: np.ndarray | None = None       # the guard's row: no wall, none
+        self._balance_mark = np.zeros((2, sg.N_BALANCE))   # the guard's (string.balance)
+        self._balance_stale = True           # the mark is taken again before the next run
         if self.string.model != sg.STRING_DISTRIBUTED:
             self._wave_i, self._wave_f, self._parts = k.NO_WAVE_I, k.NO_WAVE_F, ()
             self._wave = k.NO_WAVE
             return
         self._wave_i, self._wave_f, self._wave, self._parts = sg.build_lines(
             self.string.lines, self.wave_dtau)
-        if np.any(self._wave_f[sg.W_FS] != 0.0) or np.any(self._wave_f[sg.W_FD] != 0.0):
-            self._wall_work = self._wave_f[sg.W_WORK]
         if self._wave_i[sg.W_LEN].min() < 1:
             raise ParameterError(
                 f"a string section (or damping part) is shorter than one step of the wave "
@@ -269,7 +268,8 @@ class Simulator:
                                     bit_torque, speed, axial_speed)
         sg.fill_steady(self._wave, self._wave_i, self._wave_f, parts_t, parts, bit_force,
                        axial_speed, speed)
-        self._wave_f[sg.W_WORK] = 0.0
+        self._wave_f[sg.W_WORK:] = 0.0         # the works summed (the guard's balance)
+        self._balance_stale = True
         st = self._state
         st[k.S_SUB_COUNT:k.S_SUB_V_BIT + 1] = 0.0     # a new wave step starts now
         st[k.S_TD_INTEGRAL] = st[k.S_MOTOR_TORQUE] = top_torque
@@ -563,6 +563,10 @@ class Simulator:
         due (never during a run, so :attr:`offsets` hold for all its rows)."""
         if self.fault is not None:
             raise NumericalFault(f"simulator faulted ({self.fault}); call reset()")
+        if self._balance_stale and self.distributed:
+            sg.mark_lines(self._wave, self._wave_i, self._wave_f, self._parts[0],
+                          self.wave_dtau, self._balance_mark)
+            self._balance_stale = False
         if self._unchecked_steps + n_steps >= REBASE_CHECK_STEPS:
             self._rebase()
             self._unchecked_steps = 0
@@ -572,34 +576,47 @@ class Simulator:
         NumericalFault or HistoryOverflow when it failed."""
         self._unchecked_steps += n_steps
         self._check(status)
-        self._check_wall_energy()
+        self._check_energy(n_steps)
 
-    def _check_wall_energy(self) -> None:
-        """The physics guard: the wall's friction only takes energy. Each junction's work
-        (W_WORK) grows by limit |w| dtau or c w^2 dtau, never negative for a wall that
-        presses on the string; a negative one means the string creates energy there (a
-        negative friction limit: a normal force below zero, which the soft-string norm never
-        gives, so a bug upstream; a string lighter than the mud is refused at load). Then
-"        the simulator faults (:class:`EnergyFault`) naming the junction, its depth and the
-        time, instead of returning numbers."""
-        work = self._wall_work
-        if work is None or work.min() >= 0.0:
+    def _check_energy(self, n_steps: int) -> None:
+        """The physics guard (string.balance): after a run of ``n_steps``, each wave line's
+        energy against the work done on it since the last check (drive or hook at the top,
+        bit, wall, dampers), within the rounding of the scheme (string.call_tolerance), and
+        no wall or damper that ever gave the string energy. Else the simulator faults
+        (:class:`EnergyFault`) naming the element (the line and its junction), its depth,
+        the time and the energy in J, instead of returning numbers."""
+        if not self.distributed:
             return
-        j = int(np.argmin(work))
-        parts_t = self._parts[0]
-        axial = j >= parts_t
-        line = self.string.lines[1 if axial else 0]
-        local = j - (parts_t if axial else 0)
-        depth_m = float(sum(line.length_m[:local + 1]))
-        sc = self.scales
-        joules = float(work[j]) * self.wave_dtau * (sc.force_n * sc.length_m if axial
-                                                    else sc.torque_nm)
-        self.fault = (f"energy fault at t = {self.tau * sc.time_s:.6g} s (tau = {self.tau:.6g})"
-                      f": the wall at the {'axial' if axial else 'torsional'} line's junction "
-                      f"{local} ({depth_m:.1f} m below the top) gave the string "
-                      f"{-joules:.4g} J (its friction can only take energy: a negative normal "
-                      "force or friction limit there)")
+        finding, line, column, value, bound = sg.check_lines(
+            self._wave, self._wave_i, self._wave_f, self._parts[0], self.wave_dtau,
+            self._balance_mark, sg.call_tolerance(n_steps // self.string.substeps + 1))
+        if finding == sg.BALANCE_OK:
+            return
+        self.fault = self._energy_fault(finding, line, column, value, bound)
         raise EnergyFault(self.fault)
+
+    def _energy_fault(self, finding: int, line: int, column: int, value: float,
+                      bound: float) -> str:
+        """The one-line message of a finding of :func:`string.check_lines`."""
+        sc = self.scales
+        joule = sc.force_n * sc.length_m if line else sc.torque_nm   # per kernel unit
+        name = "axial" if line else "torsional"
+        head = f"energy fault at t = {self.tau * sc.time_s:.6g} s (tau = {self.tau:.6g}): "
+        if finding == sg.BALANCE_DRIFT:
+            return (head + f"the {name} line's energy balance is off by {value * joule:.4g} J "
+                    f"over the last run (stored change - (top work - bit work - wall work - "
+                    f"damper work); tolerance {bound * joule:.3g} J): the string "
+                    f"{'created' if value > 0.0 else 'lost'} energy that no element accounts "
+                    "for (a bug in the wave step or a write into its waves)")
+        local = column - (self._parts[0] if line else 0)
+        depth_m = float(sum(self.string.lines[line].length_m[:local + 1]))
+        where = f"the {name} line's junction {local} ({depth_m:.1f} m below the top)"
+        if finding == sg.BALANCE_WALL:
+            return (head + f"the wall at {where} gave the string {-value * joule:.4g} J (its "
+                    "friction can only take energy: a negative normal force or friction "
+                    "limit there)")
+        return (head + f"the damper at {where} gave the string {-value * joule:.4g} J (a "
+                "viscous loss can only take energy: a negative damping there)")
 
     @property
     def offsets(self) -> tuple[float, float]:
@@ -751,9 +768,23 @@ class Simulator:
             return 0.0
         return float(self._wave_f[sg.W_WORK].sum()) * self.wave_dtau
 
+    def energy_balance(self) -> np.ndarray:
+        """Each wave line's energy balance now (string.line_balance), rows (torsional,
+        axial), columns ``string.B_*``: the energy it holds, and the work done at its top,
+        at the bit, by the wall and by its dampers since the start (reset,
+        :meth:`hang_off_bottom`), kernel units as :meth:`string_energy`; zeros for the lumped
+        string, which holds no waves."""
+        out = np.zeros((2, sg.N_BALANCE))
+        if self.distributed:
+            sg.mark_lines(self._wave, self._wave_i, self._wave_f, self._parts[0],
+                          self.wave_dtau, out)
+        return out
+
     def string_arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, tuple[int, ...]]:
         """The delay lines as they are (wave, layout int, layout float, parts per line), for
-        instruments that send a pulse into the string; writes to ``wave`` are the state."""
+        instruments that send a pulse into the string; writes to ``wave`` are the state (the
+        guard's balance starts again from them at the next run)."""
+        self._balance_stale = True
         return self._wave, self._wave_i, self._wave_f, self._parts
 
     # ---- state access -----------------------------------------------------------------
@@ -790,6 +821,7 @@ class Simulator:
             self._wave_i[sg.W_POS] = snap.wave_pos
             if snap.junctions is not None:
                 self._wave_f[sg.W_LAST:] = snap.junctions
+            self._balance_stale = True
         self._prm[k.P_OFF_BOTTOM] = snap.off_bottom
         self.fault = None
 

@@ -17,6 +17,7 @@ from std_srvs.srv import SetBool, Trigger
 
 from drill_sim_ros import topics
 from drill_sim_ros.model import kernel as k
+from drill_sim_ros.model import string as sg
 from drill_sim_ros.model.params import RPM_PER_RAD_S
 from drill_sim_ros.model.presets import load_preset
 from drill_sim_ros.model.session import SimSession
@@ -378,6 +379,31 @@ def test_numerical_fault_gives_an_error_diagnostic_and_reset_recovers(ros):
     n_diag = probe.count(topics.DIAGNOSTICS)
     assert ros.spin_until(lambda: probe.count(topics.DIAGNOSTICS) > n_diag, 5.0)
     assert probe.messages(topics.DIAGNOSTICS)[-1].status[0].level != DiagnosticStatus.ERROR
+
+
+def test_an_energy_fault_is_one_error_line_and_reset_recovers(ros):
+    """The physics guard through sim_node (issue 52): energy written into the distributed
+    string's waves between two ticks, by a holder of its arrays (the kind of bug the guard
+    stands for), stops the node with an ERROR diagnostic whose message is the fault's one
+    line naming the line and the time; ~/reset recovers."""
+    node = start_node(ros, model__preset="field_8p5in_shale", real_time_factor=5.0)
+    wave, wave_i, _, parts = node._session.sim.string_arrays()    # held, then written
+    probe = start_probe(ros, [topics.TELEMETRY, topics.DIAGNOSTICS])
+    assert ros.spin_until(lambda: probe.count(topics.TELEMETRY) > 5, 20.0)
+    with node._lock.urgent():
+        wave[int(wave_i[sg.W_OFF, parts[0]])] *= 1.01          # the axial line's first slot
+
+    def errors() -> list[str]:
+        return [s.message for d in probe.messages(topics.DIAGNOSTICS) for s in d.status
+                if s.level == DiagnosticStatus.ERROR]
+
+    assert ros.spin_until(lambda: bool(errors()), 5.0)
+    message = errors()[0]
+    assert message.startswith("numerical fault: energy fault at t = "), message
+    assert "the axial line's energy balance is off by " in message and "\n" not in message
+    assert ros.call(probe, Trigger, f"{NODE}/reset", Trigger.Request()).success
+    seen = probe.count(topics.TELEMETRY)
+    assert ros.spin_until(lambda: probe.count(topics.TELEMETRY) > seen + 20, 5.0)
 
 
 # ---- pacing ----------------------------------------------------------------------------------

@@ -219,7 +219,7 @@ def build_lines(lines: tuple[WaveLine, ...], dtau: float
                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, tuple[int, ...]]:
     """The layout of the delay lines of ``lines`` (torsional first): ``(wave_i, wave_f,
     wave, counts)`` with ``wave_i`` int64 (W_INT_ROWS, parts) rows W_LEN, W_OFF, W_POS,
-    W_PAIR (:func:`junction_pairs`), ``wave_f`` float64 (W_ROWS, parts) rows W_Z .. W_WORK
+    W_PAIR (:func:`junction_pairs`), ``wave_f`` float64 (W_ROWS, parts) rows W_Z .. W_BIT
     (the state rows zero), an empty buffer, and the parts per line."""
     lens = np.concatenate([line_steps(line, dtau) for line in lines])
     wave_i = np.zeros((W_INT_ROWS, lens.size), dtype=np.int64)

@@ -18,11 +18,13 @@ W_LEN, W_OFF, W_POS, W_PAIR = 0, 1, 2, 3
 W_INT_ROWS = 4
 # float64 (W_ROWS, segments), per part, of the junction below it: impedance, point damper,
 # the wall's static and dynamic friction limits (0: no wall contact), the stick band, the
-# surface slip (m / t*) per unit of the line's speed (r_o; L*), and two rows of state: the
-# junction's speed last step (the stick band's memory) and the friction power summed over
-# the steps (x dtau: the work the wall took)
-W_Z, W_D, W_FS, W_FD, W_VS, W_SLIP, W_LAST, W_WORK = 0, 1, 2, 3, 4, 5, 6, 7
-W_ROWS = 8
+# surface slip (m / t*) per unit of the line's speed (r_o; L*), and rows of state: the
+# junction's speed last step (the stick band's memory), the wall's friction power and the
+# point damper's power D w^2 summed over the steps (x dtau: the work each took), and, in
+# the line's first (last) part only, the power that entered the line at its top (left it
+# at its bottom, the bit) summed so: the energy balance the guard checks (.balance)
+W_Z, W_D, W_FS, W_FD, W_VS, W_SLIP, W_LAST, W_WORK, W_DAMP, W_TOP, W_BIT = range(11)
+W_ROWS = 11
 
 
 @njit(cache=True, inline="always")
@@ -120,9 +122,14 @@ def junction_speed(wave_f: np.ndarray, j: int, a_in: float, b_in: float,
     from above, ``b_in`` from below): continuous across it, with the torques balanced on
     its elements, the point damper D (torque D w) and the wall's friction F:
     (a_in - Z_j w) - (b_in + Z_j+1 w) = D w + F. Without wall contact (W_FS 0) that is
-    w = (a_in - b_in) / (Z_j + Z_j+1 + D), the lossless scattering and its damper."""
+    w = (a_in - b_in) / (Z_j + Z_j+1 + D), the lossless scattering and its damper. The
+    junction takes w (a_in - b_in - (Z_j + Z_j+1) w) = D w^2 + F w of the waves' energy
+    each step: the damper's share is summed in W_DAMP, the wall's in W_WORK."""
     if wave_f[W_FS, j] == 0.0:
-        return (a_in - b_in) / (wave_f[W_Z, j] + wave_f[W_Z, j + 1] + wave_f[W_D, j])
+        d = wave_f[W_D, j]
+        w = (a_in - b_in) / (wave_f[W_Z, j] + wave_f[W_Z, j + 1] + d)
+        wave_f[W_DAMP, j] += d * w * w
+        return w
     return wall_junction(wave_f, j, a_in - b_in, pair)
 
 
@@ -144,7 +151,8 @@ def wall_junction(wave_f: np.ndarray, j: int, push: float, pair: int) -> float:
       k = F_d s and r = sqrt(u^2 + o^2), w = push r / (Z r + k), and the power
       c w^2 = k w push / (Z r + k).
 
-    Keeps the speed for the band, and the friction power summed in W_WORK."""
+    Keeps the speed for the band, the friction power summed in W_WORK and the damper's
+    D w^2 in W_DAMP."""
     u, o, sliding = wall_slips(wave_f, j, pair, wave_f[W_LAST, j], wave_f[W_LAST, pair])
     z = wave_f[W_Z, j] + wave_f[W_Z, j + 1] + wave_f[W_D, j]
     if sliding and o > 0.0:
@@ -159,6 +167,7 @@ def wall_junction(wave_f: np.ndarray, j: int, push: float, pair: int) -> float:
         if abs(push) > limit:
             w = (push - math.copysign(limit, push)) / z
         wave_f[W_WORK, j] += limit * abs(w)
+    wave_f[W_DAMP, j] += wave_f[W_D, j] * w * w
     wave_f[W_LAST, j] = w
     return w
 
@@ -169,10 +178,16 @@ def drive_line(wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray, lo: int
                w_top: float, w_bottom: float, echo: float) -> None:
     """A line (parts ``lo`` .. ``hi``) one step on, driven at its ends by the speeds over the
     step: a = b + 2 Z w_top enters at the top, b = (a - 2 Z w_bottom) x ``echo`` at the
-    bottom (``echo`` 1; 0: an anechoic bottom that sends nothing back)."""
+    bottom (``echo`` 1; 0: an anechoic bottom that sends nothing back). Sums the power
+    that enters at the top, (a^2 - b^2) / 4 Z = w_top (b + Z w_top), in W_TOP of part
+    ``lo``, and the power that leaves at the bottom, (a^2 - b^2) / 4 Z (the bit's
+    w_bottom (a - Z w_bottom) when it echoes), in W_BIT of part ``hi - 1``."""
     b_top, a_bottom = arriving(wave, wave_i, lo, hi)
-    a_top = b_top + 2.0 * wave_f[W_Z, lo] * w_top
-    b_bottom = (a_bottom - 2.0 * wave_f[W_Z, hi - 1] * w_bottom) * echo
+    z_top, z_bottom = wave_f[W_Z, lo], wave_f[W_Z, hi - 1]
+    a_top = b_top + 2.0 * z_top * w_top
+    b_bottom = (a_bottom - 2.0 * z_bottom * w_bottom) * echo
+    wave_f[W_TOP, lo] += w_top * (b_top + z_top * w_top)
+    wave_f[W_BIT, hi - 1] += (a_bottom * a_bottom - b_bottom * b_bottom) / (4.0 * z_bottom)
     scatter(wave, wave_i, wave_f, lo, hi, a_top, b_bottom)
 
 
