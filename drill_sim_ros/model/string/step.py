@@ -206,8 +206,7 @@ def scatter(wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray, lo: int, h
     as unsigned integers, np.uint64, so numba leaves out its test for a negative index,
     Python's wrap-around: a sixth of the walled string's step, measured.)"""
     off, n, pos = wave_i[W_OFF, lo], wave_i[W_LEN, lo], wave_i[W_POS, lo]
-    if n > 1:                                # (a cell keeps slot 0)
-        wave_i[W_POS, lo] = next_slot(pos, n)
+    wave_i[W_POS, lo] = next_slot(pos, n)    # (a branch here costs NRT calls in the loop)
     a_slot, b_slot = np.uint64(off + pos), np.uint64(off + n + pos)
     a_in = wave[a_slot]                      # arriving at the bottom of part lo
     wave[a_slot] = a_top
@@ -229,8 +228,8 @@ def scatter(wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray, lo: int, h
 @njit(cache=True, inline="always")
 def next_slot(pos: int, steps: int) -> int:
     """The slot of a part of ``steps`` steps after ``pos``: its delay lines move on by one.
-    (A part of one step, a walled string's cell, keeps slot 0, and the step does not write
-    it: storing it every step cost the walled step 5 %, measured.)"""
+    (A part of one step, a walled string's cell, keeps slot 0, and the junctions' loop does
+    not write it: storing it at every junction cost the walled step 5 %, measured.)"""
     return pos + 1 if pos + 1 < steps else 0
 
 
