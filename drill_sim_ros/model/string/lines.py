@@ -20,10 +20,12 @@ from drill_sim_ros.model.string.spec import (
     line_properties,
 )
 from drill_sim_ros.model.string.step import (
+    W_BAND2,
     W_D,
     W_FD,
     W_FS,
     W_INT_ROWS,
+    W_KD,
     W_LAST,
     W_LEN,
     W_OFF,
@@ -32,6 +34,7 @@ from drill_sim_ros.model.string.step import (
     W_SLIP,
     W_VS,
     W_Z,
+    W_ZJ,
     wall_slips,
 )
 
@@ -220,7 +223,7 @@ def build_lines(lines: tuple[WaveLine, ...], dtau: float
     """The layout of the delay lines of ``lines`` (torsional first): ``(wave_i, wave_f,
     wave, counts)`` with ``wave_i`` int64 (W_INT_ROWS, parts) rows W_LEN, W_OFF, W_POS,
     W_PAIR (:func:`junction_pairs`), ``wave_f`` float64 (W_ROWS, parts) rows W_Z .. W_BIT
-    (the state rows zero), an empty buffer, and the parts per line."""
+    (:func:`junction_rows`; the state rows zero), an empty buffer, and the parts per line."""
     lens = np.concatenate([line_steps(line, dtau) for line in lines])
     wave_i = np.zeros((W_INT_ROWS, lens.size), dtype=np.int64)
     wave_i[W_LEN] = lens
@@ -231,8 +234,27 @@ def build_lines(lines: tuple[WaveLine, ...], dtau: float
                       (W_FD, "dynamic_below"), (W_VS, "stick_speed"),
                       (W_SLIP, "slip_per_speed")):
         wave_f[row] = np.concatenate([_rows(line, name) for line in lines])
-    return wave_i, wave_f, np.zeros(int(2 * lens.sum())), tuple(len(x.travel_tau)
-                                                                 for x in lines)
+    counts = tuple(len(x.travel_tau) for x in lines)
+    junction_rows(wave_f, counts)
+    return wave_i, wave_f, np.zeros(int(2 * lens.sum())), counts
+
+
+def junction_rows(wave_f: np.ndarray, counts: tuple[int, ...]) -> None:
+    """The rows of ``wave_f`` the step reads instead of working them out at every junction
+    every step, from the others, in place: W_ZJ = Z_j + Z_j+1 + D_j (within each line of
+    ``counts`` parts; a line's bottom part has no junction below, 0), W_BAND2 =
+    (W_VS W_SLIP)^2 and W_KD = W_FD W_SLIP, with the step's operations in its order, so
+    the same numbers to the bit."""
+    wave_f[W_ZJ] = 0.0
+    lo = 0
+    for n in counts:
+        hi = lo + n
+        wave_f[W_ZJ, lo:hi - 1] = (wave_f[W_Z, lo:hi - 1] + wave_f[W_Z, lo + 1:hi]
+                                   + wave_f[W_D, lo:hi - 1])
+        lo = hi
+    band = wave_f[W_VS] * wave_f[W_SLIP]
+    wave_f[W_BAND2] = band * band
+    wave_f[W_KD] = wave_f[W_FD] * wave_f[W_SLIP]
 
 
 def steady_friction(wave_f: np.ndarray, j: int, pair: int, speed: float,

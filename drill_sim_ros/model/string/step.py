@@ -18,13 +18,18 @@ W_LEN, W_OFF, W_POS, W_PAIR = 0, 1, 2, 3
 W_INT_ROWS = 4
 # float64 (W_ROWS, segments), per part, of the junction below it: impedance, point damper,
 # the wall's static and dynamic friction limits (0: no wall contact), the stick band, the
-# surface slip (m / t*) per unit of the line's speed (r_o; L*), and rows of state: the
-# junction's speed last step (the stick band's memory), the wall's friction power and the
-# point damper's power D w^2 summed over the steps (x dtau: the work each took), and, in
-# the line's first (last) part only, the power that entered the line at its top (left it
-# at its bottom, the bit) summed so: the energy balance the guard checks (.balance)
-W_Z, W_D, W_FS, W_FD, W_VS, W_SLIP, W_LAST, W_WORK, W_DAMP, W_TOP, W_BIT = range(11)
-W_ROWS = 11
+# surface slip (m / t*) per unit of the line's speed (r_o; L*); three rows worked out from
+# those once (.lines.junction_rows) instead of at every junction every step: the
+# junction's impedance Z_j + Z_j+1 + D, the stick band's slip squared (W_VS W_SLIP)^2 and
+# the dynamic limit times the slip, F_d s; and rows of state: the junction's speed last
+# step (the stick band's memory), the wall's friction power and the point damper's power
+# D w^2 summed over the steps (x dtau: the work each took), and, in the line's first (last)
+# part only, the power that entered the line at its top (left it at its bottom, the bit)
+# summed so: the energy balance the guard checks (.balance)
+W_Z, W_D, W_FS, W_FD, W_VS, W_SLIP = 0, 1, 2, 3, 4, 5
+W_ZJ, W_BAND2, W_KD = 6, 7, 8
+W_LAST, W_WORK, W_DAMP, W_TOP, W_BIT = 9, 10, 11, 12, 13
+W_ROWS = 14
 
 
 @njit(cache=True, inline="always")
@@ -36,8 +41,7 @@ def wall_slips(wave_f: np.ndarray, j: int, pair: int, own_speed: float,
     r_o omega_s (Karnopp) and slides outside it."""
     u = abs(own_speed) * wave_f[W_SLIP, j]
     o = abs(other_speed) * wave_f[W_SLIP, pair]
-    band = wave_f[W_VS, j] * wave_f[W_SLIP, j]
-    return u, o, u * u + o * o > band * band
+    return u, o, u * u + o * o > wave_f[W_BAND2, j]
 
 
 # ---- compiled: the string's step (the kernel's seam) ------------------------------------
@@ -126,9 +130,8 @@ def junction_speed(wave_f: np.ndarray, j: int, a_in: float, b_in: float,
     junction takes w (a_in - b_in - (Z_j + Z_j+1) w) = D w^2 + F w of the waves' energy
     each step: the damper's share is summed in W_DAMP, the wall's in W_WORK."""
     if wave_f[W_FS, j] == 0.0:
-        d = wave_f[W_D, j]
-        w = (a_in - b_in) / (wave_f[W_Z, j] + wave_f[W_Z, j + 1] + d)
-        wave_f[W_DAMP, j] += d * w * w
+        w = (a_in - b_in) / wave_f[W_ZJ, j]
+        wave_f[W_DAMP, j] += wave_f[W_D, j] * w * w
         return w
     return wall_junction(wave_f, j, a_in - b_in, pair)
 
@@ -154,9 +157,9 @@ def wall_junction(wave_f: np.ndarray, j: int, push: float, pair: int) -> float:
     Keeps the speed for the band, the friction power summed in W_WORK and the damper's
     D w^2 in W_DAMP."""
     u, o, sliding = wall_slips(wave_f, j, pair, wave_f[W_LAST, j], wave_f[W_LAST, pair])
-    z = wave_f[W_Z, j] + wave_f[W_Z, j + 1] + wave_f[W_D, j]
+    z = wave_f[W_ZJ, j]
     if sliding and o > 0.0:
-        k = wave_f[W_FD, j] * wave_f[W_SLIP, j]
+        k = wave_f[W_KD, j]
         r = math.sqrt(u * u + o * o)
         per_z = push / (z * r + k)
         w = per_z * r
@@ -208,32 +211,40 @@ def scatter(wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray, lo: int, h
     Indexes the layout arrays in place: row views would cost reference counting every step
     (about a tenth of the distributed string's step, measured). The junctions' law is
     :func:`junction_speed`; the other line's junction beside junction j is W_PAIR (the one
-    nearest in depth, :func:`.lines.junction_pairs`). A line whose parts all span one step
-    (a walled string's cells, :func:`.lines.wall_cells`) holds part j's a at slot base + 2 j
-    and its b beside it, and its slots never move: the same arithmetic without the slot
-    bookkeeping (about a third of a walled string's step, measured)."""
-    base = wave_i[W_OFF, lo] - 2 * lo        # every part one step: 2 slots a part
-    cells = wave_i[W_OFF, hi - 1] + 2 * wave_i[W_LEN, hi - 1] - base == 2 * hi
-    a_slot = wave_i[W_OFF, lo] + wave_i[W_POS, lo]
+    nearest in depth, :func:`.lines.junction_pairs`). Each part's slots are read once, at
+    the junction above it, and its slot moved on there (:func:`next_slot`): the b arriving
+    at its top is read where the b entering at its bottom is written one junction later,
+    and the a entering at its top is written where the a arriving at its bottom is read.
+    (The slots are worked out in the loop itself: an inlined helper that writes ``wave_i``
+    made the walled string's step five times slower, measured. The slots and the pair index
+    as unsigned integers, np.uint64, so numba leaves out its test for a negative index,
+    Python's wrap-around: a sixth of the walled string's step, measured.)"""
+    off, n, pos = wave_i[W_OFF, lo], wave_i[W_LEN, lo], wave_i[W_POS, lo]
+    wave_i[W_POS, lo] = next_slot(pos, n)    # (a branch here costs NRT calls in the loop)
+    a_slot, b_slot = np.uint64(off + pos), np.uint64(off + n + pos)
     a_in = wave[a_slot]                      # arriving at the bottom of part lo
     wave[a_slot] = a_top
     for j in range(lo, hi - 1):
-        if cells:
-            b_slot, out_slot, a_slot = base + 2 * j + 3, base + 2 * j + 1, base + 2 * j + 2
-        else:
-            b_slot = wave_i[W_OFF, j + 1] + wave_i[W_LEN, j + 1] + wave_i[W_POS, j + 1]
-            out_slot = wave_i[W_OFF, j] + wave_i[W_LEN, j] + wave_i[W_POS, j]
-            a_slot = wave_i[W_OFF, j + 1] + wave_i[W_POS, j + 1]
+        out_slot = b_slot                    # the b entering part j at its bottom
+        off, n, pos = wave_i[W_OFF, j + 1], wave_i[W_LEN, j + 1], wave_i[W_POS, j + 1]
+        if n > 1:
+            wave_i[W_POS, j + 1] = next_slot(pos, n)
+        a_slot, b_slot = np.uint64(off + pos), np.uint64(off + n + pos)
         b_in = wave[b_slot]                  # arriving at the top of part j + 1
-        w = junction_speed(wave_f, j, a_in, b_in, wave_i[W_PAIR, j])
+        w = junction_speed(wave_f, j, a_in, b_in, np.uint64(wave_i[W_PAIR, j]))
         wave[out_slot] = a_in - 2.0 * wave_f[W_Z, j] * w
         a_next = wave[a_slot]
         wave[a_slot] = b_in + 2.0 * wave_f[W_Z, j + 1] * w
         a_in = a_next
-    wave[wave_i[W_OFF, hi - 1] + wave_i[W_LEN, hi - 1] + wave_i[W_POS, hi - 1]] = b_bottom
-    for j in range(lo, hi):                  # (a cell's slot stays 0)
-        pos = wave_i[W_POS, j] + 1
-        wave_i[W_POS, j] = pos if pos < wave_i[W_LEN, j] else 0
+    wave[b_slot] = b_bottom
+
+
+@njit(cache=True, inline="always")
+def next_slot(pos: int, steps: int) -> int:
+    """The slot of a part of ``steps`` steps after ``pos``: its delay lines move on by one.
+    (A part of one step, a walled string's cell, keeps slot 0, and the junctions' loop does
+    not write it: storing it at every junction cost the walled step 5 %, measured.)"""
+    return pos + 1 if pos + 1 < steps else 0
 
 
 @njit(cache=True, inline="always")
