@@ -103,12 +103,19 @@ SHORT = ("--controller", CLASS, "--mode", "torque", "--params", "field_8p5in_sha
          "--t-end", "20", "--enable-at", "5", "--no-baseline", "--json")
 
 
-def test_the_example_runs_from_the_command_line_as_the_bench_runs_it() -> None:
+@pytest.fixture(scope="module")
+def short_run() -> subprocess.CompletedProcess[str]:
+    """``drill_sim closed-loop`` of SHORT in process: run once, compared by two tests."""
+    return drill_sim(*SHORT)
+
+
+def test_the_example_runs_from_the_command_line_as_the_bench_runs_it(
+        short_run: subprocess.CompletedProcess[str]) -> None:
     """`drill_sim closed-loop --controller examples/soft_speed_pi.py:SoftSpeedPI` scores the
     bench's own run of the same scenario."""
     from drill_sim_ros.control.scorecard import score
 
-    result = drill_sim(*SHORT)
+    result = short_run
     assert result.returncode == 0, result.stderr
     out = json.loads(result.stdout)
     scenario = Scenario(preset="field_8p5in_shale_lumped", controller=CLASS, mode="torque",
@@ -120,7 +127,8 @@ def test_the_example_runs_from_the_command_line_as_the_bench_runs_it() -> None:
 
 
 @pytest.mark.ros
-def test_in_process_and_over_ros_give_the_same_telemetry() -> None:
+def test_in_process_and_over_ros_give_the_same_telemetry(
+        short_run: subprocess.CompletedProcess[str]) -> None:
     """The example over DDS (sim_node and top_drive_controller as processes) and in
     process, on noisy, delayed sensors and a setpoint ramp: the same telemetry bit for bit,
     and the command line's --ros scorecard is its in-process one."""
@@ -136,6 +144,6 @@ def test_in_process_and_over_ros_give_the_same_telemetry() -> None:
     remote = run_over_dds(scenario, timeout_s=300.0).rows
     assert local.shape == remote.shape == (2001, local.shape[1])
     assert local.tobytes() == remote.tobytes()
-    in_process, over_ros = drill_sim(*SHORT), drill_sim(*SHORT, "--ros")
+    in_process, over_ros = short_run, drill_sim(*SHORT, "--ros")
     assert in_process.returncode == over_ros.returncode == 0, over_ros.stderr
     assert json.loads(over_ros.stdout)["score"] == json.loads(in_process.stdout)["score"]
