@@ -129,6 +129,7 @@ def mismatches(package: dict, reference: dict) -> list[str]:
 
 
 @pytest.mark.slow
+@pytest.mark.timeout(900)    # the deviated case: the package at 0.074 ms, the solver on 5400
 @pytest.mark.parametrize("name", sorted(fv_cases.CASES))
 def test_drill_sim_startup_agrees_with_the_independent_solver(name: str,
                                                               tmp_path: Path) -> None:
