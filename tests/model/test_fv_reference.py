@@ -5,7 +5,7 @@ sections, well, drive, ends, modes, low-pass and figures, written from the equat
 the documented definitions. It first meets closed forms of its own (the static break-away
 torque, the sliding torque) and the package's string modes; then the package, run as a
 user runs it (a subprocess printing its JSON), must give the start-up figures of the
-solver, converged, on two cases (:mod:`tests.model.fv_cases`): within 3 %, the stick
+solver on fine cells on two cases (:mod:`tests.model.fv_cases`): within 3 %, the stick
 fraction within 0.05 (the issue's bar). The solver's own convergence (1000 / 2000 / 4000
 cells): ``benchmarks/fv_startup_convergence.py`` and docs/string.md.
 """
