@@ -79,7 +79,8 @@ def table(name: str, seconds: float, cells: list[int] | None, courant: float | N
     start = time.perf_counter()
     package = package_figures(preset, rpm, ramp_s, seconds)
     package_s = time.perf_counter() - start
-    ref = columns.get(against_cells, columns[cells[-1]])
+    against_cells = against_cells if against_cells in columns else cells[-1]
+    ref = columns[against_cells]
     head = " | ".join(f"solver {n} cells" for n in cells)
     lines = [f"{name}: {rpm:g} rpm in {ramp_s:g} s, {seconds:g} s, bend term "
              f"{'on' if case.bend_term else 'off'}, Courant {courant:g} "
