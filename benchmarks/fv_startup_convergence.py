@@ -2,14 +2,15 @@
 convergence (issue 50, point 2; prints figures, no asserts).
 
 For each case of ``tests/model/fv_cases.py`` (or ``--case``): the solver
-(``tests/model/fv_reference.py``) at each of ``--cells`` (default 1000 2000 4000), and
-``drill_sim startup --json`` run as a user runs it; one markdown table per case, the figures
-in rows: the solver's columns, the package's, and the package against the solver's
-``--against`` cells (default 2000) in % (stick fraction: the difference). ``--seconds``
-overrides the cases' run length (120: the issue's).
+(``tests/model/fv_reference.py``) at each of ``--cells`` (default: half, once and twice the
+case's cells) at the case's Courant number (or ``--courant``), and ``drill_sim startup
+--json`` run as a user runs it; one markdown table per case, the figures in rows: the
+solver's columns, the package's, and the package against the solver's ``--against`` cells
+(default the case's) in % (stick fraction: the difference). ``--seconds`` overrides the
+cases' run length (120: the issue's).
 
 Usage: .venv/bin/python benchmarks/fv_startup_convergence.py [--case tangent]
-       [--cells 1000 2000 4000] [--seconds 120] [--against 2000]
+       [--cells 1000 2000 4000] [--courant 0.9] [--seconds 120] [--against 2000]
 """
 
 from __future__ import annotations
@@ -59,25 +60,30 @@ def against(ours: float | None, ref: float | None, key: str) -> str:
     return f"{100.0 * (ours - ref) / ref:+.1f} %"
 
 
-def table(name: str, seconds: float, cells: list[int], against_cells: int) -> str:
-    make, rpm, ramp_s, default_s = fv_cases.CASES[name]
+def table(name: str, seconds: float, cells: list[int] | None, courant: float | None,
+          against_cells: int | None) -> str:
+    make, rpm, ramp_s, default_s, case_cells, case_courant = fv_cases.CASES[name]
     seconds = seconds or default_s
+    cells = cells or [case_cells // 2, case_cells, 2 * case_cells]
+    courant = courant or case_courant
+    against_cells = against_cells or case_cells
     preset = make()
     case = fv.case_from_preset(preset, fv_cases.package_has_bend_term())
     cutoff_hz = 2.0 * fv.torsional_modes_hz(case)[-1]
     columns, walls = {}, {}
     for n in cells:
         start = time.perf_counter()
-        columns[n] = fv.startup_figures(fv.run_startup(case, rpm, ramp_s, seconds, n),
-                                        cutoff_hz)
+        columns[n] = fv.startup_figures(fv.run_startup(case, rpm, ramp_s, seconds, n,
+                                                       courant), cutoff_hz)
         walls[n] = time.perf_counter() - start
     start = time.perf_counter()
     package = package_figures(preset, rpm, ramp_s, seconds)
     package_s = time.perf_counter() - start
-    ref = columns.get(against_cells, columns[cells[-1]])
+    against_cells = against_cells if against_cells in columns else cells[-1]
+    ref = columns[against_cells]
     head = " | ".join(f"solver {n} cells" for n in cells)
     lines = [f"{name}: {rpm:g} rpm in {ramp_s:g} s, {seconds:g} s, bend term "
-             f"{'on' if case.bend_term else 'off'} "
+             f"{'on' if case.bend_term else 'off'}, Courant {courant:g} "
              f"(cut-off {cutoff_hz:.4f} Hz; package's {package['cutoff_hz']})",
              f"| figure | {head} | drill_sim startup | package vs {against_cells} cells |",
              "|---" * (len(cells) + 3) + "|"]
@@ -93,12 +99,13 @@ def table(name: str, seconds: float, cells: list[int], against_cells: int) -> st
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--case", choices=sorted(fv_cases.CASES), action="append")
-    parser.add_argument("--cells", type=int, nargs="+", default=[1000, 2000, 4000])
+    parser.add_argument("--cells", type=int, nargs="+")
+    parser.add_argument("--courant", type=float)
     parser.add_argument("--seconds", type=float, default=0.0)
-    parser.add_argument("--against", type=int, default=2000)
+    parser.add_argument("--against", type=int)
     args = parser.parse_args()
     for name in args.case or sorted(fv_cases.CASES):
-        print(table(name, args.seconds, args.cells, args.against), flush=True)
+        print(table(name, args.seconds, args.cells, args.courant, args.against), flush=True)
         print()
 
 

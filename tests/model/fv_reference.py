@@ -28,9 +28,16 @@ T* = a_L - Z_L w*; the cells update from the face values. Within a uniform secti
 exactly the first-order upwind scheme on the Riemann invariants of Aarsnes & Shor (J. Pet.
 Sci. Eng. 163, 2018; their code, Open-Source-Drilling-Community/Aarsnes-and-Shor-Torsional-
 Model, ``torsionalWaveStep.m``: ``Palpha - dt/dx c diff(Palpha_pad) - dt S`` and the same for
-beta, the pipe-collar interface by the impedance ratio ``Zbar``), here at a Courant number
-below 1 (default 0.9; 1 would turn it into the method of characteristics, which the package
-uses), so the two share no numerical method.
+beta, the pipe-collar interface by the impedance ratio ``Zbar``). Below a Courant number
+of 1 (default 0.9) it shares no numerical method with the package, but it diffuses a front
+by c dx (1 - C) / 2: enough, on the deviated preset, to shorten the reach of the slip
+pulses that free the bit, so that its break-away converges only slowly (18.4, 21.4, 19.6 s
+at 1000, 2000, 4000 cells). At a Courant number of 1, on cells that take one step to cross
+in every section (``cells`` a multiple of the sections' lengths' common divisor: 27 on the
+deviated preset, 250 on the tangent), the upwind step is exact for the waves (a shift by
+one cell, the method of characteristics, as the package steps its waves, written here
+apart) and only the wall's friction is approximated, at first order in the cell
+(docs/string.md, "Which slip pulse frees the bit").
 
 The wall's friction sits at the faces, inside their Riemann problem (:func:`wall_faces`): each
 face carries the wall between the centres of its two cells and moves only when the
@@ -390,11 +397,11 @@ def cell_counts(case: Case, cells: int) -> list[int]:
 
 
 def time_step_s(case: Case, counts: list[int], courant: float) -> float:
-    """The torsional line's step at ``courant`` on its finest cell, shortened to a whole
-    number of steps per sample."""
+    """The torsional line's step at ``courant`` on its finest cell (at 1, every section
+    whose cells take the same transit time is stepped exactly: one cell a step)."""
     fastest = min(s.length_m / n / math.sqrt(s.shear_modulus_pa / s.density_kg_m3)
                   for s, n in zip(case.sections, counts, strict=True))
-    return SAMPLE_S / math.ceil(SAMPLE_S / (courant * fastest))
+    return courant * fastest
 
 
 def axial_counts(case: Case, dt: float, courant: float) -> list[int]:
@@ -446,7 +453,9 @@ def run_startup(case: Case, rpm: float, ramp_s: float, seconds: float, cells: in
     """The start-up from rest, untwisted, off bottom: the drive's setpoint ramps from 0 to
     ``rpm`` in ``ramp_s`` (0: a step); ``cells`` torsional cells along the string (the axial
     line gets as many as its faster wave allows at the same step); sampled at 100 Hz from
-    t = 0 to ``seconds``; ``on_sample(t, torsional line)`` at each sample (to look inside)."""
+    t = 0 to ``seconds``, each sample the state at the step nearest its time (the step is
+    set by the cells, not by the samples); ``on_sample(t, torsional line)`` at each sample
+    (to look inside)."""
     counts = cell_counts(case, cells)
     dt = time_step_s(case, counts, courant)
     tor = build_line(case, counts, dt, axial=False)
@@ -455,15 +464,17 @@ def run_startup(case: Case, rpm: float, ramp_s: float, seconds: float, cells: in
     target = rpm / RPM_PER_RAD_S
     rate = target / ramp_s if ramp_s > 0.0 else math.inf
     d, w_bit, bit_angle = Drive(), 0.0, 0.0
-    every, samples = round(SAMPLE_S / dt), round(seconds / SAMPLE_S) + 1
-    out = np.zeros((8, samples))
-    for step in range(samples * every - every + 1):
+    samples = round(seconds / SAMPLE_S) + 1
+    at_step = np.rint(np.arange(samples) * SAMPLE_S / dt).astype(int)   # the nearest steps
+    out, k = np.zeros((8, samples)), 0
+    for step in range(at_step[-1] + 1):
         t_top = tor.t[0] - tor.z[0] * tor.w[0] + tor.z[0] * d.w   # b_1 + Z_1 w_s
-        if step % every == 0:
-            out[:, step // every] = (step * dt, w_bit, d.w, d.setpoint, d.motor, t_top,
-                                     d.angle, bit_angle)
+        while k < samples and at_step[k] == step:
+            out[:, k] = (k * SAMPLE_S, w_bit, d.w, d.setpoint, d.motor, t_top, d.angle,
+                         bit_angle)
             if on_sample is not None:
-                on_sample(step * dt, tor)
+                on_sample(k * SAMPLE_S, tor)
+            k += 1
         # The hook is held and the bit end free, so nothing forces the axial line: it stays
         # exactly at rest (every flux and friction term zero) until something moves it, and
         # is stepped, and felt by the torsional contact, only from then on.
