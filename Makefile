@@ -91,6 +91,7 @@ bench: venv
 	$(PY) benchmarks/bench_opcua.py
 	$(PY) benchmarks/bench_gym.py
 	$(PY) benchmarks/bench_fit.py
+	$(BIN)/pytest -m study     # the slow comparisons against the independent solver
 
 # The paper's figures and the field map (docs/gallery/*.png), computed on a local Dask
 # cluster; FIGURES_CACHE keeps the maps as NetCDF so a re-run resumes them.

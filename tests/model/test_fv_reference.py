@@ -115,29 +115,43 @@ def drill_sim_startup(preset: dict, rpm: float, ramp_s: float, seconds: float,
     return json.loads(done.stdout.strip().splitlines()[-1])
 
 
-def mismatches(package: dict, reference: dict) -> list[str]:
-    """The figures outside the issue's bars, each as 'key package reference'."""
+def mismatches(package: dict, reference: dict, stick: bool = True) -> list[str]:
+    """The figures outside the issue's bars, each as 'key package reference' (the stick
+    fraction only where ``stick``)."""
     out = []
     for key in FIGURES:
         ours, ref = package[key], reference[key]
         if (ours is None) != (ref is None) or (ref is not None
                                                and abs(ours - ref) > REL * abs(ref)):
             out.append(f"{key} {ours} {ref}")
-    if abs(package["stick_fraction"] - reference["stick_fraction"]) > STICK_ABS:
+    if stick and abs(package["stick_fraction"] - reference["stick_fraction"]) > STICK_ABS:
         out.append(f"stick_fraction {package['stick_fraction']} {reference['stick_fraction']}")
     return out
 
 
 @pytest.mark.slow
-@pytest.mark.timeout(900)    # the deviated case: the package at 0.074 ms, the solver on 5400
 @pytest.mark.parametrize("name", sorted(fv_cases.CASES))
 def test_drill_sim_startup_agrees_with_the_independent_solver(name: str,
                                                               tmp_path: Path) -> None:
-    """The shipped deviated preset (at a wave step of 0.074 ms) and the long tangent
+    """The shipped deviated preset at its own 1.0 ms step and the long tangent
     (:mod:`tests.model.fv_cases`): the package's start-up figures within 3 % of the solver's
-    (the deviated case on 0.5-m cells at a Courant number of 1, the tangent on 2000 cells at
-    0.9), the stick fraction within 0.05, the same cut-off (the same string's third mode)."""
-    make, rpm, ramp_s, seconds, cells, courant = fv_cases.CASES[name]
+    (the deviated case on matched 4-m cells at a Courant number of 1, the tangent on 2000
+    cells at 0.9), the stick fraction within 0.05 where the window holds a cycle to compare,
+    the same cut-off (the same string's third mode)."""
+    agree_with_the_solver(name, fv_cases.CASES[name], tmp_path)
+
+
+@pytest.mark.study
+@pytest.mark.timeout(900)    # the package at 0.074 ms, the solver on 5400 cells: ~150 s
+@pytest.mark.parametrize("name", sorted(fv_cases.STUDY_CASES))
+def test_on_fine_cells_both_land_on_the_same_slip_pulse(name: str, tmp_path: Path) -> None:
+    """The deviated preset at 0.074 ms against the solver on 0.5-m cells (Courant 1): every
+    figure within 3 %, the stick fraction within 0.05 (``make bench``)."""
+    agree_with_the_solver(name, fv_cases.STUDY_CASES[name], tmp_path)
+
+
+def agree_with_the_solver(name: str, case_args: tuple, tmp_path: Path) -> None:
+    make, rpm, ramp_s, seconds, cells, courant = case_args
     preset = make()
     case = fv.case_from_preset(preset, fv_cases.package_has_bend_term())
     package = drill_sim_startup(preset, rpm, ramp_s, seconds, tmp_path)
@@ -146,26 +160,5 @@ def test_drill_sim_startup_agrees_with_the_independent_solver(name: str,
     reference = fv.startup_figures(fv.run_startup(case, rpm, ramp_s, seconds, cells,
                                                   courant), cutoff_hz)
     assert reference["stick_slip"]                     # the cases stick and slip off bottom
-    assert not mismatches(package, reference), mismatches(package, reference)
-
-
-@pytest.mark.slow
-def test_without_the_static_drop_the_package_agrees_within_half_a_per_cent(
-        tmp_path: Path) -> None:
-    """The deviated case with mu_s = mu_d (0.425): no drop from static to dynamic, so no
-    cascade of released elements, and the package's wall (lumped: at 64 points per section,
-    one wave step per bit step; per cell: the preset's cells) carries the same physics as
-    the solver's cells: the sections, the
-    buoyed normal force, the drive with its lag and rate limit, the free bit and the
-    figures. Every break-away figure within 0.5 % (measured 2026-12-06 with the wall lumped at
-    64 points per section and one wave step per bit step: within 0.02 %)."""
-    preset = fv_cases.deviated()
-    preset["well"]["side_friction"]["static"] = preset["well"]["side_friction"]["dynamic"]
-    if "damping_points" in preset["string"]:        # the lumped wall: at its finest
-        preset["string"].update(damping_points=64, bit_substeps=1)
-    package = drill_sim_startup(preset, 30.0, 10.0, 25.0, tmp_path)
-    case = fv.case_from_preset(preset, fv_cases.package_has_bend_term())
-    reference = fv.startup_figures(fv.run_startup(case, 30.0, 10.0, 25.0, 1000),
-                                   package["cutoff_hz"])
-    for key in FIGURES[:-1]:
-        assert package[key] == pytest.approx(reference[key], rel=0.005), key
+    off = mismatches(package, reference, name not in fv_cases.STICK_UNCOMPARED)
+    assert not off, off
