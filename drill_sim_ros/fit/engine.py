@@ -50,6 +50,7 @@ import numpy as np
 from drill_sim_ros.fit.log import SurfaceLog
 from drill_sim_ros.fit.objective import Target, noise_std
 from drill_sim_ros.fit.params import FitParameter, with_values
+from drill_sim_ros.model.analysis import lowpass
 from drill_sim_ros.model.errors import DrillSimError
 from drill_sim_ros.model.presets import preset_from_dict
 from drill_sim_ros.model.replay import replay_speed
@@ -69,21 +70,37 @@ Z95 = 0.975
 
 
 def simulate(data: dict[str, Any], values: dict[str, float], t_s: np.ndarray,
-             speed_rad_s: np.ndarray, speed_noise: tuple[int, float] | None = None
-             ) -> tuple[np.ndarray, np.ndarray] | str:
+             speed_rad_s: np.ndarray, speed_noise: tuple[int, float] | None = None,
+             cutoff_hz: float = math.inf) -> tuple[np.ndarray, np.ndarray] | str:
     """One replay (a Dask task): the string torque at the top N m and the bit speed rad/s at
     the log's times, or the one-line reason the preset with ``values`` is refused.
-    ``speed_noise`` (seed, std rad/s): white noise added to the speed it follows."""
+    ``speed_noise`` (seed, std rad/s): white noise added to the speed it follows; the speed
+    is then low-passed at ``cutoff_hz`` (:func:`replayed_speed`)."""
     if speed_noise is not None:
         seed, std = speed_noise
         speed_rad_s = speed_rad_s + std * np.random.default_rng(seed).standard_normal(
             speed_rad_s.size)
+    speed_rad_s = replayed_speed(t_s, speed_rad_s, cutoff_hz)
     try:
         preset = preset_from_dict("fit", with_values(data, values))
         run = replay_speed(preset, t_s, speed_rad_s)
     except DrillSimError as exc:
         return str(exc)
     return run.surface_torque_nm, run.bit_rpm * (math.pi / 30.0)
+
+
+def replayed_speed(t_s: np.ndarray, speed_rad_s: np.ndarray, cutoff_hz: float) -> np.ndarray:
+    """The drive speed a replay follows: the logged one low-passed at ``cutoff_hz`` (the
+    string's cut-off, zero-phase). The drive's own speed carries nothing above it that the
+    string's stick-slip answers to, but the speed sensor's white noise does, and a
+    kinematic drive would pass that jitter into the string: the wall's stick band (Karnopp,
+    a one-step memory of each junction's speed) holds a junction whose speed the jitter
+    dips into the band, so a jittered replay winds up stiffer than the rig did (measured
+    2026-12-06, benchmarks/fit_replay_bias.py: the true speed with the sensor's 0.02 rad/s
+    of noise replayed on field_8p5in_deviated slips later and higher, every time)."""
+    if not math.isfinite(cutoff_hz) or t_s.size < 2:
+        return speed_rad_s
+    return lowpass(speed_rad_s, float(np.median(np.diff(t_s))), cutoff_hz)
 
 
 @dataclass(frozen=True)
@@ -170,7 +187,8 @@ class Evaluator:
         speed with noise of its own size seeded ``job[2] + seed_offset``."""
         log = self.targets[job[1]].log
         return (self.data, self.values_of(xs[job[0]]), log.t_s, log.speed_rad_s,
-                (job[2] + seed_offset, self.speed_noise[job[1]]))
+                (job[2] + seed_offset, self.speed_noise[job[1]]),
+                self.targets[job[1]].cutoff_hz)
 
     def _take(self, key: str, segment: int, result: tuple[np.ndarray, np.ndarray] | str
               ) -> None:
@@ -231,8 +249,8 @@ class Evaluator:
 
     def map_runs(self, values: dict[str, float]) -> list[tuple[np.ndarray, np.ndarray]]:
         """Each start-up replayed with ``values``: (string torque N m, bit speed rad/s)."""
-        runs = self._map([(self.data, values, t.log.t_s, t.log.speed_rad_s)
-                          for t in self.targets])
+        runs = self._map([(self.data, values, t.log.t_s, t.log.speed_rad_s, None,
+                           t.cutoff_hz) for t in self.targets])
         for run in runs:
             if isinstance(run, str):
                 raise DrillSimError(f"the fitted values are refused: {run}")
