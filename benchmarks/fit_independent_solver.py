@@ -37,9 +37,13 @@ from tests.model import fv_reference as fv
 FIT = "well.side_friction.static,well.side_friction.dynamic"
 
 
+def csv_path(args: argparse.Namespace) -> Path:
+    return args.dir / f"{args.case}_{args.cells}_{args.seconds:g}_{args.seed}.csv"
+
+
 def fv_log(raw: dict, args: argparse.Namespace) -> synthetic.SurfaceLog:
     """The solver's start-up as the scenario's sensors log it (cached as a CSV)."""
-    path = args.dir / f"{args.case}_{args.cells}_{args.seconds:g}_{args.seed}.csv"
+    path = csv_path(args)
     if not path.exists():
         rpm, ramp_s = fv_cases.CASES[args.case][1:3]
         t0 = time.perf_counter()
@@ -74,7 +78,7 @@ def main() -> None:
     start = with_values(raw, {p: args.start * v for p, v in zip(paths, truth, strict=True)})
     preset = preset_from_dict(args.case, start)
     targets = [objective.make_target(log.part(a, b), preset) for a, b in find_startups(log)]
-    cache = args.dir / f"{log.source.replace(' ', '_')}_{args.seed}_{args.start}.jsonl"
+    cache = args.dir / f"{csv_path(args).stem}_{len(paths)}p_{args.start:g}.jsonl"
     t0 = time.perf_counter()
     if args.workers:
         from drill_sim_ros.study.engine import connect

@@ -169,10 +169,10 @@ def test_fit_moves_the_static_friction_to_within_10_percent(static_fit) -> None:
     assert abs(value["value"] / static_fit["truth"] - 1.0) < 0.10
 
 
-@pytest.mark.xfail(strict=True, reason="issue 51's 5 % and coverage are not met: replays of "
-                   "the logged speed wind the string up differently from the run that made "
-                   "the log (the break-away sits on wave arrivals, docs/string.md), the fit lands "
-                   "about 8 % high with an interval that misses the truth; docs/fit.md")
+@pytest.mark.xfail(strict=True, reason="issue 51's 5 % and coverage are not met: the misfit "
+                   "along the static coefficient is lowest at the truth (docs/fit.md), but "
+                   "least squares stops about 5 % below it, in a shoulder of the replays' "
+                   "rough misfit, with an interval that misses the truth; docs/fit.md")
 def test_fit_recovers_the_static_friction_within_5_percent_inside_its_interval(
         static_fit) -> None:
     value = static_fit["report"]["fits"][0]["values"]["well.side_friction.static"]
