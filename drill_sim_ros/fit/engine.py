@@ -60,7 +60,6 @@ from typing import Any
 
 import numpy as np
 
-from drill_sim_ros.fit.log import SurfaceLog
 from drill_sim_ros.fit.objective import Target, noise_std
 from drill_sim_ros.fit.params import FitParameter, with_values
 from drill_sim_ros.model.analysis import lowpass
@@ -147,7 +146,7 @@ class Evaluator:
         self.computed = self.reused = 0
         self.best = math.inf
         self.started = time.perf_counter()
-        self._keys = [f"{s}#{self._segment_key(t.log)}" for s, t in enumerate(self.targets)]
+        self._keys = [f"{s}#{self._segment_key(t)}" for s, t in enumerate(self.targets)]
         self.sigma = [t.noise_sigma for t in self.targets]
         self.speed_noise = [noise_std(t.log.speed_rad_s) for t in self.targets]
         self.sensitivity: list[np.ndarray | None] = [None] * len(self.targets)
@@ -155,11 +154,15 @@ class Evaluator:
             self._load(cache)
 
     # ---- cache ----------------------------------------------------------------------
-    def _segment_key(self, log: SurfaceLog) -> str:
+    def _segment_key(self, target: Target) -> str:
+        """The cache's key of a start-up: the preset, the log, the fitted paths and the
+        cut-off the replayed speed is low-passed at."""
+        log = target.log
         h = hashlib.sha256(json.dumps(self.data, sort_keys=True, default=str).encode())
         for array in (log.t_s, log.speed_rad_s, log.torque_nm):
             h.update(np.ascontiguousarray(array, dtype=np.float64).tobytes())
         h.update(",".join(p.path for p in self.params).encode())
+        h.update(f"lowpass {target.cutoff_hz!r}".encode())
         return h.hexdigest()[:24]
 
     def _key(self, segment: int, x: np.ndarray) -> str:
