@@ -21,6 +21,10 @@ from drill_sim_ros.model.startup import RPM_PER_RAD_S, run_startup
 from drill_sim_ros.model.validate_input import read_preset_file
 
 PRESET = "field_8p5in_deviated"
+# The static fit below averages twelve replays a point (fit.engine): some 1150 replays of a
+# 60 s start-up, 5-6 min of CPU, up to 15 min of wall time on a loaded machine; the tests
+# that use it (the first pays for it) get this timeout instead of the suite's 300 s.
+FIT_TIMEOUT_S = 1800
 # The fits here run the preset's string at a 2.0 ms wave step (the preset: 1.0 ms), half the
 # cost of every replay: they test the fit's machinery on a log of the same model, not the
 # preset's convergence in the wave step (docs/string.md).
@@ -141,6 +145,7 @@ def _stdout() -> Iterator[list[str]]:
     lines.extend(buffer.getvalue().strip().splitlines())
 
 
+@pytest.mark.timeout(FIT_TIMEOUT_S)
 def test_fit_reports_writes_its_preset_and_resumes(static_fit) -> None:
     """The report has the value inside its interval, the misfits and both cycles; the
     preset written names the log and holds the value; run again, the cache replays
@@ -163,12 +168,14 @@ def test_fit_reports_writes_its_preset_and_resumes(static_fit) -> None:
     assert again["values"] == fit["values"]
 
 
+@pytest.mark.timeout(FIT_TIMEOUT_S)
 def test_fit_moves_the_static_friction_to_within_10_percent(static_fit) -> None:
     """From 15 % below, the fitted static coefficient lands within 10 % of the truth."""
     value = static_fit["report"]["fits"][0]["values"]["well.side_friction.static"]
     assert abs(value["value"] / static_fit["truth"] - 1.0) < 0.10
 
 
+@pytest.mark.timeout(FIT_TIMEOUT_S)
 @pytest.mark.xfail(strict=True, reason="issue 51's coverage is not met: the fit lands within "
                    "1 % of the truth (docs/fit.md, 2026-12-06) but its 95 % interval, from the "
                    "Jacobian of a misfit that is rough on the scale of its differences, is "
