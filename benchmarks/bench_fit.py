@@ -6,17 +6,26 @@ truth) from rest, 0 to 30 rpm in 10 s, 60 s at 100 Hz, measured by the sensors o
 noisy_delayed_sensors scenario (noise and quantisation; delays left out), a seed per log.
 The fit adjusts well.side_friction.static, .dynamic, .stick_speed_rad_s and
 string.torsional_damping_per_s (or --params), starting from a preset with each of them
-20 % below the truth, on a local Dask cluster of --workers. Printed per log: the fitted
+20 % below the truth (``--start``), on a local Dask cluster of --workers (0: in this
+process); ``--substeps`` sets the wave step (54: 2.0 ms, the tests'; default the preset's).
+Resumable: each log's replays go to a cache and each finished log to a JSON line in
+``--dir``; run again, the finished logs are read back and an interrupted fit goes on where
+it stopped (``--seeds A:B`` picks the logs). Printed per log: the fitted
 values' errors against the truth, whether each 95 % interval covers it, the misfit at the
 fit and at the truth (the same weights), the recorded and fitted cycles (period, mean,
 std) and the wall time; then the coverage counts (issue 51: within 5 % and >= 17 of 20).
-Usage: .venv/bin/python benchmarks/bench_fit.py [--logs 20] [--workers 2]
+Usage: .venv/bin/python benchmarks/bench_fit.py [--seeds 1:20] [--workers 2]
+       [--params a,b] [--start 0.8] [--substeps 54] [--dir /tmp/bench_fit]
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
+import json
+import sys
 import time
+from pathlib import Path
 
 import numpy as np
 
@@ -33,15 +42,20 @@ PARAMS = ("well.side_friction.static,well.side_friction.dynamic,"
 START_SHARE = 0.8
 
 
-def one_log(seed: int, data: dict, names: str, client: object) -> dict:
+def one_log(seed: int, data: dict, names: str, client: object, share: float, cache: Path
+            ) -> dict:
     truth_preset = preset_from_dict(PRESET, data)
     log = synthetic.synthetic_log(truth_preset, 30.0, 10.0, 60.0,
                                   synthetic.scenario_sensors(seed))
     paths = names.split(",")
     truth = np.array([float(get_path(data, p)) for p in paths])
-    start = with_values(data, {p: START_SHARE * v for p, v in zip(paths, truth, strict=True)})
+    start = with_values(data, {p: share * v for p, v in zip(paths, truth, strict=True)})
     target = objective.make_target(log, truth_preset)
-    evaluator = engine.Evaluator(start, parse_fit(names, start), [target], client)
+
+    def progress(text: str) -> None:
+        print(f"\rlog {seed}: {text}", end="", file=sys.stderr, flush=True)
+    evaluator = engine.Evaluator(start, parse_fit(names, start), [target], client, cache,
+                                 progress)
     t0 = time.perf_counter()
     result = engine.fit(evaluator)
     seconds = time.perf_counter() - t0
@@ -49,33 +63,60 @@ def one_log(seed: int, data: dict, names: str, client: object) -> dict:
     run = evaluator.map_runs(evaluator.values_of(result.x))[0]
     logged = lowpass(log.torque_nm, log.sample_s, target.cutoff_hz)[target.torque.cycle]
     fitted = target.model_torque(run[0])[target.torque.cycle]
-    return {"seed": seed, "error": result.x / truth - 1.0,
-            "covers": (result.low95 <= truth) & (truth <= result.high95),
+    print(file=sys.stderr)
+    return {"seed": seed, "error": (result.x / truth - 1.0).tolist(),
+            "covers": ((result.low95 <= truth) & (truth <= result.high95)).tolist(),
             "misfit": (result.misfit_after, at_truth), "seconds": seconds,
             "replays": result.replays,
-            "cycle": (objective.cycle_features(logged, log.sample_s)[:3],
-                      objective.cycle_features(fitted, log.sample_s)[:3])}
+            "cycle": (objective.cycle_features(logged, log.sample_s)[:3].tolist(),
+                      objective.cycle_features(fitted, log.sample_s)[:3].tolist())}
+
+
+def show(r: dict) -> None:
+    (rec, fit), error_pct = r["cycle"], 100 * np.array(r["error"])
+    print(f"log {r['seed']:2d}: error % {np.array2string(error_pct, precision=1)} "
+          f"covered {np.array(r['covers']).astype(int)} misfit {r['misfit'][0]:.3g} (truth "
+          f"{r['misfit'][1]:.3g}); cycle period {rec[0]:.2f}/{fit[0]:.2f} s, mean "
+          f"{rec[1]:.0f}/{fit[1]:.0f} N m, std {rec[2]:.0f}/{fit[2]:.0f} N m "
+          f"(logged/fitted); {r['replays']} replays in {r['seconds']:.0f} s", flush=True)
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--logs", type=int, default=20)
+    ap.add_argument("--seeds", default="1:20", help="A:B, the logs' seeds (inclusive)")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--params", default=PARAMS)
+    ap.add_argument("--start", type=float, default=START_SHARE)
+    ap.add_argument("--substeps", type=int, help="the preset's bit_substeps (wave step)")
+    ap.add_argument("--dir", type=Path, default=Path("/tmp/bench_fit"))
     args = ap.parse_args()
     data = read_preset_file(preset_path(PRESET))
+    if args.substeps:
+        data["string"]["bit_substeps"] = args.substeps
     paths = args.params.split(",")
+    first, last = (int(v) for v in args.seeds.split(":"))
+    args.dir.mkdir(parents=True, exist_ok=True)
+    tag = f"{len(paths)}p_{args.start:g}_{args.substeps or 'preset'}_r{engine.REPLAYS_PER_POINT}"
+    done_path = args.dir / f"done_{tag}.jsonl"
+    done = {}
+    if done_path.exists():
+        for line in done_path.read_text().splitlines():
+            r = json.loads(line)
+            if r.get("params") == args.params:
+                done[r["seed"]] = r
     rows = []
-    with connect(None, args.workers) as client:
-        for seed in range(1, args.logs + 1):
-            r = one_log(seed, data, args.params, client)
+    with connect(None, args.workers) if args.workers else contextlib.nullcontext() as client:
+        for seed in range(first, last + 1):
+            if seed in done:
+                r = done[seed]
+            else:
+                r = one_log(seed, data, args.params, client, args.start,
+                            args.dir / f"cache_{tag}_{seed}.jsonl")
+                r["params"] = args.params
+                with done_path.open("a") as f:
+                    f.write(json.dumps(r) + "\n")
             rows.append(r)
-            (rec, fit) = r["cycle"]
-            print(f"log {seed:2d}: error % {np.array2string(100 * r['error'], precision=1)} "
-                  f"covered {r['covers'].astype(int)} misfit {r['misfit'][0]:.3g} (truth "
-                  f"{r['misfit'][1]:.3g}); cycle period {rec[0]:.2f}/{fit[0]:.2f} s, mean "
-                  f"{rec[1]:.0f}/{fit[1]:.0f} N m, std {rec[2]:.0f}/{fit[2]:.0f} N m "
-                  f"(logged/fitted); {r['replays']} replays in {r['seconds']:.0f} s", flush=True)
+            show(r)
     errors = np.array([r["error"] for r in rows])
     covers = np.array([r["covers"] for r in rows])
     for i, path in enumerate(paths):

@@ -22,6 +22,7 @@ from drill_sim_ros.fit import engine
 from drill_sim_ros.fit.log import TORQUE_KINDS, SurfaceLog, find_startups, read_log
 from drill_sim_ros.fit.objective import Target, make_target
 from drill_sim_ros.fit.params import DEFAULT_BOUNDS, parse_fit, parse_span, with_values
+from drill_sim_ros.model.errors import DrillSimError
 from drill_sim_ros.model.presets import preset_from_dict, preset_path
 from drill_sim_ros.model.validate_input import read_preset_file
 from drill_sim_ros.plot_file import (
@@ -32,6 +33,8 @@ from drill_sim_ros.plot_file import (
     plot_into,
 )
 from drill_sim_ros.terminal import StatusLine
+
+REPLAYS_RANGE = (1, 64)      # --replays: one replay a point up to 64
 
 
 def add_parser(sub: Any) -> None:
@@ -61,6 +64,10 @@ def add_parser(sub: Any) -> None:
                    "(default: a local cluster)")
     p.add_argument("--workers", type=int, help="local cluster's workers (default: one a core)")
     p.add_argument("--in-process", action="store_true", help="no Dask: replay in this process")
+    p.add_argument("--replays", type=int, default=engine.REPLAYS_PER_POINT,
+                   help=f"replays averaged per parameter vector, {REPLAYS_RANGE[0]}.."
+                   f"{REPLAYS_RANGE[1]} (default {engine.REPLAYS_PER_POINT}: fewer are "
+                   "faster and leave the misfit rougher, docs/fit.md)")
     p.add_argument("--json", action="store_true", help="print only the JSON line")
     add_plot_arguments(p, "the recorded and fitted surface speed and torque", "--out")
 
@@ -74,6 +81,9 @@ def _window(log: SurfaceLog, text: str | None) -> SurfaceLog:
 
 
 def cmd_fit(args: Any) -> int:
+    low, high = REPLAYS_RANGE
+    if not low <= args.replays <= high:
+        raise DrillSimError(f"--replays {args.replays}: must be within {low}..{high}")
     path = preset_path(args.params)
     data = read_preset_file(path)
     preset = preset_from_dict(path.stem, data)
@@ -107,19 +117,22 @@ def _run(args: Any, data: dict[str, Any], params: list, targets: list[Target],
     groups = [[t] for t in targets] if args.each else [targets]
     try:
         if args.in_process:
-            results = [_fit(data, params, g, None, cache, line) for g in groups]
+            results = [_fit(data, params, g, None, cache, line, args.replays)
+                       for g in groups]
         else:
             from drill_sim_ros.study.engine import connect
             with connect(args.scheduler, args.workers) as client:
-                results = [_fit(data, params, g, client, cache, line) for g in groups]
+                results = [_fit(data, params, g, client, cache, line, args.replays)
+                           for g in groups]
     finally:
         line.close()
     return _report(args, params, targets, groups, results)
 
 
 def _fit(data: dict[str, Any], params: list, group: list[Target], client: Any,
-         cache: Path | None, line: StatusLine) -> tuple[engine.FitResult, list]:
-    evaluator = engine.Evaluator(data, params, group, client, cache, line.show)
+         cache: Path | None, line: StatusLine, replays: int
+         ) -> tuple[engine.FitResult, list]:
+    evaluator = engine.Evaluator(data, params, group, client, cache, line.show, replays)
     result = engine.fit(evaluator)
     values = evaluator.values_of(result.x)
     runs = evaluator.map_runs(values)

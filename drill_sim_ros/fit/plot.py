@@ -30,7 +30,7 @@ def plot_fit(path: Path, data: dict[str, Any], params: list, targets: list[Targe
     for col, (target, run) in enumerate(fitted):
         log = target.log
         t = log.t_s - log.t_s[0]
-        before = simulate(data, {}, log.t_s, log.speed_rad_s)
+        before = simulate(data, {}, log.t_s, log.speed_rad_s, None, target.cutoff_hz)
         ax = axes[0, col]
         ax.plot(t, log.speed_rad_s * RPM_PER_RAD_S, color="0.6", lw=0.6, label="drive, logged")
         ax.plot(t, run[1] * RPM_PER_RAD_S, color="C1", lw=0.8, label="bit, fitted replay")

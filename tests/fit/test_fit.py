@@ -21,6 +21,12 @@ from drill_sim_ros.model.startup import RPM_PER_RAD_S, run_startup
 from drill_sim_ros.model.validate_input import read_preset_file
 
 PRESET = "field_8p5in_deviated"
+# The static fit at the tool's default, twelve replays a point (fit.engine): some 1150
+# replays, 5-6 min of CPU, up to 15 min of wall time on a loaded machine: a study
+# (``make bench``, marker ``study``), with this timeout instead of the suite's 300 s. The
+# fit that tests the machinery and the 10 % bar in ``make test`` averages TEST_REPLAYS.
+FIT_TIMEOUT_S = 1800
+TEST_REPLAYS = 4
 # The fits here run the preset's string at a 2.0 ms wave step (the preset: 1.0 ms), half the
 # cost of every replay: they test the fit's machinery on a log of the same model, not the
 # preset's convergence in the wave step (docs/string.md).
@@ -118,9 +124,20 @@ def test_noise_std_reads_white_noise_under_a_ramp() -> None:
 
 @pytest.fixture(scope="module")
 def static_fit(log_csv: str, tmp_path_factory: pytest.TempPathFactory) -> dict:
-    """``drill_sim fit`` of the wall's static coefficient from 15 % below the truth on a
-    log of the simulator (its sensors' noise and quantisation): the truth, the argv, the
-    report, the preset written."""
+    """``drill_sim fit --replays 4`` of the wall's static coefficient from 15 % below the
+    truth on a log of the simulator (its sensors' noise and quantisation): the truth, the
+    argv, the report, the preset written."""
+    return _static_fit(log_csv, tmp_path_factory, ["--replays", str(TEST_REPLAYS)])
+
+
+@pytest.fixture(scope="module")
+def static_fit_default(log_csv: str, tmp_path_factory: pytest.TempPathFactory) -> dict:
+    """The same fit at the tool's default replays a point (a study: minutes)."""
+    return _static_fit(log_csv, tmp_path_factory, [])
+
+
+def _static_fit(log_csv: str, tmp_path_factory: pytest.TempPathFactory,
+                options: list[str]) -> dict:
     tmp = tmp_path_factory.mktemp("static")
     data = coarse_data()
     truth = data["well"]["side_friction"]["static"]
@@ -129,7 +146,7 @@ def static_fit(log_csv: str, tmp_path_factory: pytest.TempPathFactory) -> dict:
     start.write_text(yaml.safe_dump(data))
     out = tmp / "fitted.yaml"
     argv = ["fit", "--params", str(start), "--log", log_csv, "--fit",
-            "well.side_friction.static", "--in-process", "--json", "--out", str(out)]
+            "well.side_friction.static", "--in-process", "--json", "--out", str(out), *options]
     with _stdout() as lines:
         assert cli.main(argv) == 0
     return {"truth": truth, "argv": argv, "report": json.loads(lines[-1]), "out": out,
@@ -173,15 +190,17 @@ def test_fit_moves_the_static_friction_to_within_10_percent(static_fit) -> None:
     assert abs(value["value"] / static_fit["truth"] - 1.0) < 0.10
 
 
-@pytest.mark.xfail(strict=True, reason="issue 51's coverage is not met: replays of "
-                   "the logged speed wind the string up differently from the run that made "
-                   "the log (the break-away sits on wave arrivals, docs/string.md), the fit lands "
-                   "3 % low with an interval that misses the truth; docs/fit.md")
+@pytest.mark.study
+@pytest.mark.timeout(FIT_TIMEOUT_S)
+@pytest.mark.xfail(strict=True, reason="issue 51's coverage is not met: the fit lands within "
+                   "1 % of the truth (docs/fit.md, 2026-12-06) but its 95 % interval, from the "
+                   "Jacobian of a misfit that is rough on the scale of its differences, is "
+                   "too narrow (+-0.6 %) and misses the truth")
 def test_fit_recovers_the_static_friction_within_5_percent_inside_its_interval(
-        static_fit) -> None:
-    value = static_fit["report"]["fits"][0]["values"]["well.side_friction.static"]
-    assert abs(value["value"] / static_fit["truth"] - 1.0) < 0.05
-    assert value["low95"] <= static_fit["truth"] <= value["high95"]
+        static_fit_default) -> None:
+    value = static_fit_default["report"]["fits"][0]["values"]["well.side_friction.static"]
+    assert abs(value["value"] / static_fit_default["truth"] - 1.0) < 0.05
+    assert value["low95"] <= static_fit_default["truth"] <= value["high95"]
 
 
 def test_a_las_log_is_read_by_mnemonic_and_unit(tmp_path) -> None:
