@@ -71,6 +71,14 @@ def test_a_bad_log_is_refused_in_one_line(tmp_path, header, rows, words) -> None
         read_log(_write(tmp_path / "bad.csv", header, rows), kind)
 
 
+@pytest.mark.parametrize("count", ["0", "65"])
+def test_replays_outside_their_range_are_refused_in_one_line(count: str, capsys) -> None:
+    code = cli.main(["fit", "--params", PRESET, "--log", "unread.csv", "--fit",
+                     "well.side_friction.static", "--replays", count])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and f"--replays {count}: must be within 1..64" in err[0]
+
+
 def test_a_log_without_a_start_up_is_refused(tmp_path, capsys) -> None:
     rows = [[0.01 * i, 30.0, 10.0] for i in range(500)]        # turning all along
     path = _write(tmp_path / "steady.csv", "time_s,surface_rpm,torque_knm", rows)
