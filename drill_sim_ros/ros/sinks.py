@@ -97,9 +97,11 @@ class SampleSinks:
         if self.recorder is not None:
             self.recorder.write_serialized(publisher.topic_name, payload, time_ns)
 
-    def backlogged(self) -> bool:
-        """The recorder is behind by more than :data:`RECORDER_HIGH_WATER` messages or
-        :data:`RECORDER_MAX_LAG_S` of simulated time."""
+    def backlogged(self, ahead_s: float = 0.0) -> bool:
+        """The recorder is behind by more than :data:`RECORDER_HIGH_WATER` messages, or
+        would be by more than :data:`RECORDER_MAX_LAG_S` of simulated time once the block
+        about to be simulated (``ahead_s``) is queued too."""
         recorder = self.recorder
-        return recorder is not None and (recorder.backlog > RECORDER_HIGH_WATER
-                                         or recorder.backlog_s > RECORDER_MAX_LAG_S)
+        return recorder is not None and (
+            recorder.backlog > RECORDER_HIGH_WATER
+            or recorder.backlog_s + ahead_s > RECORDER_MAX_LAG_S)

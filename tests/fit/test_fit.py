@@ -26,7 +26,7 @@ PRESET = "field_8p5in_deviated"
 # (``make bench``, marker ``study``), with this timeout instead of the suite's 300 s. The
 # fit that tests the machinery and the 10 % bar in ``make test`` averages TEST_REPLAYS.
 FIT_TIMEOUT_S = 1800
-TEST_REPLAYS = 4
+TEST_REPLAYS = 2
 # The fits here run the preset's string at a 2.0 ms wave step (the preset: 1.0 ms), half the
 # cost of every replay: they test the fit's machinery on a log of the same model, not the
 # preset's convergence in the wave step (docs/string.md).
@@ -132,9 +132,9 @@ def test_noise_std_reads_white_noise_under_a_ramp() -> None:
 
 @pytest.fixture(scope="module")
 def static_fit(log_csv: str, tmp_path_factory: pytest.TempPathFactory) -> dict:
-    """``drill_sim fit --replays 4`` of the wall's static coefficient from 15 % below the
-    truth on a log of the simulator (its sensors' noise and quantisation): the truth, the
-    argv, the report, the preset written."""
+    """``drill_sim fit --replays 2`` (TEST_REPLAYS) of the wall's static coefficient from
+    15 % below the truth on a log of the simulator (its sensors' noise and quantisation):
+    the truth, the argv, the report, the preset written."""
     return _static_fit(log_csv, tmp_path_factory, ["--replays", str(TEST_REPLAYS)])
 
 
