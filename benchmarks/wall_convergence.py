@@ -9,8 +9,12 @@ With ``--statics``: instead, the torque at the top when the bit breaks away on a
 ramp inside the stick band (to a tenth of it in 60 s) against the integral of r_o mu_s N, and
 the mean torque at the top turning steadily at 60 rpm (the last 20 s of 120) against the
 integral of r_o mu_d N plus the viscous drag, both integrals taken here on 20 000 pieces.
+With ``--ensemble N``: at each resolution N runs whose ramps span --ramp-s x (1 +- 0.2 %)
+(a rig cannot set a ramp closer than that), each member's break-away figures: which slip
+pulse frees the bit, as a distribution (docs/string.md, "Which slip pulse frees the bit").
 Usage: .venv/bin/python benchmarks/wall_convergence.py --params field_8p5in_deviated
        [--rpm 40 --ramp-s 2 --seconds 120] [--substeps 54 27 14 7] [--statics]
+       [--ensemble 5]
 """
 
 from __future__ import annotations
@@ -24,6 +28,7 @@ import numpy as np
 from drill_sim_ros.model import startup
 from drill_sim_ros.model.presets import Preset, load_preset
 
+ENSEMBLE_SPAN = 4e-3    # the members' ramps span this, relative, centred on --ramp-s
 FIGURES = ("breakaway_s", "breakaway_turns", "breakaway_torque_nm", "first_slip_s",
            "peak_motor_torque_nm", "period_s", "stick_fraction")
 
@@ -69,6 +74,20 @@ def statics(preset: Preset) -> None:
           f"{expected:.1f} N m ({100 * (mean / expected - 1):+.2f} %)")
 
 
+def ensemble(preset: Preset, args: argparse.Namespace) -> None:
+    """Each resolution's members, their ramps spread over ENSEMBLE_SPAN."""
+    members = args.ensemble
+    for sub in args.substeps:
+        p = replace(preset, string=replace(preset.string, bit_substeps=sub))
+        for k in range(members):
+            relative = ENSEMBLE_SPAN * (k / (members - 1) - 0.5)
+            scores = startup.startup_scores(
+                startup.run_startup(p, args.rpm, args.ramp_s * (1.0 + relative), args.seconds))
+            print(f"substeps {sub}, ramp {100 * relative:+.2f} %: "
+                  + ", ".join(f"{name} {scores.get(name)!r:.8}" for name in FIGURES[:5]),
+                  flush=True)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--params", default="field_8p5in_deviated")
@@ -77,10 +96,14 @@ def main() -> None:
     parser.add_argument("--seconds", type=float, default=120.0)
     parser.add_argument("--substeps", type=int, nargs="+", default=[54, 27, 14, 7])
     parser.add_argument("--statics", action="store_true")
+    parser.add_argument("--ensemble", type=int, default=1, metavar="N")
     args = parser.parse_args()
     preset = load_preset(args.params)
     if args.statics:
         statics(preset)
+        return
+    if args.ensemble > 1:
+        ensemble(preset, args)
         return
     rows = {}
     for sub in args.substeps:
