@@ -398,7 +398,8 @@ def friction_weakening_from_dict(values: object) -> FrictionWeakening | None:
     return FrictionWeakening(**{**values, **numbers})
 
 
-# ---- the depth-of-cut limit (docs/model.md#a-depth-of-cut-limit) ---------------------------
+# ---- the depth-of-cut limit ------------------------------------------------------------
+# (docs/model.md#a-depth-of-cut-limit-an-option-off-by-default)
 LIMIT = "physical.depth_of_cut_limit"
 LIMIT_RANGES = {"max_depth_m_per_rev": (0.0, 1.0),    # (0, 1] m per revolution
                 "mu_gamma": (0.0, 10.0)}              # [0, 10]: the limiter's mu gamma
@@ -411,7 +412,8 @@ class DepthOfCutLimit:
     of-cut control elements, the blade body behind the cutters) rides on the rock, stops
     the bit's advance and carries the weight the cutters and the wearflat do not, with the
     friction ``mu_gamma`` (mu gamma of that contact, as the wearflat's ``physical.mu_gamma``
-    in eq. 11; None: the wearflat's). docs/model.md#a-depth-of-cut-limit."""
+    in eq. 11; None: the wearflat's).
+    docs/model.md#a-depth-of-cut-limit-an-option-off-by-default."""
 
     max_depth_m_per_rev: float
     mu_gamma: float | None = None

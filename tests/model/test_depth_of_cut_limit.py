@@ -37,7 +37,7 @@ def field(**limit: object) -> Preset:
 def hold_nm(preset: Preset, depth_m: float, force_n: float, mu_gamma_limit: float) -> float:
     """The torque a stuck bit holds in SI, the cutters at ``depth_m`` per revolution, the
     wearflat in full contact and the limiter carrying the rest of ``force_n`` (eqs. 2-5,
-    11; docs/model.md#a-depth-of-cut-limit)."""
+    11; docs/model.md#a-depth-of-cut-limit-an-option-off-by-default)."""
     p = preset.physical
     a, eps = p.bit_radius_m, p.intrinsic_specific_energy_pa
     sigma_l = p.contact_stress_times_wearflat_n_per_m
