@@ -450,6 +450,9 @@ def _cmd_info(args: argparse.Namespace) -> int:
     print("  bit law rgd07" if weakening is None else
           f"  bit law {LAWS[preset.bit_law.law]}: floor ratio {weakening.floor_ratio:.4g}, "
           f"{weakening.speed_rad_s:.4g} rad/s, read through a {weakening.response_s:.4g} s lag")
+    if preset.depth_of_cut_limit is not None:
+        print(f"  depth-of-cut limit {1e3 * preset.depth_of_cut_limit.max_depth_m_per_rev:.4g} "
+              f"mm per revolution, its contact's beta {preset.bit_law.beta_limit:.4g}")
     root = analysis.rightmost_root(p)
     print(f"  tau_n0={analysis.trivial_delay(p):.4g}  critical delay="
           f"{analysis.critical_delay(p):.4g}  rightmost root={root.real:.4g}+{root.imag:.4g}i")

@@ -37,12 +37,21 @@ and its :class:`BitLaw` parameters.
 
 with f(omega) = 1 - (1 - a)(1 - exp(-omega / b)): a the floor ratio f(inf) in (0, 1], b the
 e-folding speed (scaled, omega t*). Written so that f(0) = 1 and a = 1 give exactly 1.
+
+Whatever the law, a bit may carry a depth-of-cut limit (:class:`DepthOfCutLimit`, off by
+default): its cutters cut at most ``doc_max`` per revolution, and deeper than that the bit's
+limiter (depth-of-cut control elements, the blade body behind the cutters) rides on the
+rock. The kernel then hands :func:`bit_response` the capped cutting depth and ``limited``:
+the limiter stops the bit's axial advance (a rigid unilateral contact, like the wearflat's
+eq. 31 without its bound lambda) and carries the weight the cutters and the wearflat do not,
+with its own friction ``beta_limit`` (mu gamma zeta of that contact, as beta is the
+wearflat's, eq. 10). Without it (``limited`` False) the law is RGD07's, bit for bit.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, fields, replace
 
 import numpy as np
 from numba import njit
@@ -75,6 +84,19 @@ def wearflat_contact(v0: float, f_ext: float, doc: float, lam: float,
     if v_full > 0.0:
         return v_full, lam                   # moving down: full contact
     return 0.0, v_free / kick                # V = 0: set-valued contact force
+
+
+@njit(cache=True, inline="always")
+def limiter_contact(v_new: float, kick: float) -> tuple[float, float]:
+    """The depth-of-cut limiter in contact: it stops the bit's advance into the rock.
+
+    Returns ``(v_new, w_l)``: a bit moving down (``v_new > 0``) is stopped, ``v_new = 0``,
+    by the force ``w_l = v_new / kick`` >= 0 that the step's momentum balance needs
+    (eq. 25 left); a bit moving up leaves the limiter, ``w_l = 0``.
+    """
+    if v_new > 0.0:
+        return 0.0, v_new / kick
+    return v_new, 0.0
 
 
 @njit(cache=True, inline="always")
@@ -138,26 +160,37 @@ def sliding_torque(law: int, doc: float, w_f: float, beta: float, omega: float, 
 @njit(cache=True, inline="always")
 def bit_response(v0: float, kick_v: float, f_ext: float, omega0: float, kick_w: float,
                  t_ext: float, doc: float, stuck: bool, beta: float, lam: float, law: int,
-                 omega_bit: float, law_a: float, law_b: float
-                 ) -> tuple[float, float, float, float, float, int, bool]:
+                 omega_bit: float, law_a: float, law_b: float, limited: bool,
+                 beta_limit: float) -> tuple[float, float, float, float, float, int, bool]:
     """Bit-rock forces and the bit's new velocities (eqs. 25, 29-33), the sliding torque
     from the bit law ``law`` (:func:`sliding_torque`, parameters ``law_a``, ``law_b``) at
-    the bit's speed at the start of the step ``omega_bit``.
+    the bit's speed at the start of the step ``omega_bit``. ``limited``: the bit is as
+    deep as its depth-of-cut limit, ``doc`` is the capped cutting depth, and the
+    limiter's contact (friction ``beta_limit``) carries the rest of the weight (module
+    doc; False: RGD07's law).
 
     Returns ``(v_new, omega_new, w_f, wob, tob, mode, stuck_new)``.
     """
-    if stuck and doc >= 0.0 and t_ext <= doc + beta * lam:
+    if stuck and doc >= 0.0:
         # Stick (eq. 32): the bit is immobile and the rock reacts the string torque and
         # force, until the string torque exceeds the cutting + friction torque
         # delta_k + beta lam (eqs. 14, 33 in the form valid for any top-drive speed).
         # The wearflat is in full contact as the paper assumes and carries f_ext - delta_k
         # (eq. 31, last line), so W = delta_k + W_f (eq. 29) and <U''> = 0 give eq. 44.
+        # A limiter in contact carries the rest, and its friction adds to the hold.
         w_f = stuck_wearflat(f_ext, doc, lam)
-        return 0.0, 0.0, w_f, doc + w_f, t_ext, MODE_STUCK, True
+        w_l = max(f_ext - doc - lam, 0.0) if limited else 0.0
+        static = doc + beta * lam + beta_limit * w_l if limited else doc + beta * lam
+        if t_ext <= static:
+            return 0.0, 0.0, w_f, doc + w_f + w_l, t_ext, MODE_STUCK, True
     if doc >= 0.0:
         v_new, w_f = wearflat_contact(v0, f_ext, doc, lam, kick_v)
         wob = doc + w_f                       # eq. (29): W = delta + W_f
         tob = sliding_torque(law, doc, w_f, beta, omega_bit, law_a, law_b)   # eq. (30)
+        if limited:                           # the limiter carries the rest
+            v_new, w_l = limiter_contact(v_new, kick_v)
+            wob += w_l
+            tob += beta_limit * w_l
         mode = MODE_CUTTING if w_f >= lam else MODE_LOST_CONTACT
     else:
         v_new = v0 + kick_v * f_ext           # off bottom: T = W = 0, the bit falls
@@ -277,12 +310,16 @@ class BitLaw:
     parameters ``a``, ``b`` (module doc: for the weakening laws the floor ratio and the
     e-folding speed, scaled omega t*), and ``response``, the time constant (scaled, tau)
     with which the speed the law reads follows the bit's (0: the bit's speed itself). The
-    default is RGD07's law."""
+    default is RGD07's law. ``doc_max``: the depth-of-cut limit per revolution (scaled,
+    L*; inf: none) and ``beta_limit`` its contact's friction mu gamma zeta
+    (:class:`DepthOfCutLimit`)."""
 
     law: int = LAW_RGD07
     a: float = 1.0
     b: float = 1.0
     response: float = 0.0
+    doc_max: float = math.inf
+    beta_limit: float = 0.0
 
     def __post_init__(self) -> None:
         if self.law not in range(len(LAWS)):
@@ -294,6 +331,10 @@ class BitLaw:
         if not (math.isfinite(self.response) and self.response >= 0.0):
             raise ParameterError(f"bit law response = {self.response!r} must be finite, "
                                  ">= 0")
+        if not (self.doc_max > 0.0 and math.isfinite(self.beta_limit)
+                and self.beta_limit >= 0.0):
+            raise ParameterError(f"bit law doc_max = {self.doc_max!r}, beta_limit = "
+                                 f"{self.beta_limit!r} must be > 0 (inf: none), >= 0")
 
     def alpha(self, dtau: float) -> float:
         """The share by which the speed the law reads follows the bit's over a step
@@ -355,3 +396,53 @@ def friction_weakening_from_dict(values: object) -> FrictionWeakening | None:
     numbers = {key: _weakening_number(key, values[key])
                for key in WEAKENING_RANGES if key in values}
     return FrictionWeakening(**{**values, **numbers})
+
+
+# ---- the depth-of-cut limit ------------------------------------------------------------
+# (docs/model.md#a-depth-of-cut-limit-an-option-off-by-default)
+LIMIT = "physical.depth_of_cut_limit"
+LIMIT_RANGES = {"max_depth_m_per_rev": (0.0, 1.0),    # (0, 1] m per revolution
+                "mu_gamma": (0.0, 10.0)}              # [0, 10]: the limiter's mu gamma
+
+
+@dataclass(frozen=True)
+class DepthOfCutLimit:
+    """A bit whose cutters cut at most ``max_depth_m_per_rev`` per revolution (SI; a
+    physical preset's ``physical.depth_of_cut_limit``): deeper than that, its limiter (depth-
+    of-cut control elements, the blade body behind the cutters) rides on the rock, stops
+    the bit's advance and carries the weight the cutters and the wearflat do not, with the
+    friction ``mu_gamma`` (mu gamma of that contact, as the wearflat's ``physical.mu_gamma``
+    in eq. 11; None: the wearflat's).
+    docs/model.md#a-depth-of-cut-limit-an-option-off-by-default."""
+
+    max_depth_m_per_rev: float
+    mu_gamma: float | None = None
+
+    def __post_init__(self) -> None:
+        for key, (low, high) in LIMIT_RANGES.items():
+            value = getattr(self, key)
+            if value is not None:
+                number_in(f"'{LIMIT}.{key}'", value, low, high, low_open=key != "mu_gamma")
+
+    def scaled(self, law: BitLaw, length_m: float, zeta: float, mu_gamma: float) -> BitLaw:
+        """``law`` with this limit in kernel units: the depth over L*, the friction
+        mu gamma zeta (eq. 10) with the bit's ``zeta`` and, without its own, the wearflat's
+        ``mu_gamma``."""
+        mu_gamma_limit = mu_gamma if self.mu_gamma is None else self.mu_gamma
+        return replace(law, doc_max=self.max_depth_m_per_rev / length_m,
+                       beta_limit=mu_gamma_limit * zeta)
+
+
+def depth_of_cut_limit_from_dict(values: object) -> DepthOfCutLimit | None:
+    """A preset's ``physical.depth_of_cut_limit`` mapping (None: absent, no limit);
+    ParameterError (one line) on an unknown or missing key or a value out of range."""
+    if values is None:
+        return None
+    known = tuple(f.name for f in fields(DepthOfCutLimit))
+    if not isinstance(values, dict) or "max_depth_m_per_rev" not in values:
+        raise ParameterError(f"'{LIMIT}' must be a mapping with max_depth_m_per_rev (and "
+                             f"optionally mu_gamma); got {values!r}")
+    check_known_keys(values, known, LIMIT)
+    return DepthOfCutLimit(**{key: number_in(f"'{LIMIT}.{key}'", values[key],
+                                             *LIMIT_RANGES[key], low_open=key != "mu_gamma")
+                              for key in values})

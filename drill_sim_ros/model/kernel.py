@@ -100,7 +100,9 @@ P_BIT_LAW_B = 29    # ratio and the e-folding speed (omega t*)
 P_TD_TORQUE_RATE = 30  # motor torque rate limit, scaled rate_SI t* / C (inf: none)
 P_BIT_LAW_ALPHA = 31  # the speed the bit law reads follows the bit's per step by this share,
                       # 1 - exp(-dtau / response) (1: the bit's speed itself; BitLaw.response)
-N_PARAMS = 32
+P_DOC_MAX = 32      # the depth-of-cut limit per revolution, L* (inf: none; BitLaw.doc_max)
+P_BETA_LIMIT = 33   # its contact's friction mu gamma zeta (BitLaw.beta_limit)
+N_PARAMS = 34
 OFF_BOTTOM_LIFTED = 3.0
 
 # ---- surface targets (float64) ----------------------------------------------------------
@@ -183,14 +185,16 @@ Loop.__doc__ = """The loop-carried state of a run (the ``S_*`` slots and the his
 Law = namedtuple("Law", (
     "dt", "tau_avg", "beta", "lam", "n_blades", "psi", "off_bottom", "layer_u", "cut_factor",
     "sector", "tgt_w", "w_rate", "inv_spacing", "hook_kp", "hook_ki", "pickup", "clearance",
-    "tag_speed", "substeps", "bit_law", "law_a", "law_b", "law_alpha"))
+    "tag_speed", "substeps", "bit_law", "law_a", "law_b", "law_alpha", "doc_max",
+    "beta_limit"))
 Law.__doc__ = """A run's constants of the bit law, the rock and the hook: dtau, the statistics
 window start, beta, lambda, n, psi, off bottom, the next layer's top, the cutting factor, the
 blade sector 2 pi / n, the applied weight's target and ramp rate, the profile's nodes per
 radian, the hook's WOB loop gains, its pick-up speed (0 on bottom), the clearance it picks
 up to, its lowering speed's cap (the tag speed; inf until a tag), the steps per step of
-the wave guide (:func:`_held_means`) and the bit law with its two parameters
-(bit_rock.sliding_torque) and the share by which the speed it reads follows the bit's."""
+the wave guide (:func:`_held_means`), the bit law with its two parameters
+(bit_rock.sliding_torque) and the share by which the speed it reads follows the bit's, and
+the depth-of-cut limit with its contact's friction (bit_rock.bit_response)."""
 Drive = namedtuple("Drive", (
     "mode", "omega", "torque", "omega_rate", "inertia", "kp", "ki", "max_torque", "lag_alpha",
     "max_torque_rate"))
@@ -379,9 +383,12 @@ def _respond(x: Loop, law: Law, surface: float, cursor: int, ends: tuple,
     hook's WOB loop on the force at the top."""
     doc = law.n_blades * (x.u - surface)        # delta = n (U - U(tau - tau_n)), eq. 8
     v0, kick_v, f_ext, omega0, kick_w, t_ext, t_top, f_top = ends
+    limited = doc >= law.doc_max                # the limiter on the rock (bit_rock doc)
+    cut = _cutting(law.cut_factor, law.off_bottom, law.doc_max if limited else doc)
     v_new, omega_new, w_f, wob, tob, mode, stuck = br.bit_response(
-        v0, kick_v, f_ext, omega0, kick_w, t_ext, _cutting(law.cut_factor, law.off_bottom, doc),
-        x.stuck, law.beta, law.lam, law.bit_law, x.law_omega, law.law_a, law.law_b)
+        v0, kick_v, f_ext, omega0, kick_w, t_ext, cut, x.stuck, law.beta, law.lam,
+        law.bit_law, x.law_omega, law.law_a, law.law_b, limited and not law.off_bottom,
+        law.beta_limit)
     v_hook, hook_int = x.v_hook, x.hook_int
     if not lumped:                # the hook's WOB loop
         v_hook, hook_int = _hook(law, x.w_app, f_top, hook_int,
@@ -469,7 +476,8 @@ def _law_params(prm: np.ndarray, tgt: np.ndarray, profile: np.ndarray) -> Law:
                tgt[I_W_APP], prm[P_W_RATE], profile.shape[0] / sector, prm[P_HOOK_KP],
                prm[P_HOOK_KI], prm[P_PICKUP] if lifted else 0.0, prm[P_CLEARANCE],
                prm[P_TAG_SPEED], max(1, int(prm[P_SUBSTEPS])), int(prm[P_BIT_LAW]),
-               prm[P_BIT_LAW_A], prm[P_BIT_LAW_B], prm[P_BIT_LAW_ALPHA])
+               prm[P_BIT_LAW_A], prm[P_BIT_LAW_B], prm[P_BIT_LAW_ALPHA], prm[P_DOC_MAX],
+               prm[P_BETA_LIMIT])
 
 
 @njit(cache=True, inline="always")

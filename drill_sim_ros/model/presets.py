@@ -9,7 +9,9 @@ it in SI) and, in a physical preset, an
 optional ``string`` (:func:`string_from_dict`: ``lumped``, RGD07's spring, by default, or
 ``distributed`` sections; without ``sections`` the ``pipe_*`` / ``bha_*`` keys are the
 two-section shorthand). ``physical.friction_weakening`` (optional) is the bit law's
-(:func:`bit_rock.friction_weakening_from_dict`; absent: RGD07's law), :attr:`Preset.bit_law`
+(:func:`bit_rock.friction_weakening_from_dict`; absent: RGD07's law) and
+``physical.depth_of_cut_limit`` (optional) its depth-of-cut limit
+(:func:`bit_rock.depth_of_cut_limit_from_dict`; absent: none), :attr:`Preset.bit_law` both
 in kernel units.
 """
 
@@ -25,7 +27,9 @@ from typing import Any
 from drill_sim_ros.model.bit_rock import (
     RGD07_LAW,
     BitLaw,
+    DepthOfCutLimit,
     FrictionWeakening,
+    depth_of_cut_limit_from_dict,
     friction_weakening_from_dict,
 )
 from drill_sim_ros.model.checks import check_known_keys, number_in
@@ -83,14 +87,19 @@ class Preset:
     drive: TopDrivePhysical          # SI (a dimensionless preset: in its unit scales)
     string: StringSpec = field(default_factory=StringSpec)
     friction_weakening: FrictionWeakening | None = None   # None: RGD07's bit law
+    depth_of_cut_limit: DepthOfCutLimit | None = None     # None: no limit (RGD07's)
 
     @property
     def bit_law(self) -> BitLaw:
         """The bit law in kernel units (what the simulator takes): RGD07's, or the
-        preset's ``physical.friction_weakening`` scaled."""
-        if self.friction_weakening is None:
-            return RGD07_LAW
-        return self.friction_weakening.scaled(self.scales.time_s)
+        preset's ``physical.friction_weakening`` scaled, with the preset's
+        ``physical.depth_of_cut_limit`` scaled if it has one."""
+        law = (RGD07_LAW if self.friction_weakening is None
+               else self.friction_weakening.scaled(self.scales.time_s))
+        limit, phys = self.depth_of_cut_limit, self.physical
+        if limit is None or phys is None:
+            return law
+        return limit.scaled(law, self.scales.length_m, phys.zeta, phys.mu_gamma)
 
     @property
     def is_physical(self) -> bool:
@@ -167,10 +176,11 @@ def preset_from_dict(name: str, data: dict[str, Any], base_dir: Path | None = No
     if has_phys == has_dimless:
         raise ParameterError(f"preset '{name}' needs exactly one of 'physical' or "
                              "'dimensionless'")
-    physical, string, weakening = None, StringSpec(), None
+    physical, string, weakening, limit = None, StringSpec(), None, None
     if has_phys:
         values = dict(data["physical"])
         weakening = friction_weakening_from_dict(values.pop("friction_weakening", None))
+        limit = depth_of_cut_limit_from_dict(values.pop("depth_of_cut_limit", None))
         physical = physical_from_dict(values)
         string = string_from_dict(data.get("string") or {}, physical)
         shorthand = sorted(key for key in data["physical"] if key.startswith(("pipe_", "bha_")))
@@ -192,7 +202,7 @@ def preset_from_dict(name: str, data: dict[str, Any], base_dir: Path | None = No
                     params=params, scales=scales, physical=physical,
                     dtau=float(numerics.get("dtau", 1e-4)),
                     n_nodes=None if n_nodes is None else int(n_nodes), drive=drive,
-                    string=string, friction_weakening=weakening)
+                    string=string, friction_weakening=weakening, depth_of_cut_limit=limit)
     if physical is not None:
         check_consistency(preset, data)
     return preset

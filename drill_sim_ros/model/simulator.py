@@ -37,7 +37,7 @@ DEFAULT_NODES = 2048
 # The parameter vector (kernel.P_*), one row a slot: (name, slot, source), the source an
 # attribute of the simulator (dotted). No scale: every source is in kernel units already,
 # converted once where it is built (TopDrivePhysical.scaled, string.kernel_string,
-# FrictionWeakening.scaled).
+# FrictionWeakening.scaled, DepthOfCutLimit.scaled).
 # Set elsewhere: the drive's mode (at start and by set_top_drive_mode), the rock of the
 # layer the bit is in (beta, lambda, the cutting factor, the next top: _apply_layer), off
 # bottom and the tag speed (hang_off_bottom, set_off_bottom, start_at_rest).
@@ -67,6 +67,8 @@ PARAMETERS: tuple[tuple[str, int, str], ...] = (
     ("bit_law_a", k.P_BIT_LAW_A, "bit_law.a"),
     ("bit_law_b", k.P_BIT_LAW_B, "bit_law.b"),
     ("bit_law_alpha", k.P_BIT_LAW_ALPHA, "bit_law_alpha"),
+    ("doc_max", k.P_DOC_MAX, "bit_law.doc_max"),
+    ("beta_limit", k.P_BETA_LIMIT, "bit_law.beta_limit"),
 )
 
 

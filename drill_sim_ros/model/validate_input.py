@@ -27,8 +27,9 @@ from drill_sim_ros.model.yaml_input import load_yaml
 PRESET_SECTIONS = ("description", "physical", "dimensionless", "numerics", "top_drive",
                    "string", "well")  # 'string' and 'well': checked by model.presets and
                                       # model.well
-# optional mappings in ``physical``: the bit law's (bit_rock.friction_weakening_from_dict)
-PHYSICAL_MAPPINGS = ("friction_weakening",)
+# optional mappings in ``physical``: the bit law's (bit_rock.friction_weakening_from_dict,
+# bit_rock.depth_of_cut_limit_from_dict)
+PHYSICAL_MAPPINGS = ("friction_weakening", "depth_of_cut_limit")
 # the lumped string's geometry: given by ``string.sections`` when the preset has them
 GEOMETRY_KEYS = ("pipe_outer_radius_m", "pipe_inner_radius_m", "pipe_length_m",
                  "bha_outer_radius_m", "bha_inner_radius_m", "bha_length_m")

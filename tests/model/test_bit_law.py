@@ -157,10 +157,10 @@ def test_the_stuck_bit_holds_rgd07s_static_torque() -> None:
     for law in range(len(br.LAWS)):
         args = (0.0, 1e-3, 7.0, 0.0, 1e-3)
         held = br.bit_response(*args, static * (1 - 1e-12), doc, True, beta, lam, law, 0.0,
-                               0.3, 0.5)
+                               0.3, 0.5, False, 0.0)
         assert held[5] == br.MODE_STUCK and held[6]
         slip = br.bit_response(*args, static * (1 + 1e-9), doc, True, beta, lam, law, 0.0,
-                               0.3, 0.5)
+                               0.3, 0.5, False, 0.0)
         assert not slip[6] and slip[1] > 0.0
         assert slip[4] == static
 
