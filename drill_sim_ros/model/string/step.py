@@ -21,14 +21,15 @@ W_INT_ROWS = 4
 # surface slip (m / t*) per unit of the line's speed (r_o; L*); three rows worked out from
 # those once (.lines.junction_rows) instead of at every junction every step: the
 # junction's impedance Z_j + Z_j+1 + D, the stick band's slip squared (W_VS W_SLIP)^2 and
-# the dynamic limit times the slip, F_d s; and rows of state: the junction's speed last
-# step (the stick band's memory); in the line's first part only, the power the walls'
-# friction and the point dampers' D w^2 took, summed over the line's junctions and the
-# steps (x dtau: the work they took), and the power that entered the line at its top; in
-# its last part only, the power that left it at its bottom (the bit), summed so: the
-# energy balance the guard checks (.balance); and per junction, the wall's and the
-# damper's power summed over the steps in which it was below zero (the energy it gave
-# the string; 0 for any physical element: the guard names the junction)
+# the dynamic limit times the slip, F_d s; and rows of state: the junction's surface slip
+# last step, |w| r_o (the stick band's memory, kept as the slip: each junction's is read
+# twice a step, by itself and by the other line's junction beside it); in the line's
+# first part only, the power the walls' friction and the point dampers' D w^2 took, summed
+# over the line's junctions and the steps (x dtau: the work they took), and the power
+# that entered the line at its top; in its last part only, the power that left it at its
+# bottom (the bit), summed so: the energy balance the guard checks (.balance); and per
+# junction, the wall's and the damper's power summed over the steps in which it was below
+# zero (the energy it gave the string; 0 for any physical element: the guard names it)
 W_Z, W_D, W_FS, W_FD, W_VS, W_SLIP = 0, 1, 2, 3, 4, 5
 W_ZJ, W_BAND2, W_KD = 6, 7, 8
 W_LAST, W_WORK, W_DAMP, W_TOP, W_BIT, W_WALL_GAVE, W_DAMP_GAVE = 9, 10, 11, 12, 13, 14, 15
@@ -39,12 +40,19 @@ W_ROWS = 16
 def wall_slips(wave_f: np.ndarray, j: int, pair: int, own_speed: float,
                other_speed: float) -> tuple[float, float, bool]:
     """The surface slips (m per t*) of junction ``j``'s own motion and of the other line's
-    at the same junction ``pair``, and whether the contact slides: the two motions share one
-    contact, which is stuck while its total slip sqrt(u^2 + o^2) is within the stick band
-    r_o omega_s (Karnopp) and slides outside it."""
+    at the same junction ``pair``, and whether the contact slides (:func:`slides`)."""
     u = abs(own_speed) * wave_f[W_SLIP, j]
     o = abs(other_speed) * wave_f[W_SLIP, pair]
-    return u, o, u * u + o * o > wave_f[W_BAND2, j]
+    return u, o, slides(wave_f, j, u, o)
+
+
+@njit(cache=True, inline="always")
+def slides(wave_f: np.ndarray, j: int, u: float, o: float) -> bool:
+    """Whether the wall contact of junction ``j`` slides, with the surface slips ``u`` of
+    its own motion and ``o`` of the other line's: the two motions share one contact, which
+    is stuck while its total slip sqrt(u^2 + o^2) is within the stick band r_o omega_s
+    (Karnopp) and slides outside it."""
+    return u * u + o * o > wave_f[W_BAND2, j]
 
 
 # ---- compiled: the string's step (the kernel's seam) ------------------------------------
@@ -157,8 +165,9 @@ def wall_junction(wave_f: np.ndarray, j: int, push: float,
       k = F_d s and r = sqrt(u^2 + o^2), w = push r / (Z r + k), and the power
       c w^2 = k w push / (Z r + k).
 
-    Keeps the speed for the band; returns (w, the friction power, the damper's D w^2)."""
-    u, o, sliding = wall_slips(wave_f, j, pair, wave_f[W_LAST, j], wave_f[W_LAST, pair])
+    Keeps the slip for the band; returns (w, the friction power, the damper's D w^2)."""
+    u, o = wave_f[W_LAST, j], wave_f[W_LAST, pair]     # the slips last step (wall_slips)
+    sliding = slides(wave_f, j, u, o)
     z = wave_f[W_ZJ, j]
     if sliding and o > 0.0:
         k = wave_f[W_KD, j]
@@ -172,7 +181,7 @@ def wall_junction(wave_f: np.ndarray, j: int, push: float,
         if abs(push) > limit:
             w = (push - math.copysign(limit, push)) / z
         power = limit * abs(w)
-    wave_f[W_LAST, j] = w
+    wave_f[W_LAST, j] = abs(w) * wave_f[W_SLIP, j]
     return w, power, wave_f[W_D, j] * w * w
 
 
