@@ -151,7 +151,7 @@ def wall_junction(wave_f: np.ndarray, j: int, push: float,
                   pair: int) -> tuple[float, float, float]:
     """:func:`junction_speed` with the wall's Coulomb friction (model.well), implicit in the
     new speed w, with Z = Z_j + Z_j+1 + D. The contact (:func:`wall_slips`, from the last
-    speeds of this junction and the other line's ``pair``):
+    slips of this junction and the other line's ``pair``):
 
     * within the stick band, or sliding with the other line still: set-valued, as the bit's
       stick (eq. 32): held still while the unbalanced torque ``push`` = a_in - b_in is
@@ -234,7 +234,7 @@ def scatter(wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray, lo: int, h
     as unsigned integers, np.uint64, so numba leaves out its test for a negative index,
     Python's wrap-around: a sixth of the walled string's step, measured. Summing each
     junction's power in its own row, a load and a store of two rows at every junction, cost
-    the walled string's step about 6 %; testing the two powers apart (``or``) as much.)"""
+    the walled string's step a few percent; testing the two powers apart (``or``), more.)"""
     off, n, pos = wave_i[W_OFF, lo], wave_i[W_LEN, lo], wave_i[W_POS, lo]
     wave_i[W_POS, lo] = next_slot(pos, n)    # (a branch here costs NRT calls in the loop)
     a_slot, b_slot = np.uint64(off + pos), np.uint64(off + n + pos)
