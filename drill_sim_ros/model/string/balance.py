@@ -3,10 +3,10 @@
 
 The compiled step (:mod:`.step`) sums, over the wave steps, the power that enters each line
 at its top (the drive, the hook), the power that leaves it at its bottom (the bit), and the
-power each junction takes: its wall's friction (W_WORK) and its point damper's D w^2
-(W_DAMP). The method of characteristics moves every wave unchanged along its part and
-applies the losses at the junctions, so the line's energy, sum (a^2 + b^2) dtau / 4 Z over
-its slots, changes over a wave step by exactly
+power its junctions take: their walls' friction (W_WORK) and their point dampers' D w^2
+(W_DAMP), summed over the line's junctions. The method of characteristics moves every
+wave unchanged along its part and applies the losses at the junctions, so the line's
+energy, sum (a^2 + b^2) dtau / 4 Z over its slots, changes over a wave step by exactly
 
     top work - bit work - wall work - damper work
 
@@ -20,9 +20,11 @@ steps, at most about 4 m eps of it (a random walk in practice, far less), and th
 the works themselves carry eps of their own size. :data:`RELATIVE_TOLERANCE` bounds the
 drift of one call relative to the energy stored and the works summed since the start.
 
-A wall's or a damper's work below zero at any junction means an element gave the string
-energy: no tolerance there (each step adds limit |w|, c w^2 or D w^2, >= 0 for physical
-values, exactly 0 at rest).
+A wall's or a damper's power below zero at any junction in any step means an element gave
+the string energy: no tolerance there (each step's power is limit |w|, c w^2 or D w^2,
+>= 0 for physical values, exactly 0 at rest). The step keeps, per junction, what its wall
+and its damper gave (W_WALL_GAVE, W_DAMP_GAVE: the power summed over the steps in which it
+was below zero), so the guard names the junction.
 """
 
 from __future__ import annotations
@@ -31,7 +33,14 @@ import numpy as np
 from numba import njit
 
 from drill_sim_ros.model.string.readings import line_energy
-from drill_sim_ros.model.string.step import W_BIT, W_DAMP, W_TOP, W_WORK
+from drill_sim_ros.model.string.step import (
+    W_BIT,
+    W_DAMP,
+    W_DAMP_GAVE,
+    W_TOP,
+    W_WALL_GAVE,
+    W_WORK,
+)
 
 # a line's balance, kernel units (torque C x rad; axially force unit x L*): a row of the
 # guard's mark, one per line
@@ -59,22 +68,30 @@ def call_tolerance(wave_steps: int) -> float:
 def line_balance(wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray, lo: int, hi: int,
                  dtau: float, out: np.ndarray) -> int:
     """A line's (parts ``lo .. hi - 1``) balance into ``out`` (B_* slots): the energy it
-    holds now, and the work done at its top, at its bottom (the bit), by the wall and by
+    holds now, and the work done at its top, at its bottom (the bit), by the walls and by
     the dampers since the step's sums were last zeroed (Simulator: the start, a reset).
-    Returns the first (topmost) column whose wall or damper work is below zero, else -1."""
-    wall = damper = 0.0
-    first = -1
-    for j in range(lo, hi):
-        wall += wave_f[W_WORK, j]
-        damper += wave_f[W_DAMP, j]
-        if first < 0 and (wave_f[W_WORK, j] < 0.0 or wave_f[W_DAMP, j] < 0.0):
-            first = j
+    Returns the first (topmost) column whose wall or damper gave energy, else -1."""
     out[B_STORED] = line_energy(wave, wave_i, wave_f, lo, hi, dtau)
     out[B_TOP] = wave_f[W_TOP, lo] * dtau
     out[B_BIT] = wave_f[W_BIT, hi - 1] * dtau
-    out[B_WALL] = wall * dtau
-    out[B_DAMPER] = damper * dtau
-    return first
+    out[B_WALL] = wave_f[W_WORK, lo] * dtau
+    out[B_DAMPER] = wave_f[W_DAMP, lo] * dtau
+    if not _any_gave(wave_f, lo, hi):
+        return -1
+    for j in range(lo, hi):
+        if wave_f[W_WALL_GAVE, j] < 0.0 or wave_f[W_DAMP_GAVE, j] < 0.0:
+            return j
+    return -1
+
+
+@njit(cache=True)
+def _any_gave(wave_f: np.ndarray, lo: int, hi: int) -> bool:
+    """Whether a wall or a damper of parts ``lo .. hi - 1`` ever gave energy (one pass
+    without an early exit, which the compiler runs in vector lanes)."""
+    gave = False
+    for j in range(lo, hi):
+        gave |= (wave_f[W_WALL_GAVE, j] < 0.0) | (wave_f[W_DAMP_GAVE, j] < 0.0)
+    return gave
 
 
 @njit(cache=True)
@@ -92,18 +109,19 @@ def check_lines(wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray, parts_
                 ) -> tuple[int, int, int, float, float]:
     """The guard's check of both lines since ``mark`` (:func:`mark_lines`), which it moves
     on to now. Returns ``(finding, line, column, value, bound)``: BALANCE_OK; BALANCE_WALL
-    or BALANCE_DAMPER with the topmost junction (column) whose wall (damper) work is below
-    zero and that work; BALANCE_DRIFT with the line's drift, stored change - (top - bit -
-    wall - damper work) since the mark, beyond ``bound`` = ``tolerance`` x (stored before
-    and after + |each work since the start|). ``line`` 0 torsional, 1 axial; kernel units."""
+    or BALANCE_DAMPER with the topmost junction (column) whose wall (damper) gave energy
+    and the work it did while it gave it (below zero); BALANCE_DRIFT with the line's
+    drift, stored change - (top - bit - wall - damper work) since the mark, beyond
+    ``bound`` = ``tolerance`` x (stored before and after + |each work since the start|).
+    ``line`` 0 torsional, 1 axial; kernel units."""
     now = np.empty(N_BALANCE)
     for line in range(2):
         lo, hi = (0, parts_t) if line == 0 else (parts_t, wave_i.shape[1])
         j = line_balance(wave, wave_i, wave_f, lo, hi, dtau, now)
-        if j >= 0 and wave_f[W_WORK, j] < 0.0:
-            return BALANCE_WALL, line, j, wave_f[W_WORK, j] * dtau, 0.0
+        if j >= 0 and wave_f[W_WALL_GAVE, j] < 0.0:
+            return BALANCE_WALL, line, j, wave_f[W_WALL_GAVE, j] * dtau, 0.0
         if j >= 0:
-            return BALANCE_DAMPER, line, j, wave_f[W_DAMP, j] * dtau, 0.0
+            return BALANCE_DAMPER, line, j, wave_f[W_DAMP_GAVE, j] * dtau, 0.0
         before = mark[line]
         drift = (now[B_STORED] - before[B_STORED]) - (
             (now[B_TOP] - before[B_TOP]) - (now[B_BIT] - before[B_BIT])

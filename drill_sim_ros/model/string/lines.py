@@ -277,7 +277,7 @@ def fill_steady(wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray, lo: in
     the force at the bottom end, ``end_force``, plus the drag D x speed of every point
     damper and the wall's friction (:func:`steady_friction`) of every junction below its
     top (the elements below part j sit at its bottom), so no element sheds a wave. Every
-    junction's speed memory is ``speed``. Returns the force at the top, what the drive (the
+    junction's memory is its slip at ``speed``. Returns the force at the top, what the drive (the
     hook) must hold."""
     wall = np.array([steady_friction(wave_f, j, int(wave_i[W_PAIR, j]), speed, other_speed)
                      for j in range(lo, hi)])
@@ -288,7 +288,7 @@ def fill_steady(wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray, lo: in
         force = end_force + float(drag_below[j - lo])
         wave[off:off + n] = force + z * speed
         wave[off + n:off + 2 * n] = force - z * speed
-    wave_f[W_LAST, lo:hi] = speed
+    wave_f[W_LAST, lo:hi] = abs(speed) * wave_f[W_SLIP, lo:hi]     # (the step's wall_slips)
     return end_force + speed * float(wave_f[W_D, lo:hi].sum()) + float(wall.sum())
 
 

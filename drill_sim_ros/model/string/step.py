@@ -21,27 +21,38 @@ W_INT_ROWS = 4
 # surface slip (m / t*) per unit of the line's speed (r_o; L*); three rows worked out from
 # those once (.lines.junction_rows) instead of at every junction every step: the
 # junction's impedance Z_j + Z_j+1 + D, the stick band's slip squared (W_VS W_SLIP)^2 and
-# the dynamic limit times the slip, F_d s; and rows of state: the junction's speed last
-# step (the stick band's memory), the wall's friction power and the point damper's power
-# D w^2 summed over the steps (x dtau: the work each took), and, in the line's first (last)
-# part only, the power that entered the line at its top (left it at its bottom, the bit)
-# summed so: the energy balance the guard checks (.balance)
+# the dynamic limit times the slip, F_d s; and rows of state: the junction's surface slip
+# last step, |w| r_o (the stick band's memory, kept as the slip: each junction's is read
+# twice a step, by itself and by the other line's junction beside it); in the line's
+# first part only, the power the walls' friction and the point dampers' D w^2 took, summed
+# over the line's junctions and the steps (x dtau: the work they took), and the power
+# that entered the line at its top; in its last part only, the power that left it at its
+# bottom (the bit), summed so: the energy balance the guard checks (.balance); and per
+# junction, the wall's and the damper's power summed over the steps in which it was below
+# zero (the energy it gave the string; 0 for any physical element: the guard names it)
 W_Z, W_D, W_FS, W_FD, W_VS, W_SLIP = 0, 1, 2, 3, 4, 5
 W_ZJ, W_BAND2, W_KD = 6, 7, 8
-W_LAST, W_WORK, W_DAMP, W_TOP, W_BIT = 9, 10, 11, 12, 13
-W_ROWS = 14
+W_LAST, W_WORK, W_DAMP, W_TOP, W_BIT, W_WALL_GAVE, W_DAMP_GAVE = 9, 10, 11, 12, 13, 14, 15
+W_ROWS = 16
 
 
 @njit(cache=True, inline="always")
 def wall_slips(wave_f: np.ndarray, j: int, pair: int, own_speed: float,
                other_speed: float) -> tuple[float, float, bool]:
     """The surface slips (m per t*) of junction ``j``'s own motion and of the other line's
-    at the same junction ``pair``, and whether the contact slides: the two motions share one
-    contact, which is stuck while its total slip sqrt(u^2 + o^2) is within the stick band
-    r_o omega_s (Karnopp) and slides outside it."""
+    at the same junction ``pair``, and whether the contact slides (:func:`slides`)."""
     u = abs(own_speed) * wave_f[W_SLIP, j]
     o = abs(other_speed) * wave_f[W_SLIP, pair]
-    return u, o, u * u + o * o > wave_f[W_BAND2, j]
+    return u, o, slides(wave_f, j, u, o)
+
+
+@njit(cache=True, inline="always")
+def slides(wave_f: np.ndarray, j: int, u: float, o: float) -> bool:
+    """Whether the wall contact of junction ``j`` slides, with the surface slips ``u`` of
+    its own motion and ``o`` of the other line's: the two motions share one contact, which
+    is stuck while its total slip sqrt(u^2 + o^2) is within the stick band r_o omega_s
+    (Karnopp) and slides outside it."""
+    return u * u + o * o > wave_f[W_BAND2, j]
 
 
 # ---- compiled: the string's step (the kernel's seam) ------------------------------------
@@ -121,26 +132,26 @@ def _distributed_ends(wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray, 
 
 @njit(cache=True, inline="always")
 def junction_speed(wave_f: np.ndarray, j: int, a_in: float, b_in: float,
-                   pair: int) -> float:
+                   pair: int) -> tuple[float, float, float]:
     """The speed of the junction below part ``j``, from the waves arriving at it (``a_in``
     from above, ``b_in`` from below): continuous across it, with the torques balanced on
     its elements, the point damper D (torque D w) and the wall's friction F:
     (a_in - Z_j w) - (b_in + Z_j+1 w) = D w + F. Without wall contact (W_FS 0) that is
     w = (a_in - b_in) / (Z_j + Z_j+1 + D), the lossless scattering and its damper. The
     junction takes w (a_in - b_in - (Z_j + Z_j+1) w) = D w^2 + F w of the waves' energy
-    each step: the damper's share is summed in W_DAMP, the wall's in W_WORK."""
+    each step. Returns (w, the wall's power F w, the damper's D w^2)."""
     if wave_f[W_FS, j] == 0.0:
         w = (a_in - b_in) / wave_f[W_ZJ, j]
-        wave_f[W_DAMP, j] += wave_f[W_D, j] * w * w
-        return w
+        return w, 0.0, wave_f[W_D, j] * w * w
     return wall_junction(wave_f, j, a_in - b_in, pair)
 
 
 @njit(cache=True, inline="always")
-def wall_junction(wave_f: np.ndarray, j: int, push: float, pair: int) -> float:
+def wall_junction(wave_f: np.ndarray, j: int, push: float,
+                  pair: int) -> tuple[float, float, float]:
     """:func:`junction_speed` with the wall's Coulomb friction (model.well), implicit in the
     new speed w, with Z = Z_j + Z_j+1 + D. The contact (:func:`wall_slips`, from the last
-    speeds of this junction and the other line's ``pair``):
+    slips of this junction and the other line's ``pair``):
 
     * within the stick band, or sliding with the other line still: set-valued, as the bit's
       stick (eq. 32): held still while the unbalanced torque ``push`` = a_in - b_in is
@@ -154,25 +165,24 @@ def wall_junction(wave_f: np.ndarray, j: int, push: float, pair: int) -> float:
       k = F_d s and r = sqrt(u^2 + o^2), w = push r / (Z r + k), and the power
       c w^2 = k w push / (Z r + k).
 
-    Keeps the speed for the band, the friction power summed in W_WORK and the damper's
-    D w^2 in W_DAMP."""
-    u, o, sliding = wall_slips(wave_f, j, pair, wave_f[W_LAST, j], wave_f[W_LAST, pair])
+    Keeps the slip for the band; returns (w, the friction power, the damper's D w^2)."""
+    u, o = wave_f[W_LAST, j], wave_f[W_LAST, pair]     # the slips last step (wall_slips)
+    sliding = slides(wave_f, j, u, o)
     z = wave_f[W_ZJ, j]
     if sliding and o > 0.0:
         k = wave_f[W_KD, j]
         r = math.sqrt(u * u + o * o)
         per_z = push / (z * r + k)
         w = per_z * r
-        wave_f[W_WORK, j] += k * w * per_z
+        power = k * w * per_z
     else:
         limit = wave_f[W_FD, j] if sliding else wave_f[W_FS, j]
         w = 0.0
         if abs(push) > limit:
             w = (push - math.copysign(limit, push)) / z
-        wave_f[W_WORK, j] += limit * abs(w)
-    wave_f[W_DAMP, j] += wave_f[W_D, j] * w * w
-    wave_f[W_LAST, j] = w
-    return w
+        power = limit * abs(w)
+    wave_f[W_LAST, j] = abs(w) * wave_f[W_SLIP, j]
+    return w, power, wave_f[W_D, j] * w * w
 
 
 # ---- compiled: one step of a line -------------------------------------------------------
@@ -215,15 +225,22 @@ def scatter(wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray, lo: int, h
     the junction above it, and its slot moved on there (:func:`next_slot`): the b arriving
     at its top is read where the b entering at its bottom is written one junction later,
     and the a entering at its top is written where the a arriving at its bottom is read.
+    The power the walls and the dampers take is summed over the line's junctions in two
+    numbers and added to the line's W_WORK and W_DAMP once a step (the energy balance the
+    guard checks); a junction's own row is written only in the step its wall or damper gives
+    energy (power below zero: never for physical values), so the guard can name it.
     (The slots are worked out in the loop itself: an inlined helper that writes ``wave_i``
     made the walled string's step five times slower, measured. The slots and the pair index
     as unsigned integers, np.uint64, so numba leaves out its test for a negative index,
-    Python's wrap-around: a sixth of the walled string's step, measured.)"""
+    Python's wrap-around: a sixth of the walled string's step, measured. Summing each
+    junction's power in its own row, a load and a store of two rows at every junction, cost
+    the walled string's step a few percent; testing the two powers apart (``or``), more.)"""
     off, n, pos = wave_i[W_OFF, lo], wave_i[W_LEN, lo], wave_i[W_POS, lo]
     wave_i[W_POS, lo] = next_slot(pos, n)    # (a branch here costs NRT calls in the loop)
     a_slot, b_slot = np.uint64(off + pos), np.uint64(off + n + pos)
     a_in = wave[a_slot]                      # arriving at the bottom of part lo
     wave[a_slot] = a_top
+    wall = damper = 0.0                      # the power the line's elements take
     for j in range(lo, hi - 1):
         out_slot = b_slot                    # the b entering part j at its bottom
         off, n, pos = wave_i[W_OFF, j + 1], wave_i[W_LEN, j + 1], wave_i[W_POS, j + 1]
@@ -231,12 +248,20 @@ def scatter(wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray, lo: int, h
             wave_i[W_POS, j + 1] = next_slot(pos, n)
         a_slot, b_slot = np.uint64(off + pos), np.uint64(off + n + pos)
         b_in = wave[b_slot]                  # arriving at the top of part j + 1
-        w = junction_speed(wave_f, j, a_in, b_in, np.uint64(wave_i[W_PAIR, j]))
+        w, wall_power, damper_power = junction_speed(wave_f, j, a_in, b_in,
+                                                     np.uint64(wave_i[W_PAIR, j]))
+        wall += wall_power
+        damper += damper_power
+        if min(wall_power, damper_power) < 0.0:      # an element gave energy: a bug
+            wave_f[W_WALL_GAVE, j] += min(wall_power, 0.0)
+            wave_f[W_DAMP_GAVE, j] += min(damper_power, 0.0)
         wave[out_slot] = a_in - 2.0 * wave_f[W_Z, j] * w
         a_next = wave[a_slot]
         wave[a_slot] = b_in + 2.0 * wave_f[W_Z, j + 1] * w
         a_in = a_next
     wave[b_slot] = b_bottom
+    wave_f[W_WORK, lo] += wall
+    wave_f[W_DAMP, lo] += damper
 
 
 @njit(cache=True, inline="always")
