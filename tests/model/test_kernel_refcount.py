@@ -23,8 +23,12 @@ from drill_sim_ros.model.params import DimensionlessParams
 from drill_sim_ros.model.presets import load_preset
 from drill_sim_ros.model.simulator import SimConfig, Simulator
 
-# NRT calls on the loop's blocks, per string, as of issue 34, with this numba (major.minor)
-MAX_LOOP_NRT_CALLS = {"lumped": 8, "distributed": 18}
+# NRT calls on the loop's blocks, per string, as of issue 34, with this numba (major.minor);
+# distributed 18 -> 20 with the guard's record of an element that gave energy
+# (string.step.scatter's branch, taken only then: never in a physical run; the branch-free
+# write of both rows at every junction keeps 18 but made the deviated closed loop 8 % slower,
+# 91.5 against 84.3 us a period, measured 2026-12-06 with benchmarks/bench_walled_step.py)
+MAX_LOOP_NRT_CALLS = {"lumped": 8, "distributed": 20}
 MEASURED_WITH_NUMBA = "0.68"
 FIG8A = DimensionlessParams(n=6, psi=50.0, beta=0.3, lam=5.0, w0=7.0, omega0=5.0)
 
