@@ -95,17 +95,24 @@ def test_the_slip_weakening_wall_holds_static_then_slides_at_the_dynamic_frictio
     wall and the viscous loss only, within 1 %, as with the drop at once (L = 0)."""
     weak = dataclasses.replace(short_case(0.45, 0.3), bend_term=True, slip_weakening_m=1e-3)
     line = fv.build_line(weak, [20, 2], 1e-4, axial=False)
-    line.t = -np.cumsum(np.concatenate(([0.0], 3.0 * line.cap_s[:-1])))
-    push = line.t[:-1] - line.t[1:]
+
+    def step(scale: float) -> np.ndarray:
+        """One step of the inner faces under pushes of ``scale`` x their static capacity."""
+        line.t = -np.cumsum(np.concatenate(([0.0], scale * line.cap_s[:-1])))
+        return fv.wall_faces(line, line.inv_zsum, 1e-4, None)[0]
+    push = 3.0 * line.cap_s[:-1]
     line.w_face[:] = 1.0                                  # sliding (band 0.05 rad/s)
     line.slip_m[:] = 0.5e-3
-    w_star, *_ = fv.wall_faces(line, line.inv_zsum, 1e-4, None)
+    w_star = step(3.0)
     mean_cap = 0.5 * (line.cap_s[:-1] + line.cap_d[:-1])
     np.testing.assert_allclose(w_star, (push - mean_cap) * line.inv_zsum, rtol=1e-12)
-    line.w_face[:] = 0.0                                  # stuck: static, slip reset
-    w_star, *_ = fv.wall_faces(line, line.inv_zsum, 1e-4, None)
+    walled = line.cap_s[:-1] > 0.0                       # (the vertical top touches nothing)
+    np.testing.assert_allclose(line.slip_m[:-1][walled],
+                               (0.5e-3 + 1e-4 * w_star * line.arm[:-1])[walled])
+    assert (step(0.5 * weak.mu_dynamic / weak.mu_static) == 0.0).all()   # held: stuck
+    assert (line.slip_m[:-1] == 0.0).all()
+    w_star = step(3.0)                                    # from stuck: the static capacity
     np.testing.assert_allclose(w_star, (push - line.cap_s[:-1]) * line.inv_zsum, rtol=1e-12)
-    assert (line.slip_m[:-1] == 1e-4 * np.abs(w_star * line.arm[:-1])).all()
     run = fv.run_startup(weak, 30.0, 5.0, 30.0, 500)
     dynamic_wall = fv.static_breakaway_torque_nm(dataclasses.replace(weak, mu_static=0.3))
     viscous = sum(s.torsional_damping_per_s * s.density_kg_m3 * s.polar_moment_m4
