@@ -56,6 +56,15 @@ every resolution and Courant number (0.6, 0.9) with the friction at the faces (m
 (docs/string.md: "stuck ... the junction's speed is 0"), a held face is at rest. The band is
 judged on each face's last speed.
 
+**A length for the drop** (optional, ``Case.slip_weakening_m`` = L; default 0, the law
+above exactly). The drop from mu_s to mu_d above has no length scale, and on the deviated
+preset the break-away moves with the cell at every cell tried (docs/string.md, "Which slip
+pulse frees the bit"). With L > 0 a face that leaves the band weakens linearly with its
+surface slip s since it was last within the band, mu(s) = mu_s - (mu_s - mu_d) min(s, L) / L
+(the linear slip-weakening law of fault mechanics: Ida 1972, Andrews 1976); inside the band
+it still holds up to mu_s. The slip is the contact's total, sqrt((r_o w)^2 + v^2), per face
+and line (:func:`sliding_capacity`, :func:`accumulate_slip`).
+
 **The ends.** Top, torsion: the drive's speed w_s over the step, T* = b_1 + Z_1 w_s; the
 drive as the package documents it in speed mode (docs/model.md, model/top_drive.py's module
 doc): the setpoint ramps linearly to its target, a PI loop with conditional integration and
@@ -118,7 +127,9 @@ class Case:
     survey (md m, inclination deg), mud density, side friction (mu_s, mu_d, band rad/s) and
     the drive (J kg m^2, kp N m s, ki N m, torque limit N m, motor lag s, rate limit N m/s;
     inf: none); ``bend_term``: the normal force carries tension x build rate
-    (:func:`normal_force_n_per_m`)."""
+    (:func:`normal_force_n_per_m`); ``slip_weakening_m``: the wall's slip-weakening distance
+    L (0: the drop from mu_s to mu_d at once on leaving the band, the package's law;
+    :func:`sliding_capacity`)."""
 
     sections: tuple[Section, ...]
     bit_inertia_kg_m2: float
@@ -135,6 +146,7 @@ class Case:
     motor_lag_s: float = 0.0
     max_torque_rate_nm_s: float = math.inf
     bend_term: bool = False
+    slip_weakening_m: float = 0.0
 
 
 def case_from_preset(source: str | Path | dict[str, Any], bend_term: bool = False) -> Case:
@@ -255,7 +267,8 @@ class Line:
     the wall's static and dynamic capacity (N m or N) of the wall between the two cell
     centres, the slip per unit speed (r_o or 1) and the stick band in surface slip
     (r_o w_band); the state: cell speeds w and torques (forces) T, and the faces' last
-    speeds."""
+    speeds; with a slip-weakening distance ``weakening_m`` > 0, each face's surface slip m
+    since it was last stuck (``slip_m``)."""
 
     m: np.ndarray
     z: np.ndarray
@@ -269,6 +282,8 @@ class Line:
     w: np.ndarray
     t: np.ndarray
     w_face: np.ndarray
+    weakening_m: float = 0.0
+    slip_m: np.ndarray | None = None
 
     @property
     def inv_zsum(self) -> np.ndarray:
@@ -308,7 +323,29 @@ def build_line(case: Case, counts: list[int], dt: float, axial: bool) -> Line:
     size = c["m"].size
     return Line(c["m"], c["z"], c["k"], c["loss"], c["depth_m"], case.mu_static * wall,
                 case.mu_dynamic * wall, c["arm"], c["band"], np.zeros(size), np.zeros(size),
-                np.zeros(size))
+                np.zeros(size), case.slip_weakening_m, np.zeros(size))
+
+
+def sliding_capacity(line: Line) -> np.ndarray:
+    """Each face's capacity while it slides (outside the band). Without a slip-weakening
+    distance (L = 0) the dynamic one, mu_d N: the static-to-dynamic drop happens at once on
+    leaving the band and has no length. With L > 0, linear slip weakening (Ida, J. Geophys.
+    Res. 77, 1972; Andrews, J. Geophys. Res. 81, 1976): mu(s) = mu_s - (mu_s - mu_d)
+    min(s, L) / L, s the surface slip (``slip_m``) since the face was last within the band.
+    That gives the drop a length, and a sliding patch a nucleation size
+    h* = pi sqrt(G J L / ((mu_s - mu_d) N r_o^2)) (docs/string.md, "A length for the
+    drop")."""
+    if line.weakening_m <= 0.0:
+        return line.cap_d
+    return line.cap_s - (line.cap_s - line.cap_d) * np.minimum(line.slip_m / line.weakening_m,
+                                                               1.0)
+
+
+def accumulate_slip(line: Line, faces: slice, slip_speed: np.ndarray, dt: float) -> None:
+    """The ``faces``' slip over the step at total surface ``slip_speed`` (m/s): back to 0
+    on a face within the band (stuck), else grown by ``slip_speed`` dt."""
+    line.slip_m[faces] = np.where(slip_speed > line.band[faces],
+                                  line.slip_m[faces] + slip_speed * dt, 0.0)
 
 
 def wall_faces(line: Line, inv_zsum: np.ndarray, dt: float, other_slip: np.ndarray | None
@@ -323,23 +360,28 @@ def wall_faces(line: Line, inv_zsum: np.ndarray, dt: float, other_slip: np.ndarr
     the interfaces, Bale, LeVeque, Mitran & Rossmanith, SIAM J. Sci. Comput. 24, 2002).
 
     The capacity is static while the face's last slip sqrt((arm w*)^2 + other^2) is within
-    the band, dynamic outside; it acts on this line in the share |own| / |slip| of the slip
-    velocity (own: the face's speed without friction), all of it when ``other_slip`` is
-    None (the other line at rest)."""
+    the band, dynamic (or slip-weakening: :func:`sliding_capacity`) outside; it acts on
+    this line in the share |own| / |slip| of the slip velocity (own: the face's speed
+    without friction), all of it when ``other_slip`` is None (the other line at rest)."""
     a = line.t + line.z * line.w
     b = line.t - line.z * line.w
     push = a[:-1] - b[1:]
     last = line.w_face[:-1] * line.arm[:-1]
     if other_slip is None:
-        cap = np.where(np.abs(last) > line.band[:-1], line.cap_d[:-1], line.cap_s[:-1])
+        cap = np.where(np.abs(last) > line.band[:-1], sliding_capacity(line)[:-1],
+                       line.cap_s[:-1])
     else:
         sliding = last**2 + other_slip[:-1] ** 2 > line.band[:-1] ** 2
         own = np.abs(push * inv_zsum * line.arm[:-1])
         share = np.divide(own, np.hypot(own, other_slip[:-1]), out=np.ones_like(own),
                           where=own > 0.0)
-        cap = np.where(sliding, line.cap_d[:-1], line.cap_s[:-1]) * share
+        cap = np.where(sliding, sliding_capacity(line)[:-1], line.cap_s[:-1]) * share
     w_star = np.sign(push) * np.maximum(np.abs(push) - cap, 0.0) * inv_zsum
     line.w_face[:-1] = w_star
+    if line.weakening_m > 0.0:
+        slip = line.arm[:-1] * w_star
+        accumulate_slip(line, slice(None, -1), np.abs(slip) if other_slip is None
+                        else np.hypot(slip, other_slip[:-1]), dt)
     return w_star, a[:-1] - line.z[:-1] * w_star, b[1:] + line.z[1:] * w_star
 
 
@@ -350,13 +392,15 @@ def end_with_inertia(line: Line, inertia: float, w_end: float, dt: float,
     I dw/dt = a - Z w - F. Returns (speed after the step, torque above the face); with
     ``clamp_forward`` never backwards (the package's off-bottom bit)."""
     a_end = line.t[-1] + line.z[-1] * line.w[-1]
-    cap = line.cap_d[-1] if abs(line.w_face[-1]) > line.band[-1] / line.arm[-1] \
+    cap = sliding_capacity(line)[-1] if abs(line.w_face[-1]) > line.band[-1] / line.arm[-1] \
         else line.cap_s[-1]
     push = inertia * w_end + dt * a_end
     w = math.copysign(max(abs(push) - dt * cap, 0.0), push) / (inertia + dt * line.z[-1])
     if clamp_forward:
         w = max(w, 0.0)
     line.w_face[-1] = w
+    if line.weakening_m > 0.0:
+        accumulate_slip(line, slice(-1, None), np.abs(line.arm[-1:] * w), dt)
     return w, a_end - line.z[-1] * w
 
 

@@ -87,6 +87,41 @@ def test_the_solver_s_contact_holds_and_shares_the_sliding_force() -> None:
         np.testing.assert_allclose((t_up - t_down)[held], push[held], rtol=1e-12)
 
 
+def test_the_slip_weakening_wall_holds_static_then_slides_at_the_dynamic_friction() -> None:
+    """With a slip-weakening distance L (``Case.slip_weakening_m``) a face that left the band
+    slid s = L / 2 ago resists with the mean of its static and dynamic capacities (linear
+    weakening), one within the band with the static one and its slip back to 0; and a string
+    turning steadily at 30 rpm (each face's slip far past L) carries at the top the dynamic
+    wall and the viscous loss only, within 1 %, as with the drop at once (L = 0)."""
+    weak = dataclasses.replace(short_case(0.45, 0.3), bend_term=True, slip_weakening_m=1e-3)
+    line = fv.build_line(weak, [20, 2], 1e-4, axial=False)
+
+    def step(scale: float) -> np.ndarray:
+        """One step of the inner faces under pushes of ``scale`` x their static capacity."""
+        line.t = -np.cumsum(np.concatenate(([0.0], scale * line.cap_s[:-1])))
+        return fv.wall_faces(line, line.inv_zsum, 1e-4, None)[0]
+    push = 3.0 * line.cap_s[:-1]
+    line.w_face[:] = 1.0                                  # sliding (band 0.05 rad/s)
+    line.slip_m[:] = 0.5e-3
+    w_star = step(3.0)
+    mean_cap = 0.5 * (line.cap_s[:-1] + line.cap_d[:-1])
+    np.testing.assert_allclose(w_star, (push - mean_cap) * line.inv_zsum, rtol=1e-12)
+    walled = line.cap_s[:-1] > 0.0                       # (the vertical top touches nothing)
+    np.testing.assert_allclose(line.slip_m[:-1][walled],
+                               (0.5e-3 + 1e-4 * w_star * line.arm[:-1])[walled])
+    assert (step(0.5 * weak.mu_dynamic / weak.mu_static) == 0.0).all()   # held: stuck
+    assert (line.slip_m[:-1] == 0.0).all()
+    w_star = step(3.0)                                    # from stuck: the static capacity
+    np.testing.assert_allclose(w_star, (push - line.cap_s[:-1]) * line.inv_zsum, rtol=1e-12)
+    run = fv.run_startup(weak, 30.0, 5.0, 30.0, 500)
+    dynamic_wall = fv.static_breakaway_torque_nm(dataclasses.replace(weak, mu_static=0.3))
+    viscous = sum(s.torsional_damping_per_s * s.density_kg_m3 * s.polar_moment_m4
+                  * s.length_m for s in weak.sections) * 30.0 * RAD_S_PER_RPM
+    late = run.t_s > 20.0
+    assert run.motor_torque_nm[late].mean() == pytest.approx(dynamic_wall + viscous,
+                                                             rel=0.01)
+
+
 def test_the_solver_converges_on_its_own() -> None:
     """The long tangent's first 12 s (break-away at about 4 s, first slip at 5.7 s) at 1000
     and 2000 cells: every figure of the break-away within 1 %. (On a short string the
