@@ -33,11 +33,7 @@ W_INT_ROWS = 4
 W_Z, W_D, W_FS, W_FD, W_VS, W_SLIP = 0, 1, 2, 3, 4, 5
 W_ZJ, W_BAND2, W_KD = 6, 7, 8
 W_LAST, W_WORK, W_DAMP, W_TOP, W_BIT, W_WALL_GAVE, W_DAMP_GAVE = 9, 10, 11, 12, 13, 14, 15
-# and per junction the scratch rows of one line's step (:func:`scatter`'s three passes): the
-# waves arriving at it (a from above, b from below), the other line's slip beside it, and
-# its new speed and the wall's power
-W_AIN, W_BIN, W_OTHER, W_SPEED, W_POWER = 16, 17, 18, 19, 20
-W_ROWS = 21
+W_ROWS = 16
 
 
 @njit(cache=True, inline="always")
@@ -134,6 +130,61 @@ def _distributed_ends(wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray, 
             b_top_a + wave_f[W_Z, parts_t] * v_hook)
 
 
+@njit(cache=True, inline="always")
+def junction_speed(wave_f: np.ndarray, j: int, a_in: float, b_in: float,
+                   pair: int) -> tuple[float, float, float]:
+    """The speed of the junction below part ``j``, from the waves arriving at it (``a_in``
+    from above, ``b_in`` from below): continuous across it, with the torques balanced on
+    its elements, the point damper D (torque D w) and the wall's friction F:
+    (a_in - Z_j w) - (b_in + Z_j+1 w) = D w + F. Without wall contact (W_FS 0) that is
+    w = (a_in - b_in) / (Z_j + Z_j+1 + D), the lossless scattering and its damper. The
+    junction takes w (a_in - b_in - (Z_j + Z_j+1) w) = D w^2 + F w of the waves' energy
+    each step. Returns (w, the wall's power F w, the damper's D w^2)."""
+    if wave_f[W_FS, j] == 0.0:
+        w = (a_in - b_in) / wave_f[W_ZJ, j]
+        return w, 0.0, wave_f[W_D, j] * w * w
+    return wall_junction(wave_f, j, a_in - b_in, pair)
+
+
+@njit(cache=True, inline="always")
+def wall_junction(wave_f: np.ndarray, j: int, push: float,
+                  pair: int) -> tuple[float, float, float]:
+    """:func:`junction_speed` with the wall's Coulomb friction (model.well), implicit in the
+    new speed w, with Z = Z_j + Z_j+1 + D. The contact (:func:`wall_slips`, from the last
+    slips of this junction and the other line's ``pair``):
+
+    * within the stick band, or sliding with the other line still: set-valued, as the bit's
+      stick (eq. 32): held still while the unbalanced torque ``push`` = a_in - b_in is
+      within the limit (static in the band, dynamic outside it: Karnopp), else
+      w Z = push - limit sign(push);
+    * sliding with both lines moving: the dynamic force lies along the slip velocity, so
+      this line feels F = F_d u / sqrt(u^2 + o^2) = c w, c = F_d s / sqrt(u^2 + o^2) (s the
+      slip per unit speed), taken with the last slip in the root: w = push / (Z + c). A
+      string that rotates drags axially as a viscous c = F_d / (r_o omega), and the other
+      way round. Written with one division, the step's dearest operation: with
+      k = F_d s and r = sqrt(u^2 + o^2), w = push r / (Z r + k), and the power
+      c w^2 = k w push / (Z r + k).
+
+    Keeps the slip for the band; returns (w, the friction power, the damper's D w^2)."""
+    u, o = wave_f[W_LAST, j], wave_f[W_LAST, pair]     # the slips last step (wall_slips)
+    sliding = slides(wave_f, j, u, o)
+    z = wave_f[W_ZJ, j]
+    if sliding and o > 0.0:
+        k = wave_f[W_KD, j]
+        r = math.sqrt(u * u + o * o)
+        per_z = push / (z * r + k)
+        w = per_z * r
+        power = k * w * per_z
+    else:
+        limit = wave_f[W_FD, j] if sliding else wave_f[W_FS, j]
+        w = 0.0
+        if abs(push) > limit:
+            w = (push - math.copysign(limit, push)) / z
+        power = limit * abs(w)
+    wave_f[W_LAST, j] = abs(w) * wave_f[W_SLIP, j]
+    return w, power, wave_f[W_D, j] * w * w
+
+
 # ---- compiled: one step of a line -------------------------------------------------------
 @njit(cache=True, inline="always")
 def drive_line(wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray, lo: int, hi: int,
@@ -165,99 +216,52 @@ def arriving(wave: np.ndarray, wave_i: np.ndarray, lo: int, hi: int) -> tuple[fl
 def scatter(wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray, lo: int, hi: int,
             a_top: float, b_bottom: float) -> None:
     """One step of a line: ``a_top`` enters at the top, ``b_bottom`` at the bottom, every
-    inner junction scatters what arrives (:func:`junction_law`), and the delay lines move on
-    by one step. Within a line's step no junction reads another's result: each reads the
-    waves that arrived (written at least one step ago: every slot is read before it is
-    written, and a part's slots are its own), its own slip last step and the other line's
-    slip (the other line's columns, final for this step), so the step runs in three passes:
-    (1) gather the waves arriving at each junction and the other line's slip beside it into
-    scratch rows, (2) the junctions' law over all of them at once, in vector lanes
-    (:func:`junction_law`), (3) scatter the waves each junction sends into the slots and
-    move the delay lines on (:func:`next_slot`), summing the walls' and the dampers' power in
-    junction order (the energy balance the guard checks). Indexes the layout arrays in
-    place: row views would cost reference counting every step (about a tenth of the
-    distributed string's step, measured); slots and junctions as unsigned integers,
-    np.uint64, so numba leaves out its test for a negative index (Python's wrap-around: a
-    sixth of the walled string's step, measured, and a gather instead of a vector load).
-    A junction's own GAVE rows are written only in the step its wall or damper gives energy
-    (power below zero: never for physical values), so the guard can name it."""
-    for j in range(lo, hi - 1):                       # (1) gather, before any slot is written
-        ju, below = np.uint64(j), j + 1
-        wave_f[W_AIN, ju] = wave[np.uint64(wave_i[W_OFF, j] + wave_i[W_POS, j])]
-        wave_f[W_BIN, ju] = wave[np.uint64(wave_i[W_OFF, below] + wave_i[W_LEN, below]
-                                           + wave_i[W_POS, below])]
-        wave_f[W_OTHER, ju] = wave_f[W_LAST, np.uint64(wave_i[W_PAIR, j])]
-    junction_law(wave_f, lo, hi - 1)                  # (2) the law, all junctions
-    off, n, pos = wave_i[W_OFF, lo], wave_i[W_LEN, lo], wave_i[W_POS, lo]    # (3) scatter
+    inner junction scatters what arrives (continuous speed, torques balanced with its point
+    damper), and the delay lines move on by one step. Reads each slot before writing it.
+    Indexes the layout arrays in place: row views would cost reference counting every step
+    (about a tenth of the distributed string's step, measured). The junctions' law is
+    :func:`junction_speed`; the other line's junction beside junction j is W_PAIR (the one
+    nearest in depth, :func:`.lines.junction_pairs`). Each part's slots are read once, at
+    the junction above it, and its slot moved on there (:func:`next_slot`): the b arriving
+    at its top is read where the b entering at its bottom is written one junction later,
+    and the a entering at its top is written where the a arriving at its bottom is read.
+    The power the walls and the dampers take is summed over the line's junctions in two
+    numbers and added to the line's W_WORK and W_DAMP once a step (the energy balance the
+    guard checks); a junction's own row is written only in the step its wall or damper gives
+    energy (power below zero: never for physical values), so the guard can name it.
+    (The slots are worked out in the loop itself: an inlined helper that writes ``wave_i``
+    made the walled string's step five times slower, measured. The slots and the pair index
+    as unsigned integers, np.uint64, so numba leaves out its test for a negative index,
+    Python's wrap-around: a sixth of the walled string's step, measured. Summing each
+    junction's power in its own row, a load and a store of two rows at every junction, cost
+    the walled string's step a few percent; testing the two powers apart (``or``), more.)"""
+    off, n, pos = wave_i[W_OFF, lo], wave_i[W_LEN, lo], wave_i[W_POS, lo]
     wave_i[W_POS, lo] = next_slot(pos, n)    # (a branch here costs NRT calls in the loop)
-    b_slot = np.uint64(off + n + pos)
-    wave[np.uint64(off + pos)] = a_top
+    a_slot, b_slot = np.uint64(off + pos), np.uint64(off + n + pos)
+    a_in = wave[a_slot]                      # arriving at the bottom of part lo
+    wave[a_slot] = a_top
     wall = damper = 0.0                      # the power the line's elements take
     for j in range(lo, hi - 1):
-        ju, out_slot = np.uint64(j), b_slot  # the b entering part j at its bottom
+        out_slot = b_slot                    # the b entering part j at its bottom
         off, n, pos = wave_i[W_OFF, j + 1], wave_i[W_LEN, j + 1], wave_i[W_POS, j + 1]
         if n > 1:
             wave_i[W_POS, j + 1] = next_slot(pos, n)
         a_slot, b_slot = np.uint64(off + pos), np.uint64(off + n + pos)
-        w, wall_power = wave_f[W_SPEED, ju], wave_f[W_POWER, ju]
-        damper_power = wave_f[W_D, ju] * w * w
+        b_in = wave[b_slot]                  # arriving at the top of part j + 1
+        w, wall_power, damper_power = junction_speed(wave_f, j, a_in, b_in,
+                                                     np.uint64(wave_i[W_PAIR, j]))
         wall += wall_power
         damper += damper_power
         if min(wall_power, damper_power) < 0.0:      # an element gave energy: a bug
-            wave_f[W_WALL_GAVE, ju] += min(wall_power, 0.0)
-            wave_f[W_DAMP_GAVE, ju] += min(damper_power, 0.0)
-        wave[out_slot] = wave_f[W_AIN, ju] - 2.0 * wave_f[W_Z, ju] * w
-        wave[a_slot] = wave_f[W_BIN, ju] + 2.0 * wave_f[W_Z, ju + np.uint64(1)] * w
+            wave_f[W_WALL_GAVE, j] += min(wall_power, 0.0)
+            wave_f[W_DAMP_GAVE, j] += min(damper_power, 0.0)
+        wave[out_slot] = a_in - 2.0 * wave_f[W_Z, j] * w
+        a_next = wave[a_slot]
+        wave[a_slot] = b_in + 2.0 * wave_f[W_Z, j + 1] * w
+        a_in = a_next
     wave[b_slot] = b_bottom
     wave_f[W_WORK, lo] += wall
     wave_f[W_DAMP, lo] += damper
-
-
-@njit(cache=True, inline="always")
-def junction_law(wave_f: np.ndarray, lo: int, hi: int) -> None:
-    """The junctions ``lo`` .. ``hi - 1`` of a line: each one's new speed w (W_SPEED) and
-    its wall's power F w (W_POWER) from the waves arriving at it (W_AIN from above, W_BIN
-    from below), continuous across it, with the torques balanced on its elements, the point
-    damper D (torque D w) and the wall's friction F: (a_in - Z_j w) - (b_in + Z_j+1 w) =
-    D w + F; with Z = Z_j + Z_j+1 + D (W_ZJ) and the push a_in - b_in:
-
-    * no wall contact (W_FS 0): w = push / Z, the lossless scattering and its damper;
-    * the contact (model.well) stuck (within the stick band: the slips last step of this
-      junction and of the other line's beside it, W_LAST and W_OTHER, :func:`slides`), or
-      sliding with the other line still: set-valued, as the bit's stick (eq. 32): held
-      still while the push is within the limit (static in the band, dynamic outside it:
-      Karnopp), else w Z = push - limit sign(push), power limit |w|;
-    * sliding with both lines moving: the dynamic force lies along the slip velocity, so
-      this line feels F = F_d u / sqrt(u^2 + o^2) = c w, c = F_d s / sqrt(u^2 + o^2) (s the
-      slip per unit speed), taken with the last slip in the root: with k = F_d s (W_KD)
-      and r = sqrt(u^2 + o^2), w = push r / (Z r + k), power c w^2 = k w push / (Z r + k).
-      A string that rotates drags axially as a viscous c = F_d / (r_o omega), and the
-      other way round.
-
-    Keeps each walled junction's slip |w| s (W_LAST) for the band. Written without
-    branches (every case worked out, one chosen: selects), from contiguous rows, so LLVM
-    runs it in vector lanes: the square root and the division, the step's dearest
-    operations, four at a time; IEEE square root and division are exact in every lane, and
-    every case's operations are those of the scalar law, so the same numbers to the bit."""
-    for j in range(lo, hi):
-        ju = np.uint64(j)
-        push = wave_f[W_AIN, ju] - wave_f[W_BIN, ju]
-        u, o = wave_f[W_LAST, ju], wave_f[W_OTHER, ju]
-        fs, z, k = wave_f[W_FS, ju], wave_f[W_ZJ, ju], wave_f[W_KD, ju]
-        wall = fs != 0.0
-        sliding = u * u + o * o > wave_f[W_BAND2, ju]
-        both = wall & sliding & (o > 0.0)             # sliding with both lines moving
-        limit = wave_f[W_FD, ju] if sliding else fs
-        held = wall & (not both)                          # set-valued: stuck, or one line moves
-        r = math.sqrt(u * u + o * o)
-        per_z = (push - math.copysign(limit, push) if held else push) / (
-            z * r + k if both else z)
-        w = per_z * r if both else per_z
-        w = 0.0 if held & (abs(push) <= limit) else w
-        power = k * w * per_z if both else limit * abs(w)
-        wave_f[W_SPEED, ju] = w
-        wave_f[W_POWER, ju] = power if wall else 0.0
-        wave_f[W_LAST, ju] = abs(w) * wave_f[W_SLIP, ju] if wall else u
 
 
 @njit(cache=True, inline="always")
