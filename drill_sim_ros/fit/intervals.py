@@ -7,9 +7,10 @@ u* + t d_i with d_i = C0[:, i] / C0[i, i] and C0 = (J^T J)^-1 (for a misfit quad
 this is the exact profile; for the replays' misfit the others are not re-optimised at each
 point). The profile is evaluated at ``PROFILE_STEPS`` on either side (in u; farther while
 the interval reaches past the points evaluated) and a parabola a t^2 + b t + c is fitted to
-it by least squares, which follows the misfit over the scale of those points rather than the
-slope of its roughness at the optimum (the misfit is an average of replays whose slips move
-with the smallest change, docs/fit.md). Then:
+it by least squares (:func:`vertex`), which follows the misfit over the scale of those
+points rather than the slope of its roughness at the optimum (the misfit is an average of
+replays whose slips move with the smallest change: on field_8p5in_deviated's static
+coefficient it jumps by 30 % between points 0.1 % apart, docs/fit.md). Then:
 
 1. **the profile interval**: the t where the parabola rises above its minimum by
    Delta = s^2 F(0.95; 1, dof), s^2 = S(u*) / dof the noise level estimated from the
@@ -23,8 +24,13 @@ with the smallest change, docs/fit.md). Then:
    g the residuals' rate of change along the profile (their least-squares slope over the
    profile's points); the log's realisation and the mean of the R replays averaged at a
    point (their own scatter over R) add the variance (1 + 1/R) var(dt_k), with Student's t
-   of the sensitivity replays' degrees of freedom. The half-width is
-   sqrt(h^2 + (t_q sd)^2); the fitted value is always inside.
+   of the sensitivity replays' degrees of freedom;
+3. **the misfit's roughness**: where a replay's slip jumps from one point to the next, the
+   averaged misfit scatters about the parabola; the standard error of its vertex t0 from
+   that scatter (Student's t of the points' degrees of freedom) adds its variance too.
+
+The half-width is sqrt(h^2 + the variances of 2 and 3 times their t quantiles squared),
+about t0; the fitted value is always inside.
 
 The correlations between parameters are reported from the Jacobian at the optimum:
 C0 s^2 plus the covariance of the shifts J^+ dr_k, scaled as above.
@@ -37,7 +43,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-PROFILE_STEPS = (0.02, 0.04)   # in u: the profile's points on either side of the optimum
+PROFILE_STEPS = (0.01, 0.02, 0.03, 0.04)  # in u: the profile's points on either side
 PROFILE_EXTENSIONS = 3         # at most this many doublings of the farthest step
 LEVEL = 0.95
 
@@ -100,21 +106,43 @@ def profile_intervals(evaluate: Callable[[Sequence[np.ndarray]], list[np.ndarray
         direction = c0[:, i] / c0[i, i]
         ts, rs = _profile(evaluate, u_best, residuals, direction, i, delta)
         points += ts.size - 1
-        a, b, _ = np.polyfit(ts, [float(r @ r) for r in rs], 2)
-        if a <= 0.0:
+        if ts.size < 4:
+            continue                                  # too few points: the bounds
+        top = vertex(ts, np.array([float(r @ r) for r in rs]))
+        if top is None:
             continue                                  # no minimum: the bounds
-        t0, h = -b / (2.0 * a), float(np.sqrt(delta / a))
-        half = h
+        t0, se_t0, a = top
+        h = float(np.sqrt(delta / a))
+        replay_var = (float(student.ppf(0.5 + LEVEL / 2, ts.size - 3)) * se_t0)**2
         if scatter.shape[0] >= 2:
             g = np.polyfit(ts, np.array(rs), 1)[0]    # d residuals / dt, over the profile
             shifts = -(scatter @ g) / float(g @ g)
-            replay_half[i] = q_replays * float(np.sqrt((1.0 + 1.0 / replays) *
-                                                       np.var(shifts, ddof=1)))
-            half = float(np.hypot(h, replay_half[i]))
+            replay_var += q_replays**2 * (1.0 + 1.0 / replays) * np.var(shifts, ddof=1)
+        replay_half[i] = float(np.sqrt(replay_var))
+        half = float(np.hypot(h, replay_half[i]))
         profile_half[i] = h
         low[i] = max(0.0, u_best[i] + min(0.0, t0 - half))
         high[i] = min(1.0, u_best[i] + max(0.0, t0 + half))
     return Intervals(low, high, correlation, profile_half, replay_half, points)
+
+
+def vertex(ts: np.ndarray, misfits: np.ndarray) -> tuple[float, float, float] | None:
+    """The least-squares parabola a t^2 + b t + c through (``ts``, ``misfits``): its vertex
+    t0 = -b / 2a, t0's standard error from the misfits' scatter about it (the delta
+    method; 0 when it passes through them all) and a; None when a <= 0 (no minimum)."""
+    design = np.column_stack((ts**2, ts, np.ones_like(ts)))
+    coef, *_ = np.linalg.lstsq(design, misfits, rcond=None)
+    a, b = float(coef[0]), float(coef[1])
+    if a <= 0.0:
+        return None
+    t0 = -b / (2.0 * a)
+    spread = misfits - design @ coef
+    dof = ts.size - 3
+    if dof < 1:
+        return t0, 0.0, a
+    cov = float(spread @ spread) / dof * np.linalg.pinv(design.T @ design)
+    grad = np.array([b / (2.0 * a * a), -1.0 / (2.0 * a), 0.0])    # d t0 / d (a, b, c)
+    return t0, float(np.sqrt(max(0.0, grad @ cov @ grad))), a
 
 
 def _profile(evaluate: Callable[[Sequence[np.ndarray]], list[np.ndarray]],
@@ -136,9 +164,9 @@ def _profile(evaluate: Callable[[Sequence[np.ndarray]], list[np.ndarray]],
     add([s * side for s in PROFILE_STEPS for side in (1.0, -1.0)])
     step = max(PROFILE_STEPS)
     for _ in range(PROFILE_EXTENSIONS):
-        if len(ts) >= 3:
-            a, b, _ = np.polyfit(ts, [float(r @ r) for r in rs], 2)
-            reach = abs(b / (2.0 * a)) + np.sqrt(delta / a) if a > 0.0 else np.inf
+        if len(ts) >= 4:
+            top = vertex(np.array(ts), np.array([float(r @ r) for r in rs]))
+            reach = abs(top[0]) + np.sqrt(delta / top[2]) if top else np.inf
             if reach <= max(abs(t) for t in ts):
                 break
         step *= 2.0

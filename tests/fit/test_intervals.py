@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from scipy.stats import t as student
 
-from drill_sim_ros.fit.intervals import profile_intervals
+from drill_sim_ros.fit.intervals import profile_intervals, vertex
 
 RESIDUALS = 60
 REPLAYS = 12                  # averaged per point, as the fit does
@@ -77,3 +77,21 @@ def test_intervals_cover_the_truth_95_percent_with_correlated_replay_noise() -> 
     makes them a little wider), where the profile alone covers about half the time."""
     assert 0.93 <= _coverage(True) <= 0.99
     assert _coverage(False) < 0.7
+
+
+def test_the_vertex_of_a_rough_misfit_is_within_its_standard_error() -> None:
+    """A parabola with a minimum at t* = 0.005, sampled at the profile's nine points with
+    independent noise (the misfit's roughness) of a known sd: t0 +- t(0.975, 6) se covers
+    t* about 95 % of the time (the delta method's standard error is first-order: the noise
+    here moves t0 by a tenth of the points' span)."""
+    rng = np.random.default_rng(2)
+    ts = np.array([0.0, *[s * side for s in (0.01, 0.02, 0.03, 0.04) for side in (1, -1)]])
+    clean = 1e5 * (ts - 0.005)**2 + 100.0
+    q = student.ppf(0.975, ts.size - 3)
+    hits = 0
+    for _ in range(1000):
+        t0, se, _ = vertex(ts, clean + 10.0 * rng.standard_normal(ts.size))
+        hits += int(abs(t0 - 0.005) <= q * se)
+    assert 0.92 <= hits / 1000 <= 0.98
+    t0, se, a = vertex(ts, clean)
+    assert t0 == pytest.approx(0.005) and se < 1e-9 and a == pytest.approx(1e5)
