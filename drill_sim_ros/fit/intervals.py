@@ -9,8 +9,8 @@ point). The profile is evaluated at ``PROFILE_STEPS`` on either side (in u; fart
 the interval reaches past the points evaluated) and a parabola a t^2 + b t + c is fitted to
 it by least squares (:func:`vertex`), which follows the misfit over the scale of those
 points rather than the slope of its roughness at the optimum (the misfit is an average of
-replays whose slips move with the smallest change: on field_8p5in_deviated's static
-coefficient it jumps by 30 % between points 0.1 % apart, docs/fit.md). Then:
+replays whose slips move with the smallest change: along field_8p5in_deviated's static
+coefficient it jumped by 21 % between points 0.12 % apart, docs/fit.md). Then:
 
 1. **the profile interval**: the t where the parabola rises above its minimum by
    Delta = s^2 F(0.95; 1, dof), s^2 = S(u*) / dof the noise level estimated from the
