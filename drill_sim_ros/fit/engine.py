@@ -32,11 +32,12 @@ in the parameters scaled to their bounds (u = (x - low) / (high - low), in [0, 1
    Jacobian's differences, and least squares stopped in a shoulder of it 5 % below the
    static coefficient's truth, where the misfit at the truth was lower (measured
    2026-12-06, docs/fit.md);
-4. the 95 % intervals from the misfit's profile along each parameter (fit.intervals: a
-   parabola over points 2 and 4 % of the range on either side, its rise by the F / chi-square
-   threshold times the noise level of the residuals, widened by how far the sensitivity
-   replays' scatter would move the optimum); the correlations from the Jacobian at the
-   optimum. ``FitResult.stages`` books the replays and the seconds of each stage.
+4. the 95 % intervals from the misfit's profile along each parameter (fit.intervals:
+   where it first rises, at points 1 to 4 % of the range on either side, by the F
+   threshold times the residuals' noise level plus the misfit's own noise over the draws
+   of its replays, widened by how far the sensitivity replays' scatter would move the
+   optimum); the correlations from the Jacobian at the optimum. ``FitResult.stages``
+   books the replays and the seconds of each stage.
 
 Every replay is appended to a cache file as it finishes (JSON lines keyed by a hash of the
 preset, the start-up's samples and the parameter vector); a fit started again with the same
@@ -57,7 +58,7 @@ from typing import Any
 
 import numpy as np
 
-from drill_sim_ros.fit.intervals import profile_intervals
+from drill_sim_ros.fit.intervals import jackknife_sd, profile_intervals
 from drill_sim_ros.fit.objective import Target, noise_std
 from drill_sim_ros.fit.params import FitParameter, with_values
 from drill_sim_ros.model.analysis import lowpass
@@ -256,6 +257,22 @@ class Evaluator:
                 self.sigma[s] = np.sqrt(np.maximum(self.sigma[s]**2,
                                                    target.noise_sigma**2 + scatter**2))
 
+    def misfit_sd(self, x: np.ndarray) -> float:
+        """The standard deviation of the misfit (the sum of the squared residuals) at an
+        evaluated ``x`` over the draws of its averaged replays (the jackknife over them,
+        fit.intervals): the misfit's roughness from averaging a finite number."""
+        variance = 0.0
+        for s, target in enumerate(self.targets):
+            raws = [self.done[f"{self._key(s, x)}:r{r}"] for r in range(self.replays)]
+            if any(isinstance(r, str) for r in raws):
+                return 0.0
+            logged, sigma = target.logged, self.sigma[s]
+            variance += jackknife_sd(
+                lambda mean, logged=logged, sigma=sigma: float(np.sum(((mean - logged) /
+                                                                      sigma)**2)),
+                np.array(raws))**2
+        return math.sqrt(variance)
+
     def sensitivity_scatter(self) -> np.ndarray:
         """The sensitivity replays' deviations from their mean over the weights, each row a
         replay, the start-ups' residuals side by side: how far the compared values of one
@@ -398,7 +415,8 @@ def fit(evaluator: Evaluator, seed: int = 0) -> FitResult:
     jacobian = jac(u_best)
     bands = profile_intervals(
         lambda us: [e.residuals for e in evaluator.evaluate([x_of(u) for u in us])],
-        u_best, best.residuals, jacobian, evaluator.sensitivity_scatter(), evaluator.replays)
+        u_best, best.residuals, jacobian, evaluator.sensitivity_scatter(), evaluator.replays,
+        evaluator.misfit_sd(best.x))
     count[0] += bands.points
     stage("intervals")
     warnings = _warnings(params, best, jacobian, bands.correlation)

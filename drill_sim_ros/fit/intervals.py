@@ -5,32 +5,32 @@ bounds. For parameter i the profile is S along the line through the optimum u* o
 other parameters follow their conditional optimum under the Jacobian's quadratic model,
 u* + t d_i with d_i = C0[:, i] / C0[i, i] and C0 = (J^T J)^-1 (for a misfit quadratic in u
 this is the exact profile; for the replays' misfit the others are not re-optimised at each
-point). The profile is evaluated at ``PROFILE_STEPS`` on either side (in u; farther while
-the interval reaches past the points evaluated) and a parabola a t^2 + b t + c is fitted to
-it by least squares (:func:`vertex`), which follows the misfit over the scale of those
-points rather than the slope of its roughness at the optimum (the misfit is an average of
-replays whose slips move with the smallest change: along field_8p5in_deviated's static
-coefficient it jumped by 21 % between points 0.12 % apart, docs/fit.md). Then:
+point). The profile is evaluated at ``PROFILE_STEPS`` on either side of the optimum (in u;
+farther, doubling, while a side does not rise enough). Each side's bound is where the
+profile first rises above the optimum's misfit by
 
-1. **the profile interval**: the t where the parabola rises above its minimum by
-   Delta = s^2 F(0.95; 1, dof), s^2 = S(u*) / dof the noise level estimated from the
-   residuals (dof = residuals - parameters): t0 +- h, t0 = -b / 2a, h = sqrt(Delta / a).
-   For residuals linear in u with independent noise of one size this is the exact
-   (Student's t) interval of least squares.
-2. **the replays' noise**: the residuals of one log are not independent; a replay's slips
-   move many samples together, and the log is one such realisation. The sensitivity replays
-   (fresh noise on the speed they follow, fit.engine) measure it: each one's deviation dr_k
-   from their mean would move the optimum along the profile by dt_k = -g . dr_k / g . g,
-   g the residuals' rate of change along the profile (their least-squares slope over the
-   profile's points); the log's realisation and the mean of the R replays averaged at a
-   point (their own scatter over R) add the variance (1 + 1/R) var(dt_k), with Student's t
-   of the sensitivity replays' degrees of freedom;
-3. **the misfit's roughness**: where a replay's slip jumps from one point to the next, the
-   averaged misfit scatters about the parabola; the standard error of its vertex t0 from
-   that scatter (Student's t of the points' degrees of freedom) adds its variance too.
+    rise = s^2 F(0.95; 1, dof) + z(0.95) sqrt(2) sd_S
 
-The half-width is sqrt(h^2 + the variances of 2 and 3 times their t quantiles squared),
-about t0; the fitted value is always inside.
+(:func:`crossing`: between the last point below and the first above, interpolated as a
+parabola through the optimum would), then widened:
+
+1. **the profile**: s^2 = S(u*) / dof is the noise level estimated from the residuals
+   (dof = residuals - parameters). For residuals linear in u with independent noise of one
+   size, the first term alone gives least squares' exact (Student's t) interval.
+2. **the misfit's own noise**: S is an average over R replays whose slips move with the
+   smallest change (along field_8p5in_deviated's static coefficient it jumped by 21 %
+   between points 0.12 % apart, docs/fit.md). sd_S is its standard deviation over the
+   draws of those replays at the optimum (:func:`jackknife_sd`); a point whose misfit lies
+   within the one-sided 95 % quantile of the difference of two such draws above the
+   optimum's cannot be told from it.
+3. **the replays' shifts**: the residuals of one log are not independent; a replay's slips
+   move many samples together, and the log is one such realisation. The sensitivity
+   replays (fresh noise on the speed they follow, fit.engine) measure it: each one's
+   deviation dr_k from their mean would move the optimum along the profile by
+   dt_k = -g . dr_k / g . g, g the residuals' least-squares slope over the profile's
+   points; the log's realisation and the mean of the R replays averaged at a point add the
+   variance (1 + 1/R) var(dt_k), with Student's t of the sensitivity replays' degrees of
+   freedom, in quadrature with each side's crossing.
 
 The correlations between parameters are reported from the Jacobian at the optimum:
 C0 s^2 plus the covariance of the shifts J^+ dr_k, scaled as above.
@@ -50,13 +50,13 @@ LEVEL = 0.95
 
 @dataclass(frozen=True)
 class Intervals:
-    """The intervals in u (``low``, ``high``), the correlation matrix and the profile's
-    half-widths from the misfit alone and from the replays' noise alone (u)."""
+    """The intervals in u (``low``, ``high``), the correlation matrix, the misfit's rise
+    that bounds the profile and the half-width added for the replays' shifts (u)."""
 
     low: np.ndarray
     high: np.ndarray
     correlation: np.ndarray
-    profile_half: np.ndarray
+    rise: np.ndarray
     replay_half: np.ndarray
     points: int                  # parameter vectors evaluated for the profiles
 
@@ -81,76 +81,87 @@ def jacobian_covariance(jacobian: np.ndarray, residuals: np.ndarray, scatter: np
 
 def profile_intervals(evaluate: Callable[[Sequence[np.ndarray]], list[np.ndarray]],
                       u_best: np.ndarray, residuals: np.ndarray, jacobian: np.ndarray,
-                      scatter: np.ndarray, replays: int) -> Intervals:
+                      scatter: np.ndarray, replays: int, misfit_sd: float = 0.0
+                      ) -> Intervals:
     """The intervals of each parameter (module doc). ``evaluate``: the weighted residual
     vectors of points in u (within [0, 1]); ``residuals`` and ``jacobian`` at ``u_best``;
     ``scatter`` (sensitivity replays, residuals): their weighted deviations from their
-    mean (none: zero rows); ``replays`` averaged a point."""
+    mean (none: zero rows); ``replays`` averaged a point; ``misfit_sd``: the standard
+    deviation of the misfit at the optimum over the draws of those replays
+    (:func:`jackknife_sd`)."""
     from scipy.stats import f as fisher
+    from scipy.stats import norm
     from scipy.stats import t as student
     n = u_best.size
     s2, dof = noise_level(residuals, n)
-    delta = s2 * float(fisher.ppf(LEVEL, 1, dof))
+    rise = s2 * float(fisher.ppf(LEVEL, 1, dof)) + \
+        float(norm.ppf(LEVEL)) * np.sqrt(2.0) * misfit_sd
     c0 = np.linalg.pinv(jacobian.T @ jacobian)
     cov = jacobian_covariance(jacobian, residuals, scatter, replays)
     sd = np.sqrt(np.maximum(np.diag(cov), 0.0))
     with np.errstate(invalid="ignore", divide="ignore"):
         correlation = cov / np.outer(sd, sd)
     low, high = np.zeros(n), np.ones(n)
-    profile_half, replay_half = np.full(n, np.inf), np.zeros(n)
+    replay_half = np.zeros(n)
     points = 0
     q_replays = float(student.ppf(0.5 + LEVEL / 2, max(1, scatter.shape[0] - 1)))
     for i in range(n):
         if c0[i, i] <= 0.0:
             continue                                  # not constrained: the bounds
         direction = c0[:, i] / c0[i, i]
-        ts, rs = _profile(evaluate, u_best, residuals, direction, i, delta)
+        ts, rs = _profile(evaluate, u_best, residuals, direction, rise)
         points += ts.size - 1
-        if ts.size < 4:
-            continue                                  # too few points: the bounds
-        top = vertex(ts, np.array([float(r @ r) for r in rs]))
-        if top is None:
-            continue                                  # no minimum: the bounds
-        t0, se_t0, a = top
-        h = float(np.sqrt(delta / a))
-        replay_var = (float(student.ppf(0.5 + LEVEL / 2, ts.size - 3)) * se_t0)**2
+        misfits = np.array([float(r @ r) for r in rs])
         if scatter.shape[0] >= 2:
             g = np.polyfit(ts, np.array(rs), 1)[0]    # d residuals / dt, over the profile
             shifts = -(scatter @ g) / float(g @ g)
-            replay_var += q_replays**2 * (1.0 + 1.0 / replays) * np.var(shifts, ddof=1)
-        replay_half[i] = float(np.sqrt(replay_var))
-        half = float(np.hypot(h, replay_half[i]))
-        profile_half[i] = h
-        low[i] = max(0.0, u_best[i] + min(0.0, t0 - half))
-        high[i] = min(1.0, u_best[i] + max(0.0, t0 + half))
-    return Intervals(low, high, correlation, profile_half, replay_half, points)
+            replay_half[i] = q_replays * float(np.sqrt((1.0 + 1.0 / replays) *
+                                                       np.var(shifts, ddof=1)))
+        down, up = crossing(ts, misfits, rise, -1.0), crossing(ts, misfits, rise, 1.0)
+        if down is not None:
+            low[i] = max(0.0, u_best[i] - np.hypot(down, replay_half[i]))
+        if up is not None:
+            high[i] = min(1.0, u_best[i] + np.hypot(up, replay_half[i]))
+    return Intervals(low, high, correlation, np.full(n, rise), replay_half, points)
 
 
-def vertex(ts: np.ndarray, misfits: np.ndarray) -> tuple[float, float, float] | None:
-    """The least-squares parabola a t^2 + b t + c through (``ts``, ``misfits``): its vertex
-    t0 = -b / 2a, t0's standard error from the misfits' scatter about it (the delta
-    method; 0 when it passes through them all) and a; None when a <= 0 (no minimum)."""
-    design = np.column_stack((ts**2, ts, np.ones_like(ts)))
-    coef, *_ = np.linalg.lstsq(design, misfits, rcond=None)
-    a, b = float(coef[0]), float(coef[1])
-    if a <= 0.0:
-        return None
-    t0 = -b / (2.0 * a)
-    spread = misfits - design @ coef
-    dof = ts.size - 3
-    if dof < 1:
-        return t0, 0.0, a
-    cov = float(spread @ spread) / dof * np.linalg.pinv(design.T @ design)
-    grad = np.array([b / (2.0 * a * a), -1.0 / (2.0 * a), 0.0])    # d t0 / d (a, b, c)
-    return t0, float(np.sqrt(max(0.0, grad @ cov @ grad))), a
+def crossing(ts: np.ndarray, misfits: np.ndarray, rise: float, side: float) -> float | None:
+    """How far from the optimum (t = 0, ``misfits[ts == 0]``) on ``side`` (+1 or -1) the
+    profile first rises by ``rise``: between the last point below and the first above,
+    interpolated as a parabola through the optimum would (linear in the square root of the
+    rise: exact for a misfit quadratic about the optimum); None: no point rises so far."""
+    base = float(misfits[ts == 0.0][0])
+    order = np.argsort(np.abs(ts))
+    last_t, last_rise = 0.0, 0.0
+    for k in order:
+        if ts[k] * side <= 0.0:
+            continue
+        up = float(misfits[k]) - base
+        if up > rise:
+            share = (np.sqrt(rise) - np.sqrt(last_rise)) / (np.sqrt(up) - np.sqrt(last_rise))
+            return last_t + (abs(float(ts[k])) - last_t) * float(share)
+        last_t, last_rise = abs(float(ts[k])), max(0.0, up)
+    return None
+
+
+def jackknife_sd(statistic: Callable[[np.ndarray], float], samples: np.ndarray) -> float:
+    """The jackknife standard deviation of ``statistic`` of the mean of ``samples`` (rows:
+    independent draws): how much the statistic of an average of that many draws moves
+    from one set of draws to another."""
+    count = samples.shape[0]
+    if count < 2:
+        return 0.0
+    total = samples.sum(axis=0)
+    left_out = np.array([statistic((total - row) / (count - 1)) for row in samples])
+    return float(np.sqrt((count - 1) / count * np.sum((left_out - left_out.mean())**2)))
 
 
 def _profile(evaluate: Callable[[Sequence[np.ndarray]], list[np.ndarray]],
-             u_best: np.ndarray, residuals: np.ndarray, direction: np.ndarray, i: int,
-             delta: float) -> tuple[np.ndarray, list[np.ndarray]]:
-    """The profile's points t (the step along parameter i) and their residuals: the
-    optimum, ``PROFILE_STEPS`` on either side, then the farthest step doubled while the
-    parabola's rise by ``delta`` lies beyond the points (at most ``PROFILE_EXTENSIONS``)."""
+             u_best: np.ndarray, residuals: np.ndarray, direction: np.ndarray,
+             rise: float) -> tuple[np.ndarray, list[np.ndarray]]:
+    """The profile's points t (the step along the parameter) and their residuals: the
+    optimum, ``PROFILE_STEPS`` on either side, then the farthest step doubled while a side
+    does not rise by ``rise`` (at most ``PROFILE_EXTENSIONS`` times)."""
     ts, rs = [0.0], [residuals]
 
     def add(steps: Sequence[float]) -> None:
@@ -164,11 +175,11 @@ def _profile(evaluate: Callable[[Sequence[np.ndarray]], list[np.ndarray]],
     add([s * side for s in PROFILE_STEPS for side in (1.0, -1.0)])
     step = max(PROFILE_STEPS)
     for _ in range(PROFILE_EXTENSIONS):
-        if len(ts) >= 4:
-            top = vertex(np.array(ts), np.array([float(r @ r) for r in rs]))
-            reach = abs(top[0]) + np.sqrt(delta / top[2]) if top else np.inf
-            if reach <= max(abs(t) for t in ts):
-                break
+        t_now, misfits = np.array(ts), np.array([float(r @ r) for r in rs])
+        missing = [side for side in (1.0, -1.0)
+                   if crossing(t_now, misfits, rise, side) is None]
+        if not missing:
+            break
         step *= 2.0
-        add([step, -step])
+        add([side * step for side in missing])
     return np.array(ts), rs
