@@ -7,7 +7,8 @@ u* + t d_i with d_i = C0[:, i] / C0[i, i] and C0 = (J^T J)^-1 (for a misfit quad
 this is the exact profile; for the replays' misfit the others are not re-optimised at each
 point). The profile is evaluated at ``PROFILE_STEPS`` on either side of the optimum (in u;
 farther, doubling, while a side does not rise enough). Each side's bound is where the
-profile first rises above the optimum's misfit by
+profile first rises above the optimum's misfit (or the level its neighbours on the profile
+put there, where higher: :func:`base_level`) by
 
     rise = s^2 F(0.95; 1, dof) + z(0.95) sqrt(2) sd_S
 
@@ -125,12 +126,29 @@ def profile_intervals(evaluate: Callable[[Sequence[np.ndarray]], list[np.ndarray
     return Intervals(low, high, correlation, np.full(n, rise), replay_half, points)
 
 
+def base_level(ts: np.ndarray, misfits: np.ndarray) -> float:
+    """The misfit the profile's rise is counted from: the optimum's own (t = 0), or, where
+    higher, the level c at t = 0 of the least-squares fit c + a_low t^2 (t < 0),
+    c + a_high t^2 (t > 0) to the profile's other points. The optimum's misfit is the
+    lowest of the many the optimiser drew, so its share of the misfit's noise is biased
+    low; its neighbours on the profile were not chosen for being low."""
+    own = float(misfits[ts == 0.0][0])
+    others = ts != 0.0
+    if np.count_nonzero(others) < 4:
+        return own
+    t = ts[others]
+    design = np.column_stack((np.ones_like(t), np.where(t < 0.0, t**2, 0.0),
+                              np.where(t > 0.0, t**2, 0.0)))
+    coef, *_ = np.linalg.lstsq(design, misfits[others], rcond=None)
+    return max(own, float(coef[0]))
+
+
 def crossing(ts: np.ndarray, misfits: np.ndarray, rise: float, side: float) -> float | None:
-    """How far from the optimum (t = 0, ``misfits[ts == 0]``) on ``side`` (+1 or -1) the
-    profile first rises by ``rise``: between the last point below and the first above,
+    """How far from the optimum (t = 0) on ``side`` (+1 or -1) the profile first rises by
+    ``rise`` above :func:`base_level`: between the last point below and the first above,
     interpolated as a parabola through the optimum would (linear in the square root of the
     rise: exact for a misfit quadratic about the optimum); None: no point rises so far."""
-    base = float(misfits[ts == 0.0][0])
+    base = base_level(ts, misfits)
     order = np.argsort(np.abs(ts))
     last_t, last_rise = 0.0, 0.0
     for k in order:
