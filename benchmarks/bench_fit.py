@@ -56,9 +56,9 @@ def one_log(seed: int, data: dict, names: str, client: object, share: float, cac
         print(f"\rlog {seed}: {text}", end="", file=sys.stderr, flush=True)
     evaluator = engine.Evaluator(start, parse_fit(names, start), [target], client, cache,
                                  progress)
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     result = engine.fit(evaluator)
-    seconds = time.perf_counter() - t0
+    seconds, cpu_s = time.perf_counter() - t0, time.process_time() - c0
     at_truth = evaluator.evaluate([truth])[0].misfit
     run = evaluator.map_runs(evaluator.values_of(result.x))[0]
     logged = lowpass(log.torque_nm, log.sample_s, target.cutoff_hz)[target.torque.cycle]
@@ -66,19 +66,26 @@ def one_log(seed: int, data: dict, names: str, client: object, share: float, cac
     print(file=sys.stderr)
     return {"seed": seed, "error": (result.x / truth - 1.0).tolist(),
             "covers": ((result.low95 <= truth) & (truth <= result.high95)).tolist(),
+            "interval": np.column_stack((result.low95 / truth - 1.0,
+                                         result.high95 / truth - 1.0)).tolist(),
             "misfit": (result.misfit_after, at_truth), "seconds": seconds,
-            "replays": result.replays,
+            "cpu_s": cpu_s, "replays": result.replays,
+            "stages": {k: list(v) for k, v in result.stages.items()},
             "cycle": (objective.cycle_features(logged, log.sample_s)[:3].tolist(),
                       objective.cycle_features(fitted, log.sample_s)[:3].tolist())}
 
 
 def show(r: dict) -> None:
     (rec, fit), error_pct = r["cycle"], 100 * np.array(r["error"])
+    band = "; ".join(f"{100 * lo:+.1f} to {100 * hi:+.1f}" for lo, hi in r["interval"])
+    stages = ", ".join(f"{k} {n} replays {s:.0f} s" for k, (n, s) in r["stages"].items())
     print(f"log {r['seed']:2d}: error % {np.array2string(error_pct, precision=1)} "
-          f"covered {np.array(r['covers']).astype(int)} misfit {r['misfit'][0]:.3g} (truth "
+          f"(95 % {band}) covered {np.array(r['covers']).astype(int)} misfit "
+          f"{r['misfit'][0]:.3g} (truth "
           f"{r['misfit'][1]:.3g}); cycle period {rec[0]:.2f}/{fit[0]:.2f} s, mean "
           f"{rec[1]:.0f}/{fit[1]:.0f} N m, std {rec[2]:.0f}/{fit[2]:.0f} N m "
-          f"(logged/fitted); {r['replays']} replays in {r['seconds']:.0f} s", flush=True)
+          f"(logged/fitted); {r['replays']} replays in {r['seconds']:.0f} s ({r['cpu_s']:.0f} s "
+          f"of this process's CPU; {stages})", flush=True)
 
 
 def main() -> None:
@@ -96,7 +103,8 @@ def main() -> None:
     paths = args.params.split(",")
     first, last = (int(v) for v in args.seeds.split(":"))
     args.dir.mkdir(parents=True, exist_ok=True)
-    tag = f"{len(paths)}p_{args.start:g}_{args.substeps or 'preset'}_r{engine.REPLAYS_PER_POINT}"
+    tag = (f"{len(paths)}p_{args.start:g}_{args.substeps or 'preset'}_r{engine.REPLAYS_PER_POINT}"
+           "_profile")
     done_path = args.dir / f"done_{tag}.jsonl"
     done = {}
     if done_path.exists():

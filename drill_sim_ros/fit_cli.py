@@ -170,6 +170,8 @@ def _report(args: Any, params: list, targets: list[Target], groups: list[list[Ta
             "correlation": np.round(res.correlation, 4).tolist(),
             "warnings": list(res.warnings), "evaluations": res.evaluations,
             "replays": res.replays, "from_cache": res.reused, "seconds": res.seconds,
+            "stages": {name: {"replays": n, "seconds": sec}
+                       for name, (n, sec) in res.stages.items()},
             "startups": cycles})
     report: dict[str, Any] = {"log": str(args.log), "preset": args.params,
                               "mode": "each" if args.each else "joint",
@@ -199,6 +201,9 @@ def _summary(report: dict[str, Any]) -> str:
                      f"{fit['misfit_before']:.4g} before, {fit['misfit_after']:.4g} after; "
                      f"{fit['replays']} replays ({fit['from_cache']} from the cache) in "
                      f"{fit['seconds']:.1f} s")
+        lines.append("  replays by stage: " + ", ".join(
+            f"{name} {st['replays']} ({st['seconds']:.0f} s)"
+            for name, st in fit["stages"].items()))
         names = list(fit["values"])
         corr = np.array(fit["correlation"])
         for a in range(len(names)):

@@ -32,14 +32,12 @@ in the parameters scaled to their bounds (u = (x - low) / (high - low), in [0, 1
    Jacobian's differences, and least squares stopped in a shoulder of it 5 % below the
    static coefficient's truth, where the misfit at the truth was lower (measured
    2026-12-06, docs/fit.md);
-4. the 95 % intervals from the Jacobian at the optimum: cov = s^2 (J^T J)^-1 with s^2 the
-   residuals' mean square over their degrees of freedom (at least 1: a misfit within the
-   noise does not shrink them), plus the covariance of the shifts J^+ dr_k that the
-   sensitivity replays' deviations dr_k from their mean would make (the residuals of one
-   log are correlated, the slips moving many samples together, which the first term
-   ignores), times 1 + 1 / ``REPLAYS_PER_POINT`` (the averaged replays' own scatter);
-   Student's t with the replays' degrees of freedom; the correlations from the same
-   matrix.
+4. the 95 % intervals from the misfit's profile along each parameter (fit.intervals:
+   where it first rises, at points 1 to 4 % of the range on either side, by the F
+   threshold times the residuals' noise level plus the misfit's own noise over the draws
+   of its replays, widened by how far the sensitivity replays' scatter would move the
+   optimum); the correlations from the Jacobian at the optimum. ``FitResult.stages``
+   books the replays and the seconds of each stage.
 
 Every replay is appended to a cache file as it finishes (JSON lines keyed by a hash of the
 preset, the start-up's samples and the parameter vector); a fit started again with the same
@@ -60,6 +58,7 @@ from typing import Any
 
 import numpy as np
 
+from drill_sim_ros.fit.intervals import jackknife_sd, profile_intervals
 from drill_sim_ros.fit.objective import Target, noise_std
 from drill_sim_ros.fit.params import FitParameter, with_values
 from drill_sim_ros.model.analysis import lowpass
@@ -81,7 +80,6 @@ LOCAL_STARTS = 3              # the first pass starts from the best this many po
 BRACKET_STEPS = (0.02, 0.04)  # in u: the points tried on either side of the optimum
 BRACKET_ROUNDS = 3            # at most this many restarts from a better one of them
 CORRELATED = 0.95             # |correlation| above this: the log cannot tell the two apart
-Z95 = 0.975
 
 
 def simulate(data: dict[str, Any], values: dict[str, float], t_s: np.ndarray,
@@ -259,6 +257,22 @@ class Evaluator:
                 self.sigma[s] = np.sqrt(np.maximum(self.sigma[s]**2,
                                                    target.noise_sigma**2 + scatter**2))
 
+    def misfit_sd(self, x: np.ndarray) -> float:
+        """The standard deviation of the misfit (the sum of the squared residuals) at an
+        evaluated ``x`` over the draws of its averaged replays (the jackknife over them,
+        fit.intervals): the misfit's roughness from averaging a finite number."""
+        variance = 0.0
+        for s, target in enumerate(self.targets):
+            raws = [self.done[f"{self._key(s, x)}:r{r}"] for r in range(self.replays)]
+            if any(isinstance(r, str) for r in raws):
+                return 0.0
+            logged, sigma = target.logged, self.sigma[s]
+            variance += jackknife_sd(
+                lambda mean, logged=logged, sigma=sigma: float(np.sum(((mean - logged) /
+                                                                      sigma)**2)),
+                np.array(raws))**2
+        return math.sqrt(variance)
+
     def sensitivity_scatter(self) -> np.ndarray:
         """The sensitivity replays' deviations from their mean over the weights, each row a
         replay, the start-ups' residuals side by side: how far the compared values of one
@@ -325,6 +339,7 @@ class FitResult:
     reused: int
     seconds: float
     warnings: tuple[str, ...]
+    stages: dict[str, tuple[int, float]]   # replays run and seconds taken, by stage
 
 
 def fit(evaluator: Evaluator, seed: int = 0) -> FitResult:
@@ -339,12 +354,22 @@ def fit(evaluator: Evaluator, seed: int = 0) -> FitResult:
     def x_of(u: np.ndarray) -> np.ndarray:
         return low + span * np.clip(u, 0.0, 1.0)
 
+    stages: dict[str, tuple[int, float]] = {}
+    mark = [evaluator.computed, time.perf_counter()]
+
+    def stage(name: str) -> None:
+        """Book the replays run and the time taken since the last stage under ``name``."""
+        now = time.perf_counter()
+        stages[name] = (evaluator.computed - mark[0], now - mark[1])
+        mark[:] = [evaluator.computed, now]
+
     starts = qmc.LatinHypercube(d=len(params), seed=seed).random(
         STARTS_PER_PARAMETER * len(params))
     points = [x0, *[x_of(u) for u in starts]]
     evaluator.measure_sensitivity(x0)
     evaluator.measure_sensitivity(min(evaluator.evaluate(points), key=lambda e: e.misfit).x)
     count = [len(points)]
+    stage("global")
 
     def fun(u: np.ndarray) -> np.ndarray:
         count[0] += 1
@@ -371,6 +396,7 @@ def fit(evaluator: Evaluator, seed: int = 0) -> FitResult:
         evaluator.measure_sensitivity(best.x)
         points += [e.x for e in ends]
     best = min(evaluator.evaluate(points), key=lambda e: e.misfit)
+    stage("least squares")
     for _ in range(BRACKET_ROUNDS):
         nearby = evaluator.evaluate([x_of(u) for u in _bracket((best.x - low) / span)])
         count[0] += len(nearby)
@@ -384,13 +410,20 @@ def fit(evaluator: Evaluator, seed: int = 0) -> FitResult:
         points.append(x_of(result.x))
         best = min(evaluator.evaluate(points), key=lambda e: e.misfit)
     before = evaluator.evaluate([x0])[0]
-    jacobian = jac((best.x - low) / span)
-    low95, high95, corr, warnings = _intervals(params, best, jacobian, span,
-                                               evaluator.sensitivity_scatter(),
-                                               evaluator.replays)
-    return FitResult(tuple(params), best.x, low95, high95, corr, before.misfit, best.misfit,
-                     count[0], evaluator.computed, evaluator.reused,
-                     time.perf_counter() - evaluator.started, tuple(warnings))
+    stage("bracket")
+    u_best = (best.x - low) / span
+    jacobian = jac(u_best)
+    bands = profile_intervals(
+        lambda us: [e.residuals for e in evaluator.evaluate([x_of(u) for u in us])],
+        u_best, best.residuals, jacobian, evaluator.sensitivity_scatter(), evaluator.replays,
+        evaluator.misfit_sd(best.x))
+    count[0] += bands.points
+    stage("intervals")
+    warnings = _warnings(params, best, jacobian, bands.correlation)
+    return FitResult(tuple(params), best.x, x_of(bands.low), x_of(bands.high),
+                     bands.correlation, before.misfit, best.misfit, count[0],
+                     evaluator.computed, evaluator.reused,
+                     time.perf_counter() - evaluator.started, tuple(warnings), stages)
 
 
 def _bracket(u: np.ndarray) -> list[np.ndarray]:
@@ -413,37 +446,20 @@ def _step(u: np.ndarray, i: int) -> np.ndarray:
     return h
 
 
-def _intervals(params: Sequence[FitParameter], best: Evaluation, jacobian: np.ndarray,
-               span: np.ndarray, scatter: np.ndarray, replays: int
-               ) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[str]]:
-    """The 95 % intervals and correlations from the Jacobian (module doc), with warnings;
-    ``scatter`` (replays, residuals): the sensitivity replays' weighted deviations from
-    their mean (:meth:`Evaluator.sensitivity_scatter`); ``replays`` averaged a point."""
-    from scipy.stats import t as student
-    m, n = jacobian.shape
-    dof = max(1, m - n)
-    s2 = max(1.0, float(np.sum(best.residuals**2)) / dof)
-    cov_u = s2 * np.linalg.pinv(jacobian.T @ jacobian)
-    if scatter.shape[0] >= 2:                 # the replays' own scatter, carried through
-        shifts = scatter @ np.linalg.pinv(jacobian).T     # (replays, n): du of each
-        cov_u = cov_u + (1.0 + 1.0 / replays) * np.cov(shifts, rowvar=False,
-                                                                  ddof=1).reshape(n, n)
-        dof = min(dof, scatter.shape[0] - 1)
-    cov = cov_u * np.outer(span, span)
-    sd = np.sqrt(np.maximum(np.diag(cov), 0.0))
-    half = student.ppf(Z95, dof) * sd
-    with np.errstate(invalid="ignore", divide="ignore"):
-        corr = cov / np.outer(sd, sd)
+def _warnings(params: Sequence[FitParameter], best: Evaluation, jacobian: np.ndarray,
+              correlation: np.ndarray) -> list[str]:
+    """A parameter the misfit does not move with, a pair the log cannot tell apart (their
+    |correlation| above ``CORRELATED``), fitted values the preset refused."""
     warnings = []
     for i, p in enumerate(params):
         if not np.any(jacobian[:, i]):
             warnings.append(f"the log does not constrain {p.path} (the misfit does not move "
                             "with it)")
-        for j in range(i + 1, n):
-            if abs(corr[i, j]) > CORRELATED:
+        for j in range(i + 1, len(params)):
+            if abs(correlation[i, j]) > CORRELATED:
                 warnings.append(f"the log cannot tell {p.path} and {params[j].path} apart "
-                                f"(correlation {corr[i, j]:+.3f}): fix one, or add a log "
-                                "that moves them differently")
+                                f"(correlation {correlation[i, j]:+.3f}): fix one, or add a "
+                                "log that moves them differently")
     if best.refused:
         warnings.append(f"the preset refused the fitted values: {best.refused}")
-    return best.x - half, best.x + half, corr, warnings
+    return warnings
