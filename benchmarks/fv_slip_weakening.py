@@ -36,6 +36,7 @@ import time
 
 import numpy as np
 
+from benchmarks.fv_startup_convergence import cell
 from tests.model import fv_cases
 from tests.model import fv_reference as fv
 
@@ -102,14 +103,6 @@ def length_table(case: fv.Case, weakenings_m: list[float]) -> str:
             cells.append(f"{h_t:.1f} / {h_a:.1f} / {lam:.1f}")
         lines.append(f"| {md:g} | {n:.0f} | " + " | ".join(cells) + " |")
     return "\n".join(lines)
-
-
-def cell(value: float | None, key: str) -> str:
-    if value is None:
-        return "–"
-    if key.endswith("_nm"):
-        return f"{value / 1e3:.2f} k"
-    return f"{value:.3f}" if key in ("stick_fraction", "breakaway_turns") else f"{value:.2f}"
 
 
 def run_row(case: fv.Case, weakening_m: float, cells: int, seconds: float,
