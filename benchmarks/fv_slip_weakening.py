@@ -23,8 +23,8 @@ after the table each run's train of slip pulses: when a sliding front first pass
 (below the upper build) and the deepest face it reaches before the string below 750 m is
 stuck again (2700 m: the bit; 2500 m: the collars' top).
 
-Usage: nice .venv/bin/python benchmarks/fv_slip_weakening.py [--weakening-um 0 100 1000]
-       [--cells 675 1350 2700 5400] [--seconds 25] [--table-only]
+Usage: PYTHONPATH=. nice .venv/bin/python benchmarks/fv_slip_weakening.py
+       [--weakening-um 0 100 1000] [--cells 675 1350 2700 5400] [--seconds 25] [--table-only]
 """
 
 from __future__ import annotations

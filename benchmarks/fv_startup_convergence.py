@@ -9,7 +9,7 @@ solver's columns, the package's, and the package against the solver's ``--agains
 (default the case's) in % (stick fraction: the difference). ``--seconds`` overrides the
 cases' run length (120: the issue's).
 
-Usage: .venv/bin/python benchmarks/fv_startup_convergence.py [--case tangent]
+Usage: PYTHONPATH=. .venv/bin/python benchmarks/fv_startup_convergence.py [--case tangent]
        [--cells 1000 2000 4000] [--courant 0.9] [--seconds 120] [--against 2000]
 """
 
