@@ -12,7 +12,11 @@ The sample topics are latched (reliable, transient local, depth 1), so the first
 driver receives is the latest the sim published (t = 0 at the start of a run), whenever the
 driver starts; it answers that one too, and sends nothing before it (the handshake of
 docs/control-loop.md). Nothing is lost: both directions are reliable, and each side waits
-for the other.
+for the other. The command topic is volatile, so an answer sent before the sim's
+subscription has matched the driver's writer would be lost (discovery announces a node's
+publications and subscriptions apart, so the sim's sample can arrive first): the driver
+holds each answer until its writer has matched the sim's subscription and every other the
+graph shows (:meth:`LockstepDriver.sim_listens`).
 """
 
 from __future__ import annotations
@@ -22,6 +26,7 @@ from collections.abc import Callable
 from typing import Any
 
 import numpy as np
+from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
 from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.serialization import deserialize_message
@@ -38,6 +43,8 @@ __all__ = ["LOCKSTEP_QOS", "Command", "LockstepDriver", "Policy", "top_drive_com
 LOCKSTEP_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1000,
                           reliability=ReliabilityPolicy.RELIABLE)
 _TIME = TELEMETRY_INDEX["sim_time_s"]
+MATCH_POLL_S = 0.01          # how often a held answer looks for the sim's subscription
+MATCH_WAIT_S = 10.0          # then it goes out anyway (a sim under another node name)
 
 # A policy: the sample it reacts to -> the command.
 Policy = Callable[[Any], Command]
@@ -99,6 +106,12 @@ class LockstepDriver(Node):
         msg_type = JointState if sample_topic == topics.SURFACE_MEASURED else Float64MultiArray
         self._sub = self.create_subscription(msg_type, topics.node_relative(sample_topic),
                                              self._on_sample, LATEST_SAMPLE_QOS, raw=True)
+        self._held: JointState | None = None    # an answer waiting for the sim to listen
+        self._held_polls = 0
+        self._listened_at = -1                  # the matched count sim_listens() last held at
+        self._match_timer = self.create_timer(  # wall time: /clock stands while lockstep waits
+            MATCH_POLL_S, self._send_held, clock=Clock(clock_type=ClockType.STEADY_TIME),
+            autostart=False)
 
     @property
     def done(self) -> bool:
@@ -119,8 +132,41 @@ class LockstepDriver(Node):
         if self.periods <= 0 or self.received < self.periods:
             self._command(sample, time_ns)
 
+    def sim_listens(self) -> bool:
+        """Whether the command writer has matched the sim's subscription (a node named
+        ``topics.NODE_NAME`` in this namespace) and every other subscription the graph shows
+        on the topic: only then does an answer reach the sim."""
+        readers = self.get_subscriptions_info_by_topic(self._pub.topic_name)
+        sim = any(r.node_name == topics.NODE_NAME and r.node_namespace == self.get_namespace()
+                  for r in readers)
+        return sim and self._pub.get_subscription_count() >= len(readers)
+
+    def _sim_still_listens(self) -> bool:
+        """sim_listens(), asked of the graph again only when the matched count moved."""
+        count = self._pub.get_subscription_count()
+        if count != self._listened_at:
+            self._listened_at = count if self.sim_listens() else -1
+        return self._listened_at >= 0
+
     def _command(self, sample: Any, time_ns: int) -> None:
         command = self._policy(sample)
         self._reacted_ns = time_ns
-        self._pub.publish(top_drive_command(command, time_ns))
+        message = top_drive_command(command, time_ns)
+        if self._held is None and self._sim_still_listens():
+            self._publish(message)
+            return
+        self._held, self._held_polls = message, 0
+        self._match_timer.reset()
+
+    def _send_held(self) -> None:
+        self._held_polls += 1
+        if self._held is not None and (self._sim_still_listens()
+                                       or self._held_polls * MATCH_POLL_S >= MATCH_WAIT_S):
+            message, self._held = self._held, None
+            self._publish(message)
+        if self._held is None:
+            self._match_timer.cancel()
+
+    def _publish(self, message: JointState) -> None:
+        self._pub.publish(message)
         self.sent += 1

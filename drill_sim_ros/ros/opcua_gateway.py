@@ -26,6 +26,7 @@ import asyncio
 import contextlib
 import functools
 import logging
+import signal
 import sys
 import threading
 import time
@@ -64,6 +65,7 @@ sim_nodes of two namespaces); start sim_node first. --export-nodeset FILE writes
 space (with sim_node's ranges) as NodeSet2 XML for a PLC project, and exits."""
 GIL_SWITCH_INTERVAL_S = 0.0005    # as sim_node's: a thread waiting for the GIL waits less
 POLL_S = 0.2
+STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
 DIAGNOSTICS_PERIOD_S = 1.0        # wall time, as sim_node's
 SETTINGS_RETRY_S = 0.5            # how often stale sim_node settings are asked for again
 PROGRESS_S = 5.0                  # a line while the gateway waits for sim_node at start
@@ -275,8 +277,15 @@ def _connect(link: SimLink, rig: Rig, loop: asyncio.AbstractEventLoop,
 
 
 async def serve(node: GatewayNode, settings: list[RigSettings]) -> None:
-    """Run the OPC UA server until ROS shuts down (SIGINT, SIGTERM)."""
+    """Run the OPC UA server until SIGINT or SIGTERM (or ROS shuts down otherwise).
+
+    The signals set a flag the loop reads: asyncio.run's own SIGINT handler (which replaces
+    rclpy's) only cancels the task, and Python 3.11's ``wait_for`` drops that cancellation
+    when its queue delivers an event at the same moment, which left the gateway serving."""
     loop = asyncio.get_running_loop()
+    stopping = asyncio.Event()
+    for signum in STOP_SIGNALS:
+        loop.add_signal_handler(signum, stopping.set)
     events: asyncio.Queue[Event] = asyncio.Queue()
     rigs = [Rig(link.rig, start_settings, link.send, _switcher(link), node.timing)
             for link, start_settings in zip(node.links, settings, strict=True)]
@@ -292,13 +301,15 @@ async def serve(node: GatewayNode, settings: list[RigSettings]) -> None:
                                f"(lockstep {rig.settings.lockstep}, drive mode "
                                f"{rig.settings.drive_mode.name})")
     try:
-        while rclpy.ok():
+        while rclpy.ok() and not stopping.is_set():
             try:
                 event = await asyncio.wait_for(events.get(), POLL_S)
             except TimeoutError:
                 continue
             await event()
     finally:
+        for signum in STOP_SIGNALS:
+            loop.remove_signal_handler(signum)
         executor.shutdown(timeout_sec=1.0)
         await server.stop()
 

@@ -182,7 +182,7 @@ def test_a_slow_first_start_is_waited_for_with_progress_lines(tmp_path: Path) ->
             for name, value in SIM_VALUES.items():
                 stand_in.declare_parameter(name, value)
             assert ros.spin_until(lambda: "serving" in log.read_text(), 30.0), log.read_text()
-            assert stop(gateway, signal.SIGINT) == 0
+            assert stop(gateway, signal.SIGINT) == 0, log.read_text()
     text = log.read_text()
     assert "waiting for /slow_start/drill_sim's parameters" in text
     assert "it answers, not all declared yet" in text
