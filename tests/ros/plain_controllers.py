@@ -5,7 +5,8 @@ examples/lockstep_controller.py, no helper of this package.
     python tests/ros/plain_controllers.py --report PATH [--kind a|b|c] [--kickoff-stamp
         now|zero] [--stop-at-s 30] [--die-at-s T] [--extras] [--flood N]
 
-- a: answers every sample of drill/surface/measured, stamped with the sample's stamp;
+- a: answers every sample of drill/surface/measured, stamped with the sample's stamp, once
+  its publisher has matched (an answer sent before is lost: docs/control-loop.md);
 - b: also sends one command at start-up, at once; c: sends one kick-off command once its
   publisher has matched (both stamped with the node's clock, or 0 with --kickoff-stamp zero);
 - --extras: around every fifth answer, commands that must not count: one stamped a period
@@ -54,6 +55,8 @@ class PlainController(Node):
         self.pub = self.create_publisher(JointState, "drill/cmd/top_drive", 10)
         self.create_subscription(JointState, "drill/surface/measured", self.on_sample,
                                  LATEST_SAMPLE)
+        self.held: JointState | None = None          # a sample to answer once sim_node listens
+        self.create_timer(0.01, self.answer_held)
         if args.kind == "b":
             self.kick_off()
         elif args.kind == "c":
@@ -74,7 +77,15 @@ class PlainController(Node):
             self.destroy_timer(self.wait_for_match)
             self.kick_off()
 
+    def answer_held(self) -> None:
+        if self.held is not None and self.pub.get_subscription_count() > 0:
+            sample, self.held = self.held, None
+            self.on_sample(sample)
+
     def on_sample(self, sample: JointState) -> None:
+        if self.pub.get_subscription_count() == 0:   # an answer now would be lost
+            self.held = sample                       # (docs/control-loop.md)
+            return
         time_ns = sample.header.stamp.sec * 10**9 + sample.header.stamp.nanosec
         if self.done:
             return
