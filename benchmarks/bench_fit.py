@@ -13,7 +13,10 @@ Resumable: each log's replays go to a cache and each finished log to a JSON line
 it stopped (``--seeds A:B`` picks the logs). Printed per log: the fitted
 values' errors against the truth, whether each 95 % interval covers it, the misfit at the
 fit and at the truth (the same weights), the recorded and fitted cycles (period, mean,
-std) and the wall time; then the coverage counts (issue 51: within 5 % and >= 17 of 20).
+std; and over the replays averaged at the fit and at the truth, each feature's mean and
+standard deviation and the logged one's z: docs/fit.md, the cycle is one draw of a branching
+threshold dynamics) and the wall time; then the coverage counts (issue 51: within 5 % and
+>= 17 of 20).
 Usage: .venv/bin/python benchmarks/bench_fit.py [--seeds 1:20] [--workers 2]
        [--params a,b] [--start 0.8] [--substeps 54] [--dir /tmp/bench_fit]
 """
@@ -72,7 +75,16 @@ def one_log(seed: int, data: dict, names: str, client: object, share: float, cac
             "cpu_s": cpu_s, "replays": result.replays,
             "stages": {k: list(v) for k, v in result.stages.items()},
             "cycle": (objective.cycle_features(logged, log.sample_s)[:3].tolist(),
-                      objective.cycle_features(fitted, log.sample_s)[:3].tolist())}
+                      objective.cycle_features(fitted, log.sample_s)[:3].tolist()),
+            "replayed_cycles": {"fitted": _spread(result.cycles[0]),
+                                "truth": _spread(evaluator.replayed_cycles(truth)[0])}}
+
+
+def _spread(cycles: np.ndarray | None) -> list[list[float]] | None:
+    """The mean and standard deviation of period, mean and std over a point's replays."""
+    if cycles is None:
+        return None
+    return np.column_stack((cycles.mean(axis=0), cycles.std(axis=0, ddof=1))).tolist()
 
 
 def show(r: dict) -> None:
@@ -86,6 +98,12 @@ def show(r: dict) -> None:
           f"{rec[1]:.0f}/{fit[1]:.0f} N m, std {rec[2]:.0f}/{fit[2]:.0f} N m "
           f"(logged/fitted); {r['replays']} replays in {r['seconds']:.0f} s ({r['cpu_s']:.0f} s "
           f"of this process's CPU; {stages})", flush=True)
+    for which, spread in r.get("replayed_cycles", {}).items():
+        if spread:
+            print(f"        its replays at the {which}: " + ", ".join(
+                f"{name} {m:.4g} +- {sd:.3g} (logged at z {(logged - m) / sd:+.1f})"
+                for name, (m, sd), logged in zip(("period s", "mean N m", "std N m"), spread,
+                                                 rec, strict=True)), flush=True)
 
 
 def main() -> None:

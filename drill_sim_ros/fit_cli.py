@@ -150,17 +150,38 @@ def _cycle(target: Target, torque_lp: np.ndarray) -> dict[str, float] | None:
             "amplitude_nm": float(0.5 * (np.max(window) - np.min(window)))}
 
 
+CYCLE_NAMES = ("period_s", "mean_nm", "std_nm")
+
+
+def _spread(target: Target, cycles: np.ndarray | None) -> dict[str, dict[str, float]] | None:
+    """The cycle over the replays averaged at the fitted values (engine's
+    ``replayed_cycles``): each feature's mean, standard deviation, least and largest, and
+    where the recorded one lies, ``recorded_z`` = (recorded - mean) / sd."""
+    recorded = target.cycle_of(target.logged)
+    if cycles is None or recorded is None or len(cycles) < 2:
+        return None
+    out = {}
+    for name, values, logged in zip(CYCLE_NAMES, cycles.T, recorded, strict=True):
+        sd = float(np.std(values, ddof=1))
+        out[name] = {"mean": float(np.mean(values)), "sd": sd, "min": float(np.min(values)),
+                     "max": float(np.max(values)),
+                     "recorded_z": float((logged - np.mean(values)) / sd) if sd > 0 else 0.0}
+    return out
+
+
 def _report(args: Any, params: list, targets: list[Target], groups: list[list[Target]],
             results: list) -> dict[str, Any]:
     fits = []
     for group, (res, runs) in zip(groups, results, strict=True):
         cycles = []
-        for target, run in zip(group, runs, strict=True):
+        spreads = res.cycles or (None,) * len(group)
+        for target, run, spread in zip(group, runs, spreads, strict=True):
             logged = _logged_lp(target)
             cycles.append({"start_s": float(target.log.t_s[0]),
                            "first_slip_s": (target.first_slip_s or 0.0),
                            "recorded": _cycle(target, logged),
-                           "fitted": _cycle(target, target.model_torque(run[0]))})
+                           "fitted": _cycle(target, target.model_torque(run[0])),
+                           "replays": _spread(target, spread)})
         fits.append({
             "values": {p.path: {"value": float(x), "low95": float(lo), "high95": float(hi),
                                 "initial": p.initial, "bounds": [p.low, p.high]}
@@ -217,6 +238,12 @@ def _summary(report: dict[str, Any]) -> str:
                                  f"{which:8s}: period {c['period_s']:.3f} s, mean "
                                  f"{c['mean_nm']:.0f} N m, std {c['std_nm']:.0f} N m, "
                                  f"amplitude {c['amplitude_nm']:.0f} N m")
+            if s.get("replays"):
+                r = s["replays"]
+                lines.append("  cycle over the fit's replays (mean +- sd; the recorded at z): "
+                             + ", ".join(f"{name.split('_')[0]} {r[name]['mean']:.4g} +- "
+                                         f"{r[name]['sd']:.3g} (z {r[name]['recorded_z']:+.1f})"
+                                         for name in CYCLE_NAMES))
         lines += [f"  warning: {w}" for w in fit["warnings"]]
     for path, s in report.get("spread", {}).items():
         lines.append(f"  spread over start-ups: {path} {s['mean']:.5g} +- {s['std']:.3g}")

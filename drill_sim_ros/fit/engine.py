@@ -238,6 +238,21 @@ class Evaluator:
         target = self.targets[segment]
         return (np.asarray(raw) - target.logged) / self.sigma[segment]
 
+    def replayed_cycles(self, x: np.ndarray) -> list[np.ndarray | None]:
+        """Per start-up, the torque's cycle (period s, mean and standard deviation N m;
+        :meth:`Target.cycle_of`) in each of the replays averaged at the evaluated ``x``,
+        shape (replays, 3); None where the cycle is not compared or a replay was refused.
+        Their spread, not one replay, is what the model says of the log's cycle: in the
+        deviated presets the cycle after the first slip jumps between branches with the
+        smallest change of the speed replayed, and of the parameters (docs/fit.md)."""
+        cycles: list[np.ndarray | None] = []
+        for s, target in enumerate(self.targets):
+            raws = [self.done[f"{self._key(s, x)}:r{r}"] for r in range(self.replays)]
+            ok = not any(isinstance(r, str) for r in raws)
+            rows = [target.cycle_of(np.asarray(r)) for r in raws] if ok else [None]
+            cycles.append(None if any(r is None for r in rows) else np.array(rows))
+        return cycles
+
     def measure_sensitivity(self, x: np.ndarray) -> None:
         """Add to each compared value's uncertainty the scatter of ``SENSITIVITY_REPLAYS``
         replays at ``x`` that follow the logged speed with fresh noise of its own size
@@ -340,6 +355,7 @@ class FitResult:
     seconds: float
     warnings: tuple[str, ...]
     stages: dict[str, tuple[int, float]]   # replays run and seconds taken, by stage
+    cycles: tuple[np.ndarray | None, ...] = ()   # per start-up: Evaluator.replayed_cycles
 
 
 def fit(evaluator: Evaluator, seed: int = 0) -> FitResult:
@@ -423,7 +439,8 @@ def fit(evaluator: Evaluator, seed: int = 0) -> FitResult:
     return FitResult(tuple(params), best.x, x_of(bands.low), x_of(bands.high),
                      bands.correlation, before.misfit, best.misfit, count[0],
                      evaluator.computed, evaluator.reused,
-                     time.perf_counter() - evaluator.started, tuple(warnings), stages)
+                     time.perf_counter() - evaluator.started, tuple(warnings), stages,
+                     tuple(evaluator.replayed_cycles(best.x)))
 
 
 def _bracket(u: np.ndarray) -> list[np.ndarray]:

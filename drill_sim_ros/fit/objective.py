@@ -161,6 +161,16 @@ class Target:
                                                     self.cutoff_hz), self.log.sample_s))
         return np.concatenate(out)
 
+    def cycle_of(self, raw: np.ndarray) -> np.ndarray | None:
+        """The torque's cycle (period s, mean and standard deviation N m) in a vector of
+        :meth:`raw` (or :attr:`logged`); None when the cycle is not compared."""
+        part = self.torque
+        if not part.used.size:
+            return None
+        features = np.asarray(raw)[part.transient.size:part.transient.size + part.used.size]
+        return np.array([features[list(part.used).index(FEATURES.index(name))]
+                         for name in FEATURES[:3]])
+
     @property
     def logged(self) -> np.ndarray:
         """The logged counterpart of :meth:`raw`."""
