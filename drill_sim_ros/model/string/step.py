@@ -131,27 +131,28 @@ def _distributed_ends(wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray, 
 
 
 @njit(cache=True, inline="always")
-def junction_speed(wave_f: np.ndarray, j: int, a_in: float, b_in: float,
-                   pair: int) -> tuple[float, float, float]:
+def junction_speed(wave_f: np.ndarray, j: int, a_in: float, b_in: float, u: float,
+                   o: float) -> tuple[float, float, float]:
     """The speed of the junction below part ``j``, from the waves arriving at it (``a_in``
     from above, ``b_in`` from below): continuous across it, with the torques balanced on
     its elements, the point damper D (torque D w) and the wall's friction F:
     (a_in - Z_j w) - (b_in + Z_j+1 w) = D w + F. Without wall contact (W_FS 0) that is
     w = (a_in - b_in) / (Z_j + Z_j+1 + D), the lossless scattering and its damper. The
     junction takes w (a_in - b_in - (Z_j + Z_j+1) w) = D w^2 + F w of the waves' energy
-    each step. Returns (w, the wall's power F w, the damper's D w^2)."""
+    each step. ``u``, ``o``: the wall contact's slips, this line's last step and the other
+    line's (:func:`slips_last_step`). Returns (w, the wall's power F w, the damper's D w^2)."""
     if wave_f[W_FS, j] == 0.0:
         w = (a_in - b_in) / wave_f[W_ZJ, j]
         return w, 0.0, wave_f[W_D, j] * w * w
-    return wall_junction(wave_f, j, a_in - b_in, pair)
+    return wall_junction(wave_f, j, a_in - b_in, u, o)
 
 
 @njit(cache=True, inline="always")
-def wall_junction(wave_f: np.ndarray, j: int, push: float,
-                  pair: int) -> tuple[float, float, float]:
+def wall_junction(wave_f: np.ndarray, j: int, push: float, u: float,
+                  o: float) -> tuple[float, float, float]:
     """:func:`junction_speed` with the wall's Coulomb friction (model.well), implicit in the
-    new speed w, with Z = Z_j + Z_j+1 + D. The contact (:func:`wall_slips`, from the last
-    slips of this junction and the other line's ``pair``):
+    new speed w, with Z = Z_j + Z_j+1 + D. The contact (:func:`slides`, from the slip
+    ``u`` of this junction last step and ``o`` of the other line's beside it):
 
     * within the stick band, or sliding with the other line still: set-valued, as the bit's
       stick (eq. 32): held still while the unbalanced torque ``push`` = a_in - b_in is
@@ -166,7 +167,6 @@ def wall_junction(wave_f: np.ndarray, j: int, push: float,
       c w^2 = k w push / (Z r + k).
 
     Keeps the slip for the band; returns (w, the friction power, the damper's D w^2)."""
-    u, o = wave_f[W_LAST, j], wave_f[W_LAST, pair]     # the slips last step (wall_slips)
     sliding = slides(wave_f, j, u, o)
     z = wave_f[W_ZJ, j]
     if sliding and o > 0.0:
@@ -234,22 +234,31 @@ def scatter(wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray, lo: int, h
     as unsigned integers, np.uint64, so numba leaves out its test for a negative index,
     Python's wrap-around: a sixth of the walled string's step, measured. Summing each
     junction's power in its own row, a load and a store of two rows at every junction, cost
-    the walled string's step a few percent; testing the two powers apart (``or``), more.)"""
+    the walled string's step a few percent; testing the two powers apart (``or``), more.
+    Each junction's slips, its own of the step before and the other line's (an index, then
+    the slip: two loads in a row), are read in the loop's turn before, for the next
+    junction: they open the law's longest chain of latencies (the slips, the root, the
+    division, the power's test), which bounds the sliding string's step, as many junctions
+    being in flight as the processor's window holds; read a turn ahead, the chain is
+    shorter by those loads: 8.5 to 7.6 us a wave step, the deviated preset turning steadily,
+    measured; the same numbers to the bit.)"""
     off, n, pos = wave_i[W_OFF, lo], wave_i[W_LEN, lo], wave_i[W_POS, lo]
     wave_i[W_POS, lo] = next_slot(pos, n)    # (a branch here costs NRT calls in the loop)
     a_slot, b_slot = np.uint64(off + pos), np.uint64(off + n + pos)
     a_in = wave[a_slot]                      # arriving at the bottom of part lo
     wave[a_slot] = a_top
     wall = damper = 0.0                      # the power the line's elements take
+    u_next, o_next = slips_last_step(wave_i, wave_f, lo)
     for j in range(lo, hi - 1):
+        u, o = u_next, o_next                # junction j's slips last step
         out_slot = b_slot                    # the b entering part j at its bottom
         off, n, pos = wave_i[W_OFF, j + 1], wave_i[W_LEN, j + 1], wave_i[W_POS, j + 1]
         if n > 1:
             wave_i[W_POS, j + 1] = next_slot(pos, n)
         a_slot, b_slot = np.uint64(off + pos), np.uint64(off + n + pos)
         b_in = wave[b_slot]                  # arriving at the top of part j + 1
-        w, wall_power, damper_power = junction_speed(wave_f, j, a_in, b_in,
-                                                     np.uint64(wave_i[W_PAIR, j]))
+        u_next, o_next = slips_last_step(wave_i, wave_f, j + 1)
+        w, wall_power, damper_power = junction_speed(wave_f, j, a_in, b_in, u, o)
         wall += wall_power
         damper += damper_power
         if min(wall_power, damper_power) < 0.0:      # an element gave energy: a bug
@@ -262,6 +271,15 @@ def scatter(wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray, lo: int, h
     wave[b_slot] = b_bottom
     wave_f[W_WORK, lo] += wall
     wave_f[W_DAMP, lo] += damper
+
+
+@njit(cache=True, inline="always")
+def slips_last_step(wave_i: np.ndarray, wave_f: np.ndarray, j: int) -> tuple[float, float]:
+    """The surface slip of junction ``j`` last step and that of the other line's junction
+    beside it (W_PAIR) as it stands (the torsional line steps first, so the axial one reads
+    its new slips; a line's step never writes the other line's), :func:`wall_slips`. Read
+    for every part: the bottom part's (no junction below) are read and not used."""
+    return wave_f[W_LAST, j], wave_f[W_LAST, np.uint64(wave_i[W_PAIR, j])]
 
 
 @njit(cache=True, inline="always")
