@@ -12,10 +12,12 @@ import numpy as np
 from numba import njit
 
 # rows of the integer and float layout arrays of the delay lines
-# int64 (W_INT_ROWS, parts): steps, buffer offset, slot, and the other line's part whose
-# junction lies nearest in depth to this part's (the two motions of one wall contact)
-W_LEN, W_OFF, W_POS, W_PAIR = 0, 1, 2, 3
-W_INT_ROWS = 4
+# int64 (W_INT_ROWS, parts): steps, buffer offset, slot, the other line's part whose
+# junction lies nearest in depth to this part's (the two motions of one wall contact), and
+# the first part past this part's run of parts of its impedance in its line (the parts'
+# slots follow each other: .readings.line_energy sums a run at once)
+W_LEN, W_OFF, W_POS, W_PAIR, W_RUN = 0, 1, 2, 3, 4
+W_INT_ROWS = 5
 # float64 (W_ROWS, segments), per part, of the junction below it: impedance, point damper,
 # the wall's static and dynamic friction limits (0: no wall contact), the stick band, the
 # surface slip (m / t*) per unit of the line's speed (r_o; L*); three rows worked out from
