@@ -20,6 +20,7 @@ from drill_sim_ros.model.string.spec import (
     line_properties,
 )
 from drill_sim_ros.model.string.step import (
+    W_2Z,
     W_BAND2,
     W_D,
     W_FD,
@@ -260,8 +261,8 @@ def junction_rows(wave_f: np.ndarray, counts: tuple[int, ...]) -> None:
     """The rows of ``wave_f`` the step reads instead of working them out at every junction
     every step, from the others, in place: W_ZJ = Z_j + Z_j+1 + D_j (within each line of
     ``counts`` parts; a line's bottom part has no junction below, 0), W_BAND2 =
-    (W_VS W_SLIP)^2 and W_KD = W_FD W_SLIP, with the step's operations in its order, so
-    the same numbers to the bit."""
+    (W_VS W_SLIP)^2, W_KD = W_FD W_SLIP and W_2Z = 2 W_Z, with the step's operations in its
+    order, so the same numbers to the bit."""
     wave_f[W_ZJ] = 0.0
     lo = 0
     for n in counts:
@@ -272,6 +273,7 @@ def junction_rows(wave_f: np.ndarray, counts: tuple[int, ...]) -> None:
     band = wave_f[W_VS] * wave_f[W_SLIP]
     wave_f[W_BAND2] = band * band
     wave_f[W_KD] = wave_f[W_FD] * wave_f[W_SLIP]
+    wave_f[W_2Z] = 2.0 * wave_f[W_Z]
 
 
 def steady_friction(wave_f: np.ndarray, j: int, pair: int, speed: float,

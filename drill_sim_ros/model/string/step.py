@@ -20,22 +20,23 @@ W_LEN, W_OFF, W_POS, W_PAIR, W_RUN = 0, 1, 2, 3, 4
 W_INT_ROWS = 5
 # float64 (W_ROWS, segments), per part, of the junction below it: impedance, point damper,
 # the wall's static and dynamic friction limits (0: no wall contact), the stick band, the
-# surface slip (m / t*) per unit of the line's speed (r_o; L*); three rows worked out from
+# surface slip (m / t*) per unit of the line's speed (r_o; L*); four rows worked out from
 # those once (.lines.junction_rows) instead of at every junction every step: the
-# junction's impedance Z_j + Z_j+1 + D, the stick band's slip squared (W_VS W_SLIP)^2 and
-# the dynamic limit times the slip, F_d s; and rows of state: the junction's surface slip
-# last step, |w| r_o (the stick band's memory, kept as the slip: each junction's is read
-# twice a step, by itself and by the other line's junction beside it); in the line's
-# first part only, the power the walls' friction and the point dampers' D w^2 took, summed
-# over the line's junctions and the steps (x dtau: the work they took), and the power
-# that entered the line at its top; in its last part only, the power that left it at its
-# bottom (the bit), summed so: the energy balance the guard checks (.balance); and per
-# junction, the wall's and the damper's power summed over the steps in which it was below
-# zero (the energy it gave the string; 0 for any physical element: the guard names it)
+# junction's impedance Z_j + Z_j+1 + D, the stick band's slip squared (W_VS W_SLIP)^2, the
+# dynamic limit times the slip, F_d s, and the part's 2 Z; and rows of state: the
+# junction's surface slip last step, |w| r_o (the stick band's memory, kept as the slip:
+# each junction's is read twice a step, by itself and by the other line's junction beside
+# it); in the line's first part only, the power the walls' friction and the point dampers'
+# D w^2 took, summed over the line's junctions and the steps (x dtau: the work they took),
+# and the power that entered the line at its top; in its last part only, the power that
+# left it at its bottom (the bit), summed so: the energy balance the guard checks
+# (.balance); and per junction, the wall's and the damper's power summed over the steps in
+# which it was below zero (the energy it gave the string; 0 for any physical element: the
+# guard names it)
 W_Z, W_D, W_FS, W_FD, W_VS, W_SLIP = 0, 1, 2, 3, 4, 5
-W_ZJ, W_BAND2, W_KD = 6, 7, 8
-W_LAST, W_WORK, W_DAMP, W_TOP, W_BIT, W_WALL_GAVE, W_DAMP_GAVE = 9, 10, 11, 12, 13, 14, 15
-W_ROWS = 16
+W_ZJ, W_BAND2, W_KD, W_2Z = 6, 7, 8, 9
+W_LAST, W_WORK, W_DAMP, W_TOP, W_BIT, W_WALL_GAVE, W_DAMP_GAVE = 10, 11, 12, 13, 14, 15, 16
+W_ROWS = 17
 
 
 @njit(cache=True, inline="always")
@@ -266,9 +267,9 @@ def scatter(wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray, lo: int, h
         if min(wall_power, damper_power) < 0.0:      # an element gave energy: a bug
             wave_f[W_WALL_GAVE, j] += min(wall_power, 0.0)
             wave_f[W_DAMP_GAVE, j] += min(damper_power, 0.0)
-        wave[out_slot] = a_in - 2.0 * wave_f[W_Z, j] * w
+        wave[out_slot] = a_in - wave_f[W_2Z, j] * w
         a_next = wave[a_slot]
-        wave[a_slot] = b_in + 2.0 * wave_f[W_Z, j + 1] * w
+        wave[a_slot] = b_in + wave_f[W_2Z, j + 1] * w
         a_in = a_next
     wave[b_slot] = b_bottom
     wave_f[W_WORK, lo] += wall
