@@ -12,10 +12,14 @@ wave step at every junction):
   ``run_in_process``), CPU us per control period: the whole period, the session's period
   (``Bench.step``), and the controller with its measurement; the kernel's share is the
   wave steps per period times the first figure.
+With ``--drilling``: instead of the scenario's own start, its preset drilling from a steady
+start under soft_torque, enabled from t = 0 (``benchmarks/bench_closed_loop.py``'s case, which
+times it by the wall clock only): on the deviated preset every junction slides from the
+first step.
 Before/after a change: run it on both checkouts back to back (PYTHONPATH, and a fresh
 NUMBA_CACHE_DIR for a changed model file), several times, and compare best and median.
 Usage: .venv/bin/python benchmarks/bench_walled_step.py [--scenario deviated_startup]
-           [--seconds 5] [--repeats 5]
+           [--seconds 5] [--repeats 5] [--drilling]
 """
 
 from __future__ import annotations
@@ -73,19 +77,25 @@ def main() -> None:
     parser.add_argument("--scenario", default="deviated_startup")
     parser.add_argument("--seconds", type=float, default=5.0)
     parser.add_argument("--repeats", type=int, default=5)
+    parser.add_argument("--drilling", action="store_true",
+                        help="the preset drilling from a steady start (bench_closed_loop.py)")
     args = parser.parse_args()
     scenario = load_scenario(scenario_path(args.scenario)).with_(duration_s=args.seconds)
+    if args.drilling:
+        scenario = Scenario(preset=scenario.preset, controller="soft_torque",
+                            duration_s=args.seconds, enable_at_s=0.0)
     run_in_process(scenario.with_(duration_s=0.2))                 # compile, warm up
     bench = Bench(scenario)
     substeps = bench.preset.kernel_string.substeps
     wave_steps = round(bench.session.steps / substeps)
-    print(f"{args.scenario} ({bench.preset.name}): parts {bench.session.sim.string_arrays()[3]}"
+    name = f"{scenario.preset} drilling" if args.drilling else args.scenario
+    print(f"{name} ({bench.preset.name}): parts {bench.session.sim.string_arrays()[3]}"
           f", {substeps} bit steps a wave step, {wave_steps} wave steps a period")
     session_k = [kernel_us_per_wave_step(Bench(scenario).session.sim, substeps)
                  for _ in range(args.repeats)]
     steady_k = [kernel_us_per_wave_step(preset_simulator(scenario), substeps)
                 for _ in range(args.repeats)]
-    print(f"kernel, us per wave step: the session's from the start {spread(session_k)}; "
+    print(f"kernel, us per wave step: the session's from its start {spread(session_k)}; "
           f"the preset's, turning steadily {spread(steady_k)}")
     loops = [loop_us_per_period(scenario) for _ in range(args.repeats)]
     whole = [x[0] for x in loops]

@@ -1,11 +1,12 @@
-"""Telemetry fingerprints: a short hash of each of 40 runs, to diff before and after a refactor.
+"""Telemetry fingerprints: a short hash of each of 47 runs, to diff before and after a refactor.
 
-Every scenario with the three reference controllers (25 s), torque mode on both strings, the
-session on five presets with its string profiles, the exact delay, the string hung off
-bottom. A refactor that keeps the telemetry bit for bit prints the same lines. Prints only;
-no expected values are kept (they are what the code before the change prints). Clear the
-numba cache first (``rm -rf .cache/numba``): a cached kernel does not notice a change in an
-inlined function of another file.
+Every vertical scenario with the three reference controllers (25 s), torque mode on both
+strings, the deviated scenarios and the deviated preset drilling (walled strings, soft_torque),
+the session on seven presets with its string profiles, the exact delay, the string hung off
+bottom, the walled presets turning steadily. A refactor that keeps the telemetry bit for bit
+prints the same lines. Prints only; no expected values are kept (they are what the code
+before the change prints). Use a fresh NUMBA_CACHE_DIR (or clear it): a cached kernel does
+not notice a change in an inlined function of another file.
 
 Usage: .venv/bin/python benchmarks/telemetry_fingerprint.py > before.txt  (then after, diff)
 """
@@ -21,6 +22,16 @@ from drill_sim_ros.control.scenario import Scenario, load_scenario, scenario_pat
 from drill_sim_ros.model.presets import load_preset
 from drill_sim_ros.model.session import SessionConfig, SimSession
 from drill_sim_ros.model.simulator import SimConfig, Simulator
+from drill_sim_ros.model.string import (
+    W_BIT,
+    W_DAMP,
+    W_DAMP_GAVE,
+    W_LAST,
+    W_POS,
+    W_TOP,
+    W_WALL_GAVE,
+    W_WORK,
+)
 
 
 def h(a) -> str:
@@ -41,13 +52,33 @@ def bench_cases():
     yield "lumped/torque_mode", lumped.with_(controller="z_torque", mode="torque")
     dist = Scenario(duration_s=20.0, enable_at_s=5.0)
     yield "dist/torque_mode", dist.with_(controller="z_torque", mode="torque")
+    for name in ("deviated_startup", "deviated_tag_bottom"):     # walled strings
+        yield f"{name}/soft_torque", load_scenario(scenario_path(name)).with_(
+            controller="soft_torque", duration_s=25.0)
+    yield "deviated_drilling/soft_torque", Scenario(           # bench_closed_loop's case
+        preset="field_8p5in_deviated", controller="soft_torque", duration_s=20.0,
+        enable_at_s=0.0)
+
+
+def walled_steady(preset: str) -> str:
+    """The walled preset's own simulator turning steadily (every junction sliding), 3000 wave
+    steps: its state, its waves and the layout's rows of state (the slots, the junctions'
+    slips and the guard's sums), by name: a refactor may add rows of constants."""
+    p = load_preset(preset)
+    sim = Simulator(p.params, SimConfig(dtau=p.dtau), top_drive=p.top_drive, scales=p.scales,
+                    string=p.kernel_string, bit_law=p.bit_law)
+    sim.advance(3000 * p.kernel_string.substeps, 0)
+    wave, wave_i, wave_f, _ = sim.string_arrays()
+    state_rows = [W_LAST, W_WORK, W_DAMP, W_TOP, W_BIT, W_WALL_GAVE, W_DAMP_GAVE]
+    return " ".join(h(x) for x in (sim.state, wave, wave_i[W_POS], wave_f[state_rows]))
 
 
 def main() -> None:
     for name, sc in bench_cases():
         run = run_in_process(sc)
         print(name, h(run.rows), h(run.accumulators), run.clamped_commands, flush=True)
-    for preset in ("fig5_8a", "fig9", "fig12", "field_8p5in_shale_lumped", "field_8p5in_shale"):
+    for preset in ("fig5_8a", "fig9", "fig12", "field_8p5in_shale_lumped", "field_8p5in_shale",
+                   "field_8p5in_deviated", "field_8p5in_build_turn"):
         p = load_preset(preset)
         s = SimSession(SessionConfig(preset=p, string_rate_hz=10.0))
         blocks = [s.run(200) for _ in range(3)]
@@ -72,6 +103,8 @@ def main() -> None:
     sim.hang_off_bottom()
     out = sim.advance(5000, every=10)
     print("hang", h(sim.state), h(sim.string_profile()[0]), flush=True)
+    for preset in ("field_8p5in_deviated", "field_8p5in_build_turn"):
+        print("steady", preset, walled_steady(preset), flush=True)
 
 
 if __name__ == "__main__":

@@ -20,6 +20,7 @@ from drill_sim_ros.model.string.spec import (
     line_properties,
 )
 from drill_sim_ros.model.string.step import (
+    W_2Z,
     W_BAND2,
     W_D,
     W_FD,
@@ -31,6 +32,7 @@ from drill_sim_ros.model.string.step import (
     W_OFF,
     W_PAIR,
     W_ROWS,
+    W_RUN,
     W_SLIP,
     W_VS,
     W_Z,
@@ -222,8 +224,9 @@ def build_lines(lines: tuple[WaveLine, ...], dtau: float
                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, tuple[int, ...]]:
     """The layout of the delay lines of ``lines`` (torsional first): ``(wave_i, wave_f,
     wave, counts)`` with ``wave_i`` int64 (W_INT_ROWS, parts) rows W_LEN, W_OFF, W_POS,
-    W_PAIR (:func:`junction_pairs`), ``wave_f`` float64 (W_ROWS, parts) rows W_Z .. W_BIT
-    (:func:`junction_rows`; the state rows zero), an empty buffer, and the parts per line."""
+    W_PAIR (:func:`junction_pairs`), W_RUN (:func:`impedance_runs`), ``wave_f`` float64
+    (W_ROWS, parts) rows W_Z .. W_BIT (:func:`junction_rows`; the state rows zero), an empty
+    buffer, and the parts per line."""
     lens = np.concatenate([line_steps(line, dtau) for line in lines])
     wave_i = np.zeros((W_INT_ROWS, lens.size), dtype=np.int64)
     wave_i[W_LEN] = lens
@@ -235,16 +238,31 @@ def build_lines(lines: tuple[WaveLine, ...], dtau: float
                       (W_SLIP, "slip_per_speed")):
         wave_f[row] = np.concatenate([_rows(line, name) for line in lines])
     counts = tuple(len(x.travel_tau) for x in lines)
+    wave_i[W_RUN] = impedance_runs(wave_f[W_Z], counts)
     junction_rows(wave_f, counts)
     return wave_i, wave_f, np.zeros(int(2 * lens.sum())), counts
+
+
+def impedance_runs(impedance: np.ndarray, counts: tuple[int, ...]) -> np.ndarray:
+    """For every part of the lines of ``counts`` parts, the first part past its run of
+    parts of equal ``impedance`` in its line (the line's end after its last run)."""
+    out = np.empty(impedance.size, dtype=np.int64)
+    lo = 0
+    for n in counts:
+        hi = lo + n
+        starts = lo + 1 + np.flatnonzero(impedance[lo + 1:hi] != impedance[lo:hi - 1])
+        ends = np.append(starts, hi)
+        out[lo:hi] = ends[np.searchsorted(starts, np.arange(lo, hi), side="right")]
+        lo = hi
+    return out
 
 
 def junction_rows(wave_f: np.ndarray, counts: tuple[int, ...]) -> None:
     """The rows of ``wave_f`` the step reads instead of working them out at every junction
     every step, from the others, in place: W_ZJ = Z_j + Z_j+1 + D_j (within each line of
     ``counts`` parts; a line's bottom part has no junction below, 0), W_BAND2 =
-    (W_VS W_SLIP)^2 and W_KD = W_FD W_SLIP, with the step's operations in its order, so
-    the same numbers to the bit."""
+    (W_VS W_SLIP)^2, W_KD = W_FD W_SLIP and W_2Z = 2 W_Z, with the step's operations in its
+    order, so the same numbers to the bit."""
     wave_f[W_ZJ] = 0.0
     lo = 0
     for n in counts:
@@ -255,6 +273,7 @@ def junction_rows(wave_f: np.ndarray, counts: tuple[int, ...]) -> None:
     band = wave_f[W_VS] * wave_f[W_SLIP]
     wave_f[W_BAND2] = band * band
     wave_f[W_KD] = wave_f[W_FD] * wave_f[W_SLIP]
+    wave_f[W_2Z] = 2.0 * wave_f[W_Z]
 
 
 def steady_friction(wave_f: np.ndarray, j: int, pair: int, speed: float,

@@ -12,28 +12,31 @@ import numpy as np
 from numba import njit
 
 # rows of the integer and float layout arrays of the delay lines
-# int64 (W_INT_ROWS, parts): steps, buffer offset, slot, and the other line's part whose
-# junction lies nearest in depth to this part's (the two motions of one wall contact)
-W_LEN, W_OFF, W_POS, W_PAIR = 0, 1, 2, 3
-W_INT_ROWS = 4
+# int64 (W_INT_ROWS, parts): steps, buffer offset, slot, the other line's part whose
+# junction lies nearest in depth to this part's (the two motions of one wall contact), and
+# the first part past this part's run of parts of its impedance in its line (the parts'
+# slots follow each other: .readings.line_energy sums a run at once)
+W_LEN, W_OFF, W_POS, W_PAIR, W_RUN = 0, 1, 2, 3, 4
+W_INT_ROWS = 5
 # float64 (W_ROWS, segments), per part, of the junction below it: impedance, point damper,
 # the wall's static and dynamic friction limits (0: no wall contact), the stick band, the
-# surface slip (m / t*) per unit of the line's speed (r_o; L*); three rows worked out from
+# surface slip (m / t*) per unit of the line's speed (r_o; L*); four rows worked out from
 # those once (.lines.junction_rows) instead of at every junction every step: the
-# junction's impedance Z_j + Z_j+1 + D, the stick band's slip squared (W_VS W_SLIP)^2 and
-# the dynamic limit times the slip, F_d s; and rows of state: the junction's surface slip
-# last step, |w| r_o (the stick band's memory, kept as the slip: each junction's is read
-# twice a step, by itself and by the other line's junction beside it); in the line's
-# first part only, the power the walls' friction and the point dampers' D w^2 took, summed
-# over the line's junctions and the steps (x dtau: the work they took), and the power
-# that entered the line at its top; in its last part only, the power that left it at its
-# bottom (the bit), summed so: the energy balance the guard checks (.balance); and per
-# junction, the wall's and the damper's power summed over the steps in which it was below
-# zero (the energy it gave the string; 0 for any physical element: the guard names it)
+# junction's impedance Z_j + Z_j+1 + D, the stick band's slip squared (W_VS W_SLIP)^2, the
+# dynamic limit times the slip, F_d s, and the part's 2 Z; and rows of state: the
+# junction's surface slip last step, |w| r_o (the stick band's memory, kept as the slip:
+# each junction's is read twice a step, by itself and by the other line's junction beside
+# it); in the line's first part only, the power the walls' friction and the point dampers'
+# D w^2 took, summed over the line's junctions and the steps (x dtau: the work they took),
+# and the power that entered the line at its top; in its last part only, the power that
+# left it at its bottom (the bit), summed so: the energy balance the guard checks
+# (.balance); and per junction, the wall's and the damper's power summed over the steps in
+# which it was below zero (the energy it gave the string; 0 for any physical element: the
+# guard names it)
 W_Z, W_D, W_FS, W_FD, W_VS, W_SLIP = 0, 1, 2, 3, 4, 5
-W_ZJ, W_BAND2, W_KD = 6, 7, 8
-W_LAST, W_WORK, W_DAMP, W_TOP, W_BIT, W_WALL_GAVE, W_DAMP_GAVE = 9, 10, 11, 12, 13, 14, 15
-W_ROWS = 16
+W_ZJ, W_BAND2, W_KD, W_2Z = 6, 7, 8, 9
+W_LAST, W_WORK, W_DAMP, W_TOP, W_BIT, W_WALL_GAVE, W_DAMP_GAVE = 10, 11, 12, 13, 14, 15, 16
+W_ROWS = 17
 
 
 @njit(cache=True, inline="always")
@@ -131,27 +134,28 @@ def _distributed_ends(wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray, 
 
 
 @njit(cache=True, inline="always")
-def junction_speed(wave_f: np.ndarray, j: int, a_in: float, b_in: float,
-                   pair: int) -> tuple[float, float, float]:
+def junction_speed(wave_f: np.ndarray, j: int, a_in: float, b_in: float, u: float,
+                   o: float) -> tuple[float, float, float]:
     """The speed of the junction below part ``j``, from the waves arriving at it (``a_in``
     from above, ``b_in`` from below): continuous across it, with the torques balanced on
     its elements, the point damper D (torque D w) and the wall's friction F:
     (a_in - Z_j w) - (b_in + Z_j+1 w) = D w + F. Without wall contact (W_FS 0) that is
     w = (a_in - b_in) / (Z_j + Z_j+1 + D), the lossless scattering and its damper. The
     junction takes w (a_in - b_in - (Z_j + Z_j+1) w) = D w^2 + F w of the waves' energy
-    each step. Returns (w, the wall's power F w, the damper's D w^2)."""
+    each step. ``u``, ``o``: the wall contact's slips, this line's last step and the other
+    line's (:func:`slips_last_step`). Returns (w, the wall's power F w, the damper's D w^2)."""
     if wave_f[W_FS, j] == 0.0:
         w = (a_in - b_in) / wave_f[W_ZJ, j]
         return w, 0.0, wave_f[W_D, j] * w * w
-    return wall_junction(wave_f, j, a_in - b_in, pair)
+    return wall_junction(wave_f, j, a_in - b_in, u, o)
 
 
 @njit(cache=True, inline="always")
-def wall_junction(wave_f: np.ndarray, j: int, push: float,
-                  pair: int) -> tuple[float, float, float]:
+def wall_junction(wave_f: np.ndarray, j: int, push: float, u: float,
+                  o: float) -> tuple[float, float, float]:
     """:func:`junction_speed` with the wall's Coulomb friction (model.well), implicit in the
-    new speed w, with Z = Z_j + Z_j+1 + D. The contact (:func:`wall_slips`, from the last
-    slips of this junction and the other line's ``pair``):
+    new speed w, with Z = Z_j + Z_j+1 + D. The contact (:func:`slides`, from the slip
+    ``u`` of this junction last step and ``o`` of the other line's beside it):
 
     * within the stick band, or sliding with the other line still: set-valued, as the bit's
       stick (eq. 32): held still while the unbalanced torque ``push`` = a_in - b_in is
@@ -166,7 +170,6 @@ def wall_junction(wave_f: np.ndarray, j: int, push: float,
       c w^2 = k w push / (Z r + k).
 
     Keeps the slip for the band; returns (w, the friction power, the damper's D w^2)."""
-    u, o = wave_f[W_LAST, j], wave_f[W_LAST, pair]     # the slips last step (wall_slips)
     sliding = slides(wave_f, j, u, o)
     z = wave_f[W_ZJ, j]
     if sliding and o > 0.0:
@@ -234,34 +237,52 @@ def scatter(wave: np.ndarray, wave_i: np.ndarray, wave_f: np.ndarray, lo: int, h
     as unsigned integers, np.uint64, so numba leaves out its test for a negative index,
     Python's wrap-around: a sixth of the walled string's step, measured. Summing each
     junction's power in its own row, a load and a store of two rows at every junction, cost
-    the walled string's step a few percent; testing the two powers apart (``or``), more.)"""
+    the walled string's step a few percent; testing the two powers apart (``or``), more.
+    Each junction's slips, its own of the step before and the other line's (an index, then
+    the slip: two loads in a row), are read in the loop's turn before, for the next
+    junction: they open the law's longest chain of latencies (the slips, the root, the
+    division, the power's test), which bounds the sliding string's step, as many junctions
+    being in flight as the processor's window holds; read a turn ahead, the chain is
+    shorter by those loads: 8.5 to 7.6 us a wave step, the deviated preset turning steadily,
+    measured; the same numbers to the bit.)"""
     off, n, pos = wave_i[W_OFF, lo], wave_i[W_LEN, lo], wave_i[W_POS, lo]
     wave_i[W_POS, lo] = next_slot(pos, n)    # (a branch here costs NRT calls in the loop)
     a_slot, b_slot = np.uint64(off + pos), np.uint64(off + n + pos)
     a_in = wave[a_slot]                      # arriving at the bottom of part lo
     wave[a_slot] = a_top
     wall = damper = 0.0                      # the power the line's elements take
+    u_next, o_next = slips_last_step(wave_i, wave_f, lo)
     for j in range(lo, hi - 1):
+        u, o = u_next, o_next                # junction j's slips last step
         out_slot = b_slot                    # the b entering part j at its bottom
         off, n, pos = wave_i[W_OFF, j + 1], wave_i[W_LEN, j + 1], wave_i[W_POS, j + 1]
         if n > 1:
             wave_i[W_POS, j + 1] = next_slot(pos, n)
         a_slot, b_slot = np.uint64(off + pos), np.uint64(off + n + pos)
         b_in = wave[b_slot]                  # arriving at the top of part j + 1
-        w, wall_power, damper_power = junction_speed(wave_f, j, a_in, b_in,
-                                                     np.uint64(wave_i[W_PAIR, j]))
+        u_next, o_next = slips_last_step(wave_i, wave_f, j + 1)
+        w, wall_power, damper_power = junction_speed(wave_f, j, a_in, b_in, u, o)
         wall += wall_power
         damper += damper_power
         if min(wall_power, damper_power) < 0.0:      # an element gave energy: a bug
             wave_f[W_WALL_GAVE, j] += min(wall_power, 0.0)
             wave_f[W_DAMP_GAVE, j] += min(damper_power, 0.0)
-        wave[out_slot] = a_in - 2.0 * wave_f[W_Z, j] * w
+        wave[out_slot] = a_in - wave_f[W_2Z, j] * w
         a_next = wave[a_slot]
-        wave[a_slot] = b_in + 2.0 * wave_f[W_Z, j + 1] * w
+        wave[a_slot] = b_in + wave_f[W_2Z, j + 1] * w
         a_in = a_next
     wave[b_slot] = b_bottom
     wave_f[W_WORK, lo] += wall
     wave_f[W_DAMP, lo] += damper
+
+
+@njit(cache=True, inline="always")
+def slips_last_step(wave_i: np.ndarray, wave_f: np.ndarray, j: int) -> tuple[float, float]:
+    """The surface slip of junction ``j`` last step and that of the other line's junction
+    beside it (W_PAIR) as it stands (the torsional line steps first, so the axial one reads
+    its new slips; a line's step never writes the other line's), :func:`wall_slips`. Read
+    for every part: the bottom part's (no junction below) are read and not used."""
+    return wave_f[W_LAST, j], wave_f[W_LAST, np.uint64(wave_i[W_PAIR, j])]
 
 
 @njit(cache=True, inline="always")
