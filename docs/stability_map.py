@@ -4,12 +4,12 @@ For each controller the closed-loop map of the default field preset over surface
 (``drill_sim map ... --t-end 180 --enable-at 60``; its statistics window is the map's
 default, the second half of the run, 90-180 s), and on the same grid the prediction of
 ``drill_sim stability`` (control/stability.py: the first mode's loop gain
-G = |r_bit| |r_top| |exp(-2 gamma L_pipe)|, grows when G > 1). A simulated point counts as
-stick-slip by the scorecard's rule as far as the map records it: stuck 10 % of the window
-or more, or a mean SSI of 1 or more. Printed: per controller the agreement share, and the
-points that disagree with their G, stick fraction and SSI, each run again through the
-bench for the scorecard's status (a stall, the bit held while the drive sits at its torque
-limit, is not the first mode's growth) and its shares at the torque limit and off bottom;
+G = |r_bit| |r_top| |exp(-2 gamma L_pipe)|, grows when G > 1). Every point of the map is run
+again through the bench (the same scenario, so the same run) for the scorecard's own status
+over the map's window: the prediction agrees where it predicts growth and the status is not
+``ok`` (stick-slip, or a stall: the bit held while the drive sits at its torque limit), or
+decay and ``ok``. Printed: per controller the agreement share, and the points that disagree
+with their G, stick fraction, SSI, status and shares at the torque limit and off bottom;
 where it stalls, the depth of cut the bit stuck at and the torque that holds it still
 (RGD07 eq. 30 at rest, :func:`static_torque_nm`). Then, at every point where a re-run
 stalled, --ensemble members per controller (member k: the bit's sigma l x (1 + k 1e-12),
@@ -21,8 +21,8 @@ The maps are run (by the command printed) into --maps unless their files are the
 
 Usage: .venv/bin/python docs/stability_map.py [--maps DIR] [--plot docs/img/stability_map.png]
        [--ensemble N]
-       (the three maps: about 5 min on 2 cores; the prediction: about 20 s; the re-runs:
-       about 3 min; the ensemble of 6 at the 4 stalled points: about 3 min on 2 cores)
+       (the three maps: about 5 min on 2 cores; the prediction: about 20 s; the 168 re-runs:
+       about 3 min on 2 cores; the ensemble of 6 at the 4 stalled points: about 3 min)
 """
 
 from __future__ import annotations
@@ -37,7 +37,6 @@ import numpy as np
 
 from drill_sim_ros.control import stability as st
 from drill_sim_ros.control.scenario import Scenario, seeded
-from drill_sim_ros.control.scorecard import SSI_OK, STICK_FRACTION_OK
 from drill_sim_ros.model.bit_rock import MODE_STUCK
 from drill_sim_ros.model.telemetry import TELEMETRY_INDEX
 
@@ -56,14 +55,23 @@ def map_command(controller: str, out: Path) -> list[str]:
             "--t-end", "180", "--out", str(out)]
 
 
-def simulated(path: Path) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(stick-slip?, stick fraction, SSI) on the (rpm, WOB) grid of a map file."""
+def stuck_share(path: Path) -> np.ndarray:
+    """The stick fraction on the (rpm, WOB) grid of a map file (the figure's colour)."""
     import xarray as xr
     with xr.open_dataset(path) as ds:
-        ds = ds.sel(surface_rpm=list(RPM), wob_n=list(WOB_N))
-        stuck = ds.stick_fraction.values
-        ssi = ds.ssi.values
-    return (stuck >= STICK_FRACTION_OK) | (ssi >= SSI_OK), stuck, ssi
+        return ds.sel(surface_rpm=list(RPM), wob_n=list(WOB_N)).stick_fraction.values
+
+
+def _point_card(job: tuple[str, float, float]) -> dict[str, object]:
+    return rerun(*job)
+
+
+def scored(controller: str) -> list[list[dict[str, object]]]:
+    """The scorecard of every map point of ``controller`` (rerun), indexed [rpm][WOB]."""
+    jobs = [(controller, float(r), float(w)) for r in RPM for w in WOB_N]
+    with ProcessPoolExecutor(WORKERS) as pool:
+        cards = list(pool.map(_point_card, jobs))
+    return [cards[i * len(WOB_N):(i + 1) * len(WOB_N)] for i in range(len(RPM))]
 
 
 def predicted(tops: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
@@ -120,31 +128,31 @@ def stall_text(card: dict[str, object]) -> str:
             f"{static_torque_nm(depth) / 1e3:.0f} kN m")
 
 
-def report(controller: str, gain: np.ndarray, sim: tuple[np.ndarray, ...]
+def report(controller: str, gain: np.ndarray, cards: list[list[dict[str, object]]]
            ) -> list[tuple[int, int]]:
-    """Agreement, then every disagreeing point with its re-run's status; the stalled
-    points' (rpm, WOB) grid indices."""
-    sticks, stuck, ssi = sim
-    agree = (gain > 1.0) == sticks
+    """Agreement, then every disagreeing point with its status; the stalled points' (rpm,
+    WOB) grid indices."""
+    status = np.array([[str(c["status"]) for c in row] for row in cards])
+    fails = status != "ok"
+    agree = (gain > 1.0) == fails
+    stalled = [(int(i), int(j)) for i, j in zip(*np.nonzero(status == "stalled"), strict=True)]
     print(f"\n{controller}: agreement {agree.sum()} of {agree.size} "
-          f"({agree.mean():.0%}); simulated stick-slip at {sticks.sum()}, "
-          f"predicted growth at {(gain > 1.0).sum()}")
-    print("| rpm | WOB kN | G | predicted | stuck | SSI | simulated | re-run: status, "
-          "at the torque limit, off bottom |")
-    print("|---|---|---|---|---|---|---|---|")
-    stalled = []
+          f"({agree.mean():.0%}); simulated stick-slip at {(status == 'stick-slip').sum()}, "
+          f"stalled at {len(stalled)}, predicted growth at {(gain > 1.0).sum()}")
+    print("| rpm | WOB kN | G | predicted | stuck | SSI | status, at the torque limit, "
+          "off bottom |")
+    print("|---|---|---|---|---|---|---|")
     for i, j in zip(*np.nonzero(~agree), strict=True):
-        card = rerun(controller, float(RPM[i]), float(WOB_N[j]))
-        if card["status"] == "stalled":
-            stalled.append((int(i), int(j)))
+        card = cards[i][j]
         print(f"| {RPM[i]} | {WOB_N[j] / 1e3:.0f} | {gain[i, j]:.2f} | "
-              f"{'grows' if gain[i, j] > 1 else 'decays'} | {stuck[i, j]:.2f} | "
-              f"{ssi[i, j]:.2f} | {'stick-slip' if sticks[i, j] else 'ok'} | "
-              f"{stall_text(card)}, {card['saturation_fraction']:.2f}, "
-              f"{card['off_bottom_fraction']:.2f} |")
+              f"{'grows' if gain[i, j] > 1 else 'decays'} | {card['stick_fraction']:.2f} | "
+              f"{card['ssi_mean'] or 0.0:.2f} | {stall_text(card)}, "
+              f"{card['saturation_fraction']:.2f}, {card['off_bottom_fraction']:.2f} |")
     kept = agree.size - len(stalled)
-    print(f"{controller}: without the {len(stalled)} stalled points: {agree.sum()} of {kept} "
-          f"({agree.sum() / kept:.0%})")
+    agree_kept = sum(bool(agree[i, j]) for i, j in np.ndindex(agree.shape)
+                     if status[i, j] != "stalled")
+    print(f"{controller}: without the {len(stalled)} stalled points: {agree_kept} of {kept} "
+          f"({agree_kept / kept:.0%})")
     return stalled
 
 
@@ -185,22 +193,23 @@ def stall_ensemble(points: list[tuple[int, int]], members: int) -> None:
               f"{static_torque_nm(max(depths)) / 1e3:.0f} kN m)")
 
 
-def plot(path: Path, gains: dict[str, np.ndarray], sims: dict[str, tuple[np.ndarray, ...]],
-         stalled: dict[str, list[tuple[int, int]]]) -> None:
-    """One panel per controller: the simulated stick fraction (colour; a ring: stick-slip
-    by the rule), the predicted G = 1 contour, the points where they disagree and, of
-    those, the ones whose re-run stalled (a square)."""
+def plot(path: Path, gains: dict[str, np.ndarray], stuck: dict[str, np.ndarray],
+         fails: dict[str, np.ndarray], stalled: dict[str, list[tuple[int, int]]]) -> None:
+    """One panel per controller: the simulated stick fraction (colour; a ring: the status
+    not ok), the predicted G = 1 contour, the points where they disagree and the ones that
+    stalled (a square)."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     fig, axes = plt.subplots(1, len(gains), figsize=(5.2 * len(gains), 4.4), sharey=True)
     x, y = np.array(RPM, float), np.array(WOB_N, float) / 1e3
     for ax, (name, gain) in zip(np.atleast_1d(axes), gains.items(), strict=True):
-        sticks, stuck, _ = sims[name]
-        mesh = ax.pcolormesh(x, y, stuck.T, shading="nearest", cmap="Reds", vmin=0, vmax=1)
+        sticks = fails[name]
+        mesh = ax.pcolormesh(x, y, stuck[name].T, shading="nearest", cmap="Reds", vmin=0,
+                             vmax=1)
         xx, yy = np.meshgrid(x, y, indexing="ij")
         ax.scatter(xx[sticks], yy[sticks], s=70, facecolors="none", edgecolors="k",
-                   label="simulated stick-slip")
+                   label="simulated: not ok")
         wrong = (gain > 1.0) != sticks
         ax.scatter(xx[wrong], yy[wrong], marker="x", s=60, c="tab:blue",
                    label="prediction disagrees")
@@ -208,7 +217,7 @@ def plot(path: Path, gains: dict[str, np.ndarray], sims: dict[str, tuple[np.ndar
         for i, j in stalled[name]:
             held[i, j] = True
         ax.scatter(xx[held], yy[held], marker="s", s=150, facecolors="none",
-                   edgecolors="tab:purple", linewidths=1.5, label="re-run stalled")
+                   edgecolors="tab:purple", linewidths=1.5, label="stalled")
         finite = np.minimum(gain, 10.0)       # a bit unstable by itself: G infinite
         levels = ax.contour(x, y, finite.T, levels=[1.0], colors="tab:blue", linewidths=2)
         ax.clabel(levels, fmt="G = 1", fontsize=8)
@@ -259,14 +268,14 @@ def main() -> int:
                         help="members per controller at each stalled point (0: none)")
     args = parser.parse_args()
     args.maps.mkdir(parents=True, exist_ok=True)
-    sims = {}
+    stuck = {}
     for c in st.CONTROLLERS:
         out = args.maps / f"map_{c}.nc"
         cmd = map_command(c, out)
         print("$ drill_sim " + " ".join(cmd[3:]))
         if not out.exists():
             subprocess.run(cmd, check=True)
-        sims[c] = simulated(out)
+        stuck[c] = stuck_share(out)
     tops = st.measure_tops(PRESET, list(st.CONTROLLERS))
     band = st.top_band_hz(st.checked_preset(PRESET))
     for c, r in tops.items():
@@ -277,13 +286,16 @@ def main() -> int:
     print(f"the bit unstable by itself (G infinite): {alone.sum()} points, at "
           + ", ".join(f"{RPM[i]} rpm {WOB_N[j] / 1e3:.0f} kN" for i, j in zip(*np.nonzero(alone),
                                                                      strict=True)))
-    stalled = {c: report(c, gains[c], sims[c]) for c in st.CONTROLLERS}
+    cards = {c: scored(c) for c in st.CONTROLLERS}
+    stalled = {c: report(c, gains[c], cards[c]) for c in st.CONTROLLERS}
+    fails = {c: np.array([[str(x["status"]) != "ok" for x in row] for row in cards[c]])
+             for c in st.CONTROLLERS}
     bit_check()
     points = sorted(set().union(*stalled.values()))
     if args.ensemble > 0 and points:
         stall_ensemble(points, args.ensemble)
     if args.plot is not None:
-        plot(args.plot, gains, sims, stalled)
+        plot(args.plot, gains, stuck, fails, stalled)
         print(f"wrote {args.plot}", file=sys.stderr)
     return 0
 
