@@ -318,7 +318,7 @@ def advance(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile: np.ndarra
             n_steps: int, every: int, exact: bool) -> tuple[int, int]:
     """Up to ``n_steps`` of bit law, drive and string (module doc). Returns (status, rows)."""
     return _steps(st, prm, tgt, profile, hist, meta, acc, out, wave, wave_i, wave_f, n_steps,
-                  every, exact, False)
+                  every, exact, np.bool_(False))     # not the literal: see advance_and_sample
 
 
 @njit(cache=True, error_model="numpy")
@@ -538,9 +538,12 @@ def advance_and_sample(st: np.ndarray, prm: np.ndarray, tgt: np.ndarray, profile
                                wave_f, n_steps, every, exact)
     if status != STATUS_OK or rows >= out.shape[0]:
         return status, rows
-    one = np.int64(1)               # not the literal 1: that would compile _steps twice
+    # not the literals 1 and True: each literal is a signature of its own, and _steps (the
+    # whole step loop) would compile twice, once for advance and once here (a cold cache:
+    # 7-12 s a string kind)
+    one = np.int64(1)
     _steps(st, prm, tgt, profile, hist, meta, acc, out[rows:rows + 1], wave, wave_i, wave_f,
-           one, one, exact, True)
+           one, one, exact, np.bool_(True))
     return status, rows + 1
 
 

@@ -62,12 +62,12 @@ def test_complex_top_reflection_of_the_speed_loop_is_the_formula() -> None:
     convention of model/bit_reflection.py)."""
     import numpy as np
 
-    from drill_sim_ros.control.reflection import complex_reflection_with
-    preset = st.checked_preset(FIELD)
+    from tests.control import native_reflection as nr
+    preset = st.checked_preset(nr.FIELD)
     drive = preset.top_drive.physical(preset.scales)
     z = preset.string.sections[0].torsional_impedance_nm_s
-    f = np.array([0.05, 0.2, 1.0, 3.0])
+    f = nr.STABILITY_F_HZ
     s = 2j * np.pi * f
     z_td = drive.inertia_kg_m2 * s + drive.kp_nm_s + drive.ki_nm / s
-    measured = complex_reflection_with(FIELD, "none", f, seconds=60.0)
+    measured = nr.native_reflection(f)          # 60 s, shared with tests/model/test_string.py
     assert np.max(np.abs(measured - (z_td - z) / (z_td + z))) < 0.03

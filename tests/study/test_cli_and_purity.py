@@ -8,8 +8,10 @@ from pathlib import Path
 
 import matplotlib.image as mpimg
 import numpy as np
+import pytest
 
 from drill_sim_ros.study import engine, store
+from tests.robust.helpers import run_cli
 from tests.study.helpers import drill_sim, small_spec
 
 
@@ -55,14 +57,16 @@ def test_controller_unknown_name(tmp_path: Path) -> None:
                               "--out", str(tmp_path / "m.nc")), "softer", "soft_torque")
 
 
-def test_map_plot_draws_regimes_and_variables(tmp_path: Path) -> None:
+def test_map_plot_draws_regimes_and_variables(tmp_path: Path,
+                                             capsys: pytest.CaptureFixture[str]) -> None:
+    """The two plots in this process (cli.main), the two errors as a user meets them."""
     out = tmp_path / "map.nc"
     with engine.connect(workers=1) as client:
         engine.run_map(small_spec(), out, client)
     for var in ("regime", "kappa"):
         png = tmp_path / f"{var}.png"
-        result = drill_sim("map-plot", str(out), "-o", str(png), "--var", var)
-        assert result.returncode == 0, result.stderr
+        rc, _, err = run_cli(capsys, "map-plot", str(out), "-o", str(png), "--var", var)
+        assert rc == 0, err
         image = mpimg.imread(png)
         assert image.shape[0] > 300 and image.shape[1] > 400
         assert len(np.unique(image.reshape(-1, image.shape[-1]), axis=0)) > 10

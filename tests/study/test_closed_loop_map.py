@@ -21,6 +21,7 @@ from drill_sim_ros.study import engine, regime, store
 from drill_sim_ros.study.closed_loop import scenario_for
 from drill_sim_ros.study.grid import Axis, Control, MapSpec, Numerics
 from drill_sim_ros.study.point import COLUMN, evaluate_point
+from tests.robust.helpers import run_cli
 from tests.study.helpers import drill_sim
 
 FIELD = load_preset("field_8p5in_shale_lumped")
@@ -39,10 +40,13 @@ def field_spec(controller: str, rpm: tuple[float, ...], wob_n: tuple[float, ...]
                    control=Control(controller, "speed", enable_at_s))
 
 
-def test_controlled_map_points_equal_drill_sim_closed_loop(tmp_path: Path) -> None:
+def test_controlled_map_points_equal_drill_sim_closed_loop(
+        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """A 2 x 2 soft_torque map (2 local workers, switch-on at 10 s, window from 10 s) against
     `drill_sim closed-loop --json` of each point's scenario (one setpoint: the point's rpm
-    and WOB): the scorecard's figures, exactly (both are the same deterministic bench)."""
+    and WOB): the scorecard's figures, exactly (both are the same deterministic bench). The
+    map runs as a process with its workers; the four closed-loop runs through cli.main in
+    this process (tests/test_closed_loop_cli.py runs the command as a process)."""
     end_s, on_s = 30.0, 10.0
     out = tmp_path / "map.nc"
     result = drill_sim("map", "--params", FIELD.name, "--vary", "surface_rpm=60,120",
@@ -61,9 +65,10 @@ def test_controlled_map_points_equal_drill_sim_closed_loop(tmp_path: Path) -> No
         path.write_text(yaml.safe_dump({
             "preset": FIELD.name, "duration_s": end_s, "controller": "soft_torque",
             "enable_at_s": on_s, "schedule": [dict(p) for p in scenario.schedule]}))
-        run = drill_sim("closed-loop", "--scenario", str(path), "--json", "--no-baseline")
-        assert run.returncode == 0, run.stderr
-        card = json.loads(run.stdout)["score"]
+        rc, stdout, stderr = run_cli(capsys, "closed-loop", "--scenario", str(path), "--json",
+                                     "--no-baseline")
+        assert rc == 0, stderr
+        card = json.loads(stdout)["score"]
         where = np.unravel_index(flat, spec.shape)
         for var, key in SAME_AS_CLOSED_LOOP.items():
             got, want = float(ds[var].values[where]), card[key]

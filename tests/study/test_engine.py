@@ -66,7 +66,6 @@ def dask_cluster(tmp_path: Path):
     finally:
         for proc in reversed(procs):
             proc.terminate()
-        for proc in procs:
             try:
                 proc.wait(timeout=30)
             except subprocess.TimeoutExpired:

@@ -14,6 +14,7 @@ from drill_sim_ros.model import analysis
 from drill_sim_ros.study import regime, store
 from drill_sim_ros.study.grid import Numerics
 from drill_sim_ros.study.point import COLUMN, evaluate_point, torsional_period
+from tests.robust.helpers import run_cli
 from tests.study.helpers import FIG8A, drill_sim, small_spec
 
 # map variable -> `drill_sim run --json` key
@@ -26,9 +27,13 @@ SAME_AS_RUN = {"kappa": "kappa", "eta": "eta", "mean_depth_of_cut": "mean_depth_
                "drilling_strength": "drilling_strength"}
 
 
-def test_map_points_equal_drill_sim_run(tmp_path: Path) -> None:
+def test_map_points_equal_drill_sim_run(tmp_path: Path,
+                                       capsys: pytest.CaptureFixture[str]) -> None:
     """`drill_sim map` (a local cluster, 2 workers) against `drill_sim run --json` per
-    point: the same numbers, exactly (both are deterministic runs of the same model)."""
+    point: the same numbers, exactly (both are deterministic runs of the same model). The
+    map runs as a user runs it (its own process and workers); the six runs run in this
+    process (cli.main: its argv and its stdout), which spares six interpreter and kernel
+    start-ups; tests/test_cli.py runs `drill_sim run` as a process."""
     spec = small_spec()
     out = tmp_path / "map.nc"
     result = drill_sim("map", "--n", "6", "--psi", "50", "--beta", "0.3", "--lam", "5",
@@ -41,11 +46,12 @@ def test_map_points_equal_drill_sim_run(tmp_path: Path) -> None:
     assert ds.attrs["package_version"] and ds["kappa"].attrs["units"] == "1"
     for flat in range(spec.size):
         p = spec.point(flat)
-        run = drill_sim("run", "--n", str(p.n), "--psi", repr(p.psi), "--beta", repr(p.beta),
-                        "--lam", repr(p.lam), "--w0", repr(p.w0), "--omega0", repr(p.omega0),
-                        "--tau-end", "60", "--average-from", "30", "--dtau", "1e-4", "--json")
-        assert run.returncode == 0, run.stderr
-        expected = json.loads(run.stdout)
+        rc, stdout, stderr = run_cli(
+            capsys, "run", "--n", str(p.n), "--psi", repr(p.psi), "--beta", repr(p.beta),
+            "--lam", repr(p.lam), "--w0", repr(p.w0), "--omega0", repr(p.omega0),
+            "--tau-end", "60", "--average-from", "30", "--dtau", "1e-4", "--json")
+        assert rc == 0, stderr
+        expected = json.loads(stdout)
         where = np.unravel_index(flat, spec.shape)
         for var, key in SAME_AS_RUN.items():
             got = float(ds[var].values[where])
