@@ -101,11 +101,11 @@ def main() -> None:
     for hz in (1.0 / wave_step_s, 100.0) if "1" in args.parts else ():
         own = run_startup(preset, rpm, ramp_s, 59.0, sample_hz=hz)
         replay = replay_speed(preset, own.t_s, own.drive_rpm / RPM_PER_RAD_S)
-        every = round(0.01 / float(np.median(np.diff(own.t_s))))
         print(f"1. its own drive speed at {hz:.0f} Hz replayed: the torque within "
               f"{np.max(np.abs(replay.surface_torque_nm - own.surface_torque_nm)):.3g} N m; "
               "cycle " + ", ".join(f"{n} {v:.4g}" for n, v in zip(
-                  NAMES, on_log(replay.surface_torque_nm[::every]), strict=True)), flush=True)
+                  NAMES, on_log(np.interp(run.t_s, own.t_s, replay.surface_torque_nm)),
+                  strict=True)), flush=True)
     rng = np.random.default_rng(args.seed)
     static = float(data["well"]["side_friction"]["static"])
     truth = np.array([on_log(run_startup(preset_from_dict(name, with_values(
