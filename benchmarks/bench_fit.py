@@ -17,8 +17,12 @@ std; and over the replays averaged at the fit and at the truth, each feature's m
 standard deviation and the logged one's z: docs/fit.md, the cycle is one draw of a branching
 threshold dynamics) and the wall time; then the coverage counts (issue 51: within 5 % and
 >= 17 of 20).
+Other start-ups: ``--preset`` (a name, a YAML path, or ``tangent``: the Well B-like mapping
+of tests/model/fv_cases.py, whose cycle does not branch: docs/fit.md), ``--rpm``,
+``--ramp-s`` (default field_8p5in_deviated, 30 rpm in 10 s).
 Usage: .venv/bin/python benchmarks/bench_fit.py [--seeds 1:20] [--workers 2]
        [--params a,b] [--start 0.8] [--substeps 54] [--dir /tmp/bench_fit]
+       [--preset field_8p5in_deviated] [--rpm 30] [--ramp-s 10]
 """
 
 from __future__ import annotations
@@ -38,6 +42,7 @@ from drill_sim_ros.model.analysis import lowpass
 from drill_sim_ros.model.presets import preset_from_dict, preset_path
 from drill_sim_ros.model.validate_input import read_preset_file
 from drill_sim_ros.study.engine import connect
+from tests.model import fv_cases
 
 PRESET = "field_8p5in_deviated"
 PARAMS = ("well.side_friction.static,well.side_friction.dynamic,"
@@ -45,10 +50,25 @@ PARAMS = ("well.side_friction.static,well.side_friction.dynamic,"
 START_SHARE = 0.8
 
 
-def one_log(seed: int, data: dict, names: str, client: object, share: float, cache: Path
-            ) -> dict:
-    truth_preset = preset_from_dict(PRESET, data)
-    log = synthetic.synthetic_log(truth_preset, 30.0, 10.0, 60.0,
+def preset_data(name: str) -> dict:
+    """The preset mapping: ``tangent`` from tests/model/fv_cases.py, else a name or path (a
+    survey file it names made absolute, for the fit's replays that build it without a
+    base directory)."""
+    if name == "tangent":
+        return fv_cases.tangent()
+    path = preset_path(name)
+    data = read_preset_file(path)
+    survey = (data.get("well") or {}).get("survey")
+    if isinstance(survey, str):
+        data["well"]["survey"] = str(path.parent / survey)
+    return data
+
+
+def one_log(seed: int, data: dict, names: str, client: object, share: float, cache: Path,
+            startup: tuple[str, float, float] = (PRESET, 30.0, 10.0)) -> dict:
+    name, rpm, ramp_s = startup
+    truth_preset = preset_from_dict(name, data)
+    log = synthetic.synthetic_log(truth_preset, rpm, ramp_s, 60.0,
                                   synthetic.scenario_sensors(seed))
     paths = names.split(",")
     truth = np.array([float(get_path(data, p)) for p in paths])
@@ -114,8 +134,12 @@ def main() -> None:
     ap.add_argument("--start", type=float, default=START_SHARE)
     ap.add_argument("--substeps", type=int, help="the preset's bit_substeps (wave step)")
     ap.add_argument("--dir", type=Path, default=Path("/tmp/bench_fit"))
+    ap.add_argument("--preset", default=PRESET,
+                    help="a preset name, a YAML path, or tangent (tests/model/fv_cases.py)")
+    ap.add_argument("--rpm", type=float, default=30.0)
+    ap.add_argument("--ramp-s", type=float, default=10.0)
     args = ap.parse_args()
-    data = read_preset_file(preset_path(PRESET))
+    data = preset_data(args.preset)
     if args.substeps:
         data["string"]["bit_substeps"] = args.substeps
     paths = args.params.split(",")
@@ -123,6 +147,9 @@ def main() -> None:
     args.dir.mkdir(parents=True, exist_ok=True)
     tag = (f"{len(paths)}p_{args.start:g}_{args.substeps or 'preset'}_r{engine.REPLAYS_PER_POINT}"
            "_profile")
+    startup = (args.preset, args.rpm, args.ramp_s)
+    if startup != (PRESET, 30.0, 10.0):
+        tag += f"_{Path(args.preset).stem}_{args.rpm:g}rpm_{args.ramp_s:g}s"
     done_path = args.dir / f"done_{tag}.jsonl"
     done = {}
     if done_path.exists():
@@ -137,7 +164,7 @@ def main() -> None:
                 r = done[seed]
             else:
                 r = one_log(seed, data, args.params, client, args.start,
-                            args.dir / f"cache_{tag}_{seed}.jsonl")
+                            args.dir / f"cache_{tag}_{seed}.jsonl", startup)
                 r["params"] = args.params
                 with done_path.open("a") as f:
                     f.write(json.dumps(r) + "\n")
