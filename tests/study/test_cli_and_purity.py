@@ -9,8 +9,10 @@ from pathlib import Path
 import matplotlib.image as mpimg
 import numpy as np
 import pytest
+from matplotlib.colors import to_rgb
 
 from drill_sim_ros.study import engine, store
+from drill_sim_ros.study.regime import REGIME_COLORS, REGIME_NAMES
 from tests.robust.helpers import run_cli
 from tests.study.helpers import drill_sim, small_spec
 
@@ -63,13 +65,30 @@ def test_map_plot_draws_regimes_and_variables(tmp_path: Path,
     out = tmp_path / "map.nc"
     with engine.connect(workers=1) as client:
         engine.run_map(small_spec(), out, client)
+    images = {}
     for var in ("regime", "kappa"):
         png = tmp_path / f"{var}.png"
         rc, _, err = run_cli(capsys, "map-plot", str(out), "-o", str(png), "--var", var)
         assert rc == 0, err
-        image = mpimg.imread(png)
-        assert image.shape[0] > 300 and image.shape[1] > 400
-        assert len(np.unique(image.reshape(-1, image.shape[-1]), axis=0)) > 10
+        images[var] = mpimg.imread(png)[..., :3]
+        assert images[var].shape[0] > 300 and images[var].shape[1] > 400
+    # Each regime the map holds fills its cells in its own colour (a cell is some 10^4
+    # pixels; the legend's patch some 10^2), and a regime it does not hold is not drawn.
+    codes = {int(c) for c in np.unique(store.load(out)["regime"].values)}
+    assert len(codes) >= 2, codes  # beta either side of 1 (RGD07 Fig. 8a)
+    for code, colour in enumerate(REGIME_COLORS):
+        pixels = np.all(np.abs(images["regime"] - to_rgb(colour)) < 1.5 / 255, axis=-1).sum()
+        assert (pixels > 5000) == (code in codes), (REGIME_NAMES[code], pixels)
+    # The colour map follows the variable: the same map with kappa constant draws otherwise.
+    flat = store.load(out)
+    flat["kappa"] = flat["kappa"] * 0.0 + float(flat["kappa"].mean())
+    store.save(flat, tmp_path / "flat.nc")
+    rc, _, err = run_cli(capsys, "map-plot", str(tmp_path / "flat.nc"), "-o",
+                         str(tmp_path / "flat.png"), "--var", "kappa")
+    assert rc == 0, err
+    changed = np.any(np.abs(mpimg.imread(tmp_path / "flat.png")[..., :3] - images["kappa"])
+                     > 0.1, axis=-1)
+    assert changed.mean() > 0.1, changed.mean()
     _one_line_error(drill_sim("map-plot", str(out), "--var", "nope"), "nope", "kappa")
     _one_line_error(drill_sim("map-plot", str(tmp_path / "missing.nc")), "missing.nc")
 
