@@ -22,7 +22,9 @@ of tests/model/fv_cases.py, whose cycle does not branch: docs/fit.md), ``--rpm``
 ``--ramp-s`` (default field_8p5in_deviated, 30 rpm in 10 s).
 Usage: .venv/bin/python benchmarks/bench_fit.py [--seeds 1:20] [--workers 2]
        [--params a,b] [--start 0.8] [--substeps 54] [--dir /tmp/bench_fit]
-       [--preset field_8p5in_deviated] [--rpm 30] [--ramp-s 10]
+       [--preset field_8p5in_deviated] [--rpm 30] [--ramp-s 10] [--markdown]
+(``--markdown``: each log as a row of docs/fit.md's coverage tables; run again with the same
+arguments, the finished logs are only read back.)
 """
 
 from __future__ import annotations
@@ -126,6 +128,16 @@ def show(r: dict) -> None:
                                                  rec, strict=True)), flush=True)
 
 
+def markdown_row(r: dict) -> str:
+    """One row of docs/fit.md's coverage tables (the first fitted parameter)."""
+    (rec, fit), (low, high) = r["cycle"], r["interval"][0]
+    return (f"| {r['seed']} | {100 * r['error'][0]:+.1f} % | {100 * low:+.1f} to "
+            f"{100 * high:+.1f} % | {'yes' if r['covers'][0] else 'no'} | "
+            f"{r['misfit'][0]:.3g} / {r['misfit'][1]:.3g} | {rec[0]:.2f}/{fit[0]:.2f} s, "
+            f"{rec[1]:.0f}/{fit[1]:.0f}, {rec[2]:.0f}/{fit[2]:.0f} N m | {r['replays']}, "
+            f"{r['seconds']:.0f} s |")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seeds", default="1:20", help="A:B, the logs' seeds (inclusive)")
@@ -138,6 +150,8 @@ def main() -> None:
                     help="a preset name, a YAML path, or tangent (tests/model/fv_cases.py)")
     ap.add_argument("--rpm", type=float, default=30.0)
     ap.add_argument("--ramp-s", type=float, default=10.0)
+    ap.add_argument("--markdown", action="store_true",
+                    help="print each log as a row of docs/fit.md's tables")
     args = ap.parse_args()
     data = preset_data(args.preset)
     if args.substeps:
@@ -169,7 +183,7 @@ def main() -> None:
                 with done_path.open("a") as f:
                     f.write(json.dumps(r) + "\n")
             rows.append(r)
-            show(r)
+            print(markdown_row(r), flush=True) if args.markdown else show(r)
     errors = np.array([r["error"] for r in rows])
     covers = np.array([r["covers"] for r in rows])
     for i, path in enumerate(paths):
