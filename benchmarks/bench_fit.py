@@ -41,8 +41,7 @@ import numpy as np
 from drill_sim_ros.fit import engine, objective, synthetic
 from drill_sim_ros.fit.params import get_path, parse_fit, with_values
 from drill_sim_ros.model.analysis import lowpass
-from drill_sim_ros.model.presets import preset_from_dict, preset_path
-from drill_sim_ros.model.validate_input import read_preset_file
+from drill_sim_ros.model.presets import preset_from_dict, preset_path, read_preset_data
 from drill_sim_ros.study.engine import connect
 from tests.model import fv_cases
 
@@ -58,12 +57,7 @@ def preset_data(name: str) -> dict:
     base directory)."""
     if name == "tangent":
         return fv_cases.tangent()
-    path = preset_path(name)
-    data = read_preset_file(path)
-    survey = (data.get("well") or {}).get("survey")
-    if isinstance(survey, str):
-        data["well"]["survey"] = str(path.parent / survey)
-    return data
+    return read_preset_data(preset_path(name))
 
 
 def one_log(seed: int, data: dict, names: str, client: object, share: float, cache: Path,

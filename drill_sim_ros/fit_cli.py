@@ -23,8 +23,7 @@ from drill_sim_ros.fit.log import TORQUE_KINDS, SurfaceLog, find_startups, read_
 from drill_sim_ros.fit.objective import Target, make_target
 from drill_sim_ros.fit.params import DEFAULT_BOUNDS, parse_fit, parse_span, with_values
 from drill_sim_ros.model.errors import DrillSimError
-from drill_sim_ros.model.presets import preset_from_dict, preset_path
-from drill_sim_ros.model.validate_input import read_preset_file
+from drill_sim_ros.model.presets import preset_from_dict, preset_path, read_preset_data
 from drill_sim_ros.plot_file import (
     add_plot_arguments,
     commit_output,
@@ -85,7 +84,7 @@ def cmd_fit(args: Any) -> int:
     if not low <= args.replays <= high:
         raise DrillSimError(f"--replays {args.replays}: must be within {low}..{high}")
     path = preset_path(args.params)
-    data = read_preset_file(path)
+    data = read_preset_data(path)
     preset = preset_from_dict(path.stem, data)
     params = parse_fit(args.fit, data)
     log = _window(read_log(args.log, args.torque), args.window)

@@ -64,9 +64,9 @@ from drill_sim_ros.model.presets import (
     load_preset,
     preset_from_dict,
     preset_path,
+    read_preset_data,
 )
 from drill_sim_ros.model.top_drive import limit_of_setting
-from drill_sim_ros.model.validate_input import read_preset_file
 from drill_sim_ros.model.yaml_input import load_yaml
 
 SCENARIO_KEYS = ("preset", "duration_s", "control_rate_hz", "mode", "controller", "params",
@@ -170,7 +170,7 @@ class Scenario:
         if not overrides:
             return load_preset(self.preset)
         path = preset_path(self.preset)
-        data = read_preset_file(path) or {}
+        data = read_preset_data(path) or {}
         for section, values in overrides.items():
             if not isinstance(data.get(section, {}), dict):
                 raise ParameterError(f"scenario: overrides.{section}: the preset's {section} "

@@ -359,6 +359,20 @@ def string_from_dict(values: Any, phys: PhysicalParams) -> StringSpec:
     return spec
 
 
+def read_preset_data(path: Path) -> dict[str, Any]:
+    """The mapping of the preset file ``path``, with the file it may name (a well's survey
+    CSV, relative to the preset's directory) made absolute: it then builds by
+    :func:`preset_from_dict` from any working directory, without ``base_dir`` (the fit's
+    replays and a scenario's overrides build it from the mapping)."""
+    data = read_preset_file(path)
+    well = data.get("well") if isinstance(data, dict) else None
+    survey = well.get("survey") if isinstance(well, dict) else None
+    if isinstance(survey, str) and survey:
+        named = Path(survey).expanduser()
+        well["survey"] = str(named if named.is_absolute() else path.parent / named)
+    return data
+
+
 def load_preset(name_or_path: Any = DEFAULT_PRESET) -> Preset:
     """Load a preset by name or path, its file read once; each error is one line naming the
     file and the bad key."""

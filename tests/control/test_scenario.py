@@ -88,3 +88,14 @@ def test_the_lumped_first_mode_scenario_ranks_the_controllers() -> None:
         assert card["status"] == "ok", name
         assert card["ssi_last"] <= 0.15, name
         assert card["saturation_fraction"] <= 0.05, name
+
+
+def test_overrides_of_a_preset_naming_a_survey_file_build_from_any_directory(
+        tmp_path, monkeypatch) -> None:
+    """The survey CSV is named relative to the preset's directory, not the working one."""
+    monkeypatch.chdir(tmp_path)
+    scenario = scenario_from_dict({"preset": "field_8p5in_build_turn",
+                                   "overrides": {"physical": {"surface_rpm": 45.0}}})
+    preset = scenario.load_preset()
+    assert preset.physical.surface_rpm == 45.0
+    assert len(preset.string.well.survey.md_m) > 2       # the CSV's stations

@@ -88,6 +88,18 @@ def test_a_log_without_a_start_up_is_refused(tmp_path, capsys) -> None:
     assert code == 2 and len(err) == 1 and "no start-up" in err[0]
 
 
+def test_a_preset_naming_a_survey_file_is_read_from_any_directory(tmp_path, capsys,
+                                                                    monkeypatch) -> None:
+    """Its survey CSV is found beside the preset (the log's error, not the survey's)."""
+    rows = [[0.01 * i, 30.0, 10.0] for i in range(500)]
+    path = _write(tmp_path / "steady.csv", "time_s,surface_rpm,torque_knm", rows)
+    monkeypatch.chdir(tmp_path)
+    code = cli.main(["fit", "--params", "field_8p5in_build_turn", "--log", path, "--fit",
+                     "well.side_friction.static", "--in-process"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and "no start-up" in err[0], err
+
+
 def test_start_ups_are_found_from_rest_to_turning() -> None:
     t = np.arange(0.0, 30.0, 0.01)
     rpm = np.where((t % 15.0) < 3.0, 0.0, np.minimum(30.0, 10.0 * ((t % 15.0) - 3.0)))
