@@ -79,14 +79,16 @@ def require_distributed(preset: Preset) -> None:
 
 
 def reflection_preset(preset: Preset) -> Preset:
-    """``preset`` with its string replaced by its top section twice over, undamped: a
-    uniform line in which a pulse from the bit meets only the top drive (the bottom is
-    made anechoic by :meth:`Simulator.hang_off_bottom`), so the waves that come back down
-    are the drive's reflection and nothing else. Scales, rock and drive are unchanged."""
+    """``preset`` with its string replaced by its top section twice over, undamped and
+    out of any well (no wall): a uniform line in which a pulse from the bit meets only the
+    top drive (the bottom is made anechoic by :meth:`Simulator.hang_off_bottom`), so the
+    waves that come back down are the drive's reflection and nothing else. Scales, rock
+    and drive are unchanged. (With the wall of a deviated preset left on, the line at rest
+    stuck to it and the "reflection" read 10^6-10^8.)"""
     require_distributed(preset)
     top = preset.string.undamped().sections[0]
     return replace(preset, string=replace(preset.string, sections=(top, top),
-                                          bit_inertia_kg_m2=0.0))
+                                          bit_inertia_kg_m2=0.0, well=None))
 
 
 def off_bottom_simulator(preset: Preset, drive: TopDrive, dtau: float | None = None,

@@ -71,3 +71,23 @@ def test_complex_top_reflection_of_the_speed_loop_is_the_formula() -> None:
     z_td = drive.inertia_kg_m2 * s + drive.kp_nm_s + drive.ki_nm / s
     measured = nr.native_reflection(f)          # 60 s, shared with tests/model/test_string.py
     assert np.max(np.abs(measured - (z_td - z) / (z_td + z))) < 0.03
+
+
+def test_the_top_reflection_of_a_walled_preset_is_its_drives_alone() -> None:
+    """A deviated preset: the instrument's line is a uniform anechoic line that meets only
+    the top drive, so the wall of the preset's well is not on it and the speed loop reflects
+    as the formula above. (With the wall left on, the line at rest stuck to it and |r|
+    read 10^6 to 10^8, and ``drill_sim stability`` called every controller's mode growing.)"""
+    import numpy as np
+
+    from drill_sim_ros.control.reflection import complex_reflection_with
+    name = "field_8p5in_deviated"
+    preset = st.checked_preset(name)
+    assert preset.string.well is not None and preset.string.well.has_friction
+    drive = preset.top_drive.physical(preset.scales)
+    z = preset.string.sections[0].torsional_impedance_nm_s
+    f = np.array([0.2, 1.0])
+    s = 2j * np.pi * f
+    z_td = drive.inertia_kg_m2 * s + drive.kp_nm_s + drive.ki_nm / s
+    measured = complex_reflection_with(name, "none", f, seconds=30.0, settle_s=10.0)
+    assert np.max(np.abs(measured - (z_td - z) / (z_td + z))) < 0.03
