@@ -48,7 +48,8 @@ def add_parsers(sub: Any) -> None:
 def cmd_modes(args: Any) -> int:
     if not 1 <= args.count <= 6:
         raise ParameterError(f"--count = {args.count} must be in [1, 6]")
-    modes = si.identify_modes(load_preset(args.params), count=args.count).as_dict()
+    preset = load_preset(args.params)
+    modes = si.identify_modes(preset, count=args.count).as_dict()
     out = {kind: {key: [rounded(v) for v in values] for key, values in d.items()}
            for kind, d in modes.items()}
     if not args.json:
@@ -57,8 +58,18 @@ def cmd_modes(args: Any) -> int:
         for kind in ("torsional", "axial"):
             for i in range(len(out[kind]["analytic_hz"])):
                 print(_modes_row(i, kind, out[kind]))
+        well = preset.string.well
+        if well is not None and well.has_friction:
+            print(WALL_NOTE)
     print(json.dumps(out))
     return 0
+
+
+WALL_NOTE = ("note: the string rings in its well, on the wall; the analytic columns are the "
+             "free string's. Turning, the wall's sliding friction lies along the slip and "
+             "damps axial motion as a viscous force mu_d N / (r_o omega) per metre "
+             "(docs/string.md, 'The wall's friction'), so axial rings may die too fast to "
+             "identify (n/a)")
 
 
 def rounded(value: float | None) -> float | None:
