@@ -207,6 +207,8 @@ def _tau_end(args: argparse.Namespace, scales: Scales, physical: bool) -> float:
     if args.t_end is not None:
         if not physical:
             raise DrillSimError("--t-end needs a physical preset (--params); use --tau-end")
+        if not (math.isfinite(args.t_end) and args.t_end > 0.0):
+            raise DrillSimError(f"--t-end = {args.t_end!r} must be a positive number of s")
         tau_end = args.t_end / scales.time_s
     else:
         tau_end = 600.0 if args.tau_end is None else args.tau_end

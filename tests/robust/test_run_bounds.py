@@ -19,6 +19,12 @@ def test_a_run_of_more_steps_than_the_bound_is_refused(capsys) -> None:
     assert out == ""
 
 
+def test_a_negative_t_end_is_named_as_typed(capsys) -> None:
+    rc, out, err = run_cli(capsys, "run", "--params", "field_8p5in_shale", "--t-end", "-3")
+    one_error_line(rc, err, "--t-end = -3.0", "positive")
+    assert out == ""
+
+
 def test_sweep_values_that_are_not_numbers_are_one_line(capsys) -> None:
     rc, _, err = run_cli(capsys, "sweep", "--vary", "beta", "--values", "a,b")
     one_error_line(rc, err, "--values 'a,b'", "START:STOP:COUNT")
