@@ -146,8 +146,10 @@ SPECS: tuple[ParamSpec, ...] = (
               "instability).", -1e3, 1e3, read_only=True, unit="1"),
     ParamSpec("model.submerged_string_weight_n", DOUBLE, submerged_string_weight_n,
               "Buoyed weight of drill pipe + BHA [N]; hook load = this - applied WOB. "
-              "Default: steel mass x g x (1 - 1200 kg/m3 mud / steel density); 0 for "
-              "dimensionless presets.", 0.0, 1e10),
+              "Default: steel mass x g x (1 - 1200 kg/m3 mud / steel density); in a "
+              "preset's well, the buoyed weight along the hole's axis in its own mud (what "
+              "the string hangs with when nothing drags); 0 for dimensionless presets.",
+              0.0, 1e10),
     ParamSpec("limits.max_surface_rpm", DOUBLE, defaults.MAX_SURFACE_RPM,
               "Surface-rpm commands above this [rev/min] are clamped to it.", 0.0, 1e4),
     ParamSpec("limits.max_wob_n", DOUBLE, _max_wob_n,
