@@ -71,6 +71,9 @@ def add_parser(sub: Any) -> None:
     add_plot_arguments(p, "the recorded and fitted surface speed and torque", "--out")
 
 
+PLAIN_PROGRESS_S = 30.0   # without a terminal, a progress line this often (a fit takes minutes)
+
+
 def _window(log: SurfaceLog, text: str | None) -> SurfaceLog:
     if text is None:
         return log
@@ -112,7 +115,7 @@ def cmd_fit(args: Any) -> int:
 
 def _run(args: Any, data: dict[str, Any], params: list, targets: list[Target],
          cache: Path | None) -> dict[str, Any]:
-    line = StatusLine()
+    line = StatusLine(every_s=PLAIN_PROGRESS_S)
     groups = [[t] for t in targets] if args.each else [targets]
     try:
         if args.in_process:

@@ -1,13 +1,16 @@
 """One live line on a terminal (status and progress lines of every command).
 
 The only writer to a stream in library code; silent unless the stream is a TTY (or
-``force``), so logs and pipes stay clean.
+``force``), so logs and pipes stay clean. A long command may ask for a plain line every
+``every_s`` seconds where there is no TTY (``drill_sim fit``: minutes of work), so a log of
+it still shows progress.
 """
 
 from __future__ import annotations
 
 import math
 import sys
+import time
 from typing import TextIO
 
 from drill_sim_ros.model.telemetry import MODE_NAMES, TELEMETRY_INDEX
@@ -16,14 +19,21 @@ from drill_sim_ros.model.telemetry import MODE_NAMES, TELEMETRY_INDEX
 class StatusLine:
     """Rewrites one line of ``stream`` (default stderr) in place."""
 
-    def __init__(self, stream: TextIO | None = None, force: bool = False) -> None:
+    def __init__(self, stream: TextIO | None = None, force: bool = False,
+                 every_s: float | None = None) -> None:
         self._stream = stream if stream is not None else sys.stderr
         self.active = force or bool(getattr(self._stream, "isatty", lambda: False)())
         self._shown = False
+        self._every_s = None if self.active else every_s
+        self._last_plain_s = time.monotonic()
 
     def show(self, text: str) -> None:
         if self.active:
             self._shown = self._write(f"\r{text}\x1b[K")
+        elif self._every_s is not None and \
+                time.monotonic() - self._last_plain_s >= self._every_s:
+            self._last_plain_s = time.monotonic()
+            self._write(f"{text}\n")
 
     def close(self) -> None:
         """End the line so later output starts on a fresh one (idempotent)."""
