@@ -23,7 +23,12 @@ from drill_sim_ros.fit.log import TORQUE_KINDS, SurfaceLog, find_startups, read_
 from drill_sim_ros.fit.objective import Target, make_target
 from drill_sim_ros.fit.params import DEFAULT_BOUNDS, parse_fit, parse_span, with_values
 from drill_sim_ros.model.errors import DrillSimError
-from drill_sim_ros.model.presets import preset_from_dict, preset_path, read_preset_data
+from drill_sim_ros.model.presets import (
+    preset_from_dict,
+    preset_path,
+    read_preset_data,
+    submerged_string_weight_n,
+)
 from drill_sim_ros.plot_file import (
     add_plot_arguments,
     commit_output,
@@ -128,7 +133,7 @@ def _run(args: Any, data: dict[str, Any], params: list, targets: list[Target],
                            for g in groups]
     finally:
         line.close()
-    return _report(args, params, targets, groups, results)
+    return _report(args, data, params, targets, groups, results)
 
 
 def _fit(data: dict[str, Any], params: list, group: list[Target], client: Any,
@@ -171,19 +176,49 @@ def _spread(target: Target, cycles: np.ndarray | None) -> dict[str, dict[str, fl
     return out
 
 
-def _report(args: Any, params: list, targets: list[Target], groups: list[list[Target]],
-            results: list) -> dict[str, Any]:
+HOOK_LOAD_WARN_SHARE = 0.05   # a logged hook load this far from the hanging weight: a warning
+
+
+def _hook_load(target: Target, hanging_n: float) -> dict[str, float] | None:
+    """The log's hook load (median over the start-up) against the model's: off bottom with
+    the hook held, the string's buoyed weight along the hole (``submerged_string_weight_n``),
+    whatever the wall's friction (turning, the friction lies along the slip, across the
+    string), so it checks the string and the mud, not the fitted friction; None: not
+    logged."""
+    logged = target.log.hook_load_n
+    if logged is None or hanging_n <= 0.0:
+        return None
+    median = float(np.median(logged))
+    return {"logged_n": median, "model_n": hanging_n, "share": median / hanging_n - 1.0}
+
+
+def _hook_warning(start_s: float, check: dict[str, float] | None) -> list[str]:
+    if check is None or abs(check["share"]) <= HOOK_LOAD_WARN_SHARE:
+        return []
+    return [f"the start-up at {start_s:.1f} s logs a hook load of {check['logged_n'] / 1e3:.0f} "
+            f"kN, {100 * check['share']:+.0f} % of the {check['model_n'] / 1e3:.0f} kN the "
+            "preset's string hangs with off bottom: check the string's sections and the mud "
+            "density, and whether the log's hook load includes the travelling block"]
+
+
+def _report(args: Any, data: dict[str, Any], params: list, targets: list[Target],
+            groups: list[list[Target]], results: list) -> dict[str, Any]:
     fits = []
     for group, (res, runs) in zip(groups, results, strict=True):
-        cycles = []
+        cycles, hook_warnings = [], []
+        fitted = with_values(data, {p.path: float(x) for p, x in zip(params, res.x,
+                                                                      strict=True)})
+        hanging_n = submerged_string_weight_n(preset_from_dict("fitted", fitted))
         spreads = res.cycles or (None,) * len(group)
         for target, run, spread in zip(group, runs, spreads, strict=True):
             logged = _logged_lp(target)
+            hook = _hook_load(target, hanging_n)
+            hook_warnings += _hook_warning(float(target.log.t_s[0]), hook)
             cycles.append({"start_s": float(target.log.t_s[0]),
                            "first_slip_s": (target.first_slip_s or 0.0),
                            "recorded": _cycle(target, logged),
                            "fitted": _cycle(target, target.model_torque(run[0])),
-                           "replays": _spread(target, spread)})
+                           "replays": _spread(target, spread), "hook_load": hook})
         fits.append({
             "values": {p.path: {"value": float(x), "low95": float(lo), "high95": float(hi),
                                 "initial": p.initial, "bounds": [p.low, p.high]}
@@ -191,7 +226,7 @@ def _report(args: Any, params: list, targets: list[Target], groups: list[list[Ta
                                                strict=True)},
             "misfit_before": res.misfit_before, "misfit_after": res.misfit_after,
             "correlation": np.round(res.correlation, 4).tolist(),
-            "warnings": list(res.warnings), "evaluations": res.evaluations,
+            "warnings": [*res.warnings, *hook_warnings], "evaluations": res.evaluations,
             "replays": res.replays, "from_cache": res.reused, "seconds": res.seconds,
             "stages": {name: {"replays": n, "seconds": sec}
                        for name, (n, sec) in res.stages.items()},
@@ -240,6 +275,11 @@ def _summary(report: dict[str, Any]) -> str:
                                  f"{which:8s}: period {c['period_s']:.3f} s, mean "
                                  f"{c['mean_nm']:.0f} N m, std {c['std_nm']:.0f} N m, "
                                  f"amplitude {c['amplitude_nm']:.0f} N m")
+            if s.get("hook_load"):
+                h = s["hook_load"]
+                lines.append(f"  hook load, logged {h['logged_n'] / 1e3:.1f} kN against the "
+                             f"{h['model_n'] / 1e3:.1f} kN the string hangs with off bottom "
+                             f"({100 * h['share']:+.1f} %; no part of the misfit: docs/fit.md)")
             if s.get("replays"):
                 r = s["replays"]
                 lines.append("  cycle over the fit's replays (mean +- sd; the recorded at z): "

@@ -100,6 +100,28 @@ def test_a_preset_naming_a_survey_file_is_read_from_any_directory(tmp_path, caps
     assert code == 2 and len(err) == 1 and "no start-up" in err[0], err
 
 
+def test_a_logged_hook_load_is_checked_against_the_hanging_weight() -> None:
+    """Off bottom the hook holds the string's buoyed weight along the hole: a log within 5 %
+    of it passes, one 10 % heavier is named in a warning (not in the misfit)."""
+    from types import SimpleNamespace
+
+    from drill_sim_ros import fit_cli
+    from drill_sim_ros.model.presets import submerged_string_weight_n
+    hanging_n = submerged_string_weight_n(load_preset(PRESET))
+    assert 3e5 < hanging_n < 2e6                  # some 800 kN of 5-in pipe and collars
+    for factor, warned in ((1.0, False), (1.04, False), (1.10, True)):
+        hook = np.full(100, factor * hanging_n)
+        target = SimpleNamespace(log=SimpleNamespace(hook_load_n=hook))
+        check = fit_cli._hook_load(target, hanging_n)
+        assert check["share"] == pytest.approx(factor - 1.0)
+        warning = fit_cli._hook_warning(12.0, check)
+        assert bool(warning) == warned
+        if warned:
+            assert "+10 %" in warning[0] and "12.0 s" in warning[0]
+    target = SimpleNamespace(log=SimpleNamespace(hook_load_n=None))
+    assert fit_cli._hook_load(target, hanging_n) is None
+
+
 def test_start_ups_are_found_from_rest_to_turning() -> None:
     t = np.arange(0.0, 30.0, 0.01)
     rpm = np.where((t % 15.0) < 3.0, 0.0, np.minimum(30.0, 10.0 * ((t % 15.0) - 3.0)))
