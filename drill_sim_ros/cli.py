@@ -33,7 +33,7 @@ from drill_sim_ros import (
     torque_drag_cli,
 )
 from drill_sim_ros.archive.output import open_output
-from drill_sim_ros.archive.signals import stop_on_signals
+from drill_sim_ros.archive.signals import stop_on_signals, stop_requested
 from drill_sim_ros.model import analysis, telemetry
 from drill_sim_ros.model import kernel as k
 from drill_sim_ros.model.bit_rock import LAWS, RGD07_LAW, BitLaw
@@ -497,11 +497,19 @@ def _main(args: argparse.Namespace) -> int:
         print(f"drill_sim: error: {' '.join(str(exc).splitlines())}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
-        print(f"drill_sim {args.command}: interrupted", file=sys.stderr)
-        return 130
+        return _interrupted(args.command)
     except BrokenPipeError:        # the reader went away (`drill_sim params | head`)
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())   # no flush error
         return 128 + signal.SIGPIPE
+    except Exception:
+        if stop_requested():      # numba's compiler, torn by the stop, re-raises it as an
+            return _interrupted(args.command)   # error of its own (RuntimeError)
+        raise
+
+
+def _interrupted(command: str) -> int:
+    print(f"drill_sim {command}: interrupted", file=sys.stderr)
+    return 130
 
 
 if __name__ == "__main__":

@@ -24,6 +24,14 @@ from contextlib import contextmanager
 
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
 INTERRUPTED_STATUS = 130      # as after Ctrl-C
+_STOP_REQUESTED = threading.Event()     # a stop signal arrived within stop_on_signals
+
+
+def stop_requested() -> bool:
+    """Whether a stop signal arrived in the current :func:`stop_on_signals` block: an error
+    raised after it is the interruption's (numba's compiler, torn by the KeyboardInterrupt,
+    re-raises it as a RuntimeError), not the user's to read as a traceback."""
+    return _STOP_REQUESTED.is_set()
 
 
 def _interrupt(signum: int, frame: object) -> None:
@@ -33,6 +41,7 @@ def _interrupt(signum: int, frame: object) -> None:
 def _stopper(on_stop: Callable[[], None] | None,
              grace_s: float | None) -> Callable[[int, object], None]:
     def stop(signum: int, frame: object) -> None:
+        _STOP_REQUESTED.set()
         if on_stop is not None:
             on_stop()
         if grace_s is not None:
@@ -52,6 +61,7 @@ def stop_on_signals(on_stop: Callable[[], None] | None = None,
     if threading.current_thread() is not threading.main_thread():
         yield
         return
+    _STOP_REQUESTED.clear()
     handler = _stopper(on_stop, grace_s)
     previous = {sig: signal.signal(sig, handler) for sig in STOP_SIGNALS}
     hook, sys.unraisablehook = sys.unraisablehook, _quiet_stop(sys.unraisablehook)
@@ -66,9 +76,13 @@ def stop_on_signals(on_stop: Callable[[], None] | None = None,
 def _quiet_stop(hook: Callable[[object], None]) -> Callable[[object], None]:
     """``sys.unraisablehook`` that drops the stop's own KeyboardInterrupt where Python could
     not raise it (a callback, e.g. inside numba's compiler: "Exception ignored in ...", a
-    traceback the user did not cause); the last resort ends the process then. Anything else
-    goes to ``hook``."""
+    traceback the user did not cause); the last resort ends the process then. Once a stop
+    was asked for, it drops every such report: objects the interruption tore mid-work (an
+    LLVM module numba was compiling) fail in their finalizers. Anything else goes to
+    ``hook``."""
     def quiet(unraisable: object) -> None:
+        if stop_requested():
+            return
         if not isinstance(getattr(unraisable, "exc_value", None), KeyboardInterrupt):
             hook(unraisable)
     return quiet

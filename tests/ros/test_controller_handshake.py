@@ -92,6 +92,12 @@ class Watch:
     def count(self, key: str, value: int, timeout_s: float = 20.0) -> dict[str, str]:
         return self.until(lambda d: d.get(key) == str(value), f"{key} != {value}", timeout_s)
 
+    def subscribers(self, topic: str, count: int, timeout_s: float = 60.0) -> None:
+        """Wait until ``count`` nodes subscribe to ``topic`` (processes started up)."""
+        assert self.ros.spin_until(lambda: self.probe.count_subscribers(topic) >= count,
+                                   timeout_s), \
+            f"{self.probe.count_subscribers(topic)} subscribers of {topic}, not {count}"
+
     def sim_up(self) -> None:
         self.until(lambda d: bool(d), "sim_node published no /diagnostics", 60.0)
 
@@ -224,6 +230,9 @@ def test_two_controllers_at_once_advance_the_sim_once_per_sample(tmp_path):
             running(controller_command(reports[0]), tmp_path / "one.log") as one, \
             running(controller_command(reports[1]), tmp_path / "two.log") as two:
         watch = Watch(ros)
+        # both up before the sim: the one ready first would otherwise run all the periods
+        # while the other still starts (a loaded machine: [0, 3000] answers, 2026-12-06)
+        watch.subscribers(topics.SURFACE_MEASURED, 2)
         record, log, sim_cm = sim_and_watch(tmp_path, PATIENT_WARN_S)
         with sim_cm as sim:
             answered = [watch.report(r)["sent"] for r in reports]
@@ -244,6 +253,7 @@ def test_out_of_order_and_repeated_stamps_and_a_flood_neither_apply_nor_advance(
             running(controller_command(extras, "--extras"), tmp_path / "x.log") as answers, \
             running(controller_command(flood, "--flood", str(FLOOD)), tmp_path / "f.log") as f:
         watch = Watch(ros)
+        watch.subscribers(topics.SURFACE_MEASURED, 2)          # both up before the sim
         record, log, sim_cm = sim_and_watch(tmp_path, PATIENT_WARN_S)
         with sim_cm as sim:
             assert watch.report(flood)["extras"] == FLOOD
