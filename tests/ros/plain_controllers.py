@@ -3,7 +3,7 @@ tests/ros/test_controller_handshake.py; only rclpy and the law of
 examples/lockstep_controller.py, no helper of this package.
 
     python tests/ros/plain_controllers.py --report PATH [--kind a|b|c] [--kickoff-stamp
-        now|zero] [--stop-at-s 30] [--die-at-s T] [--extras] [--flood N]
+        now|zero] [--stop-at-s 30] [--die-at-s T] [--extras] [--flood N [--depth D]]
 
 - a: answers every sample of drill/surface/measured, stamped with the sample's stamp, once
   its publisher has matched (an answer sent before is lost: docs/control-loop.md);
@@ -13,7 +13,10 @@ examples/lockstep_controller.py, no helper of this package.
   older, one at -1 s and one at 1e9 s before it, and a second answer after it (0 rpm, all);
 - --die-at-s: SIGKILL itself on receiving the sample of that stamp, before answering;
 - --flood N: answers nothing; once the run passes 1 s, sends N commands stamped -1 s and
-  1e9 s (0 rpm) as fast as it can.
+  1e9 s (0 rpm) as fast as it can;
+- --depth D: its publisher keeps the last D commands (10, rclpy's usual; 0: all of them, so
+  DDS delivers every one and none is lost; the flood then waits for the sim to acknowledge
+  every KEPT_BURST commands, as a writer keeping all refuses more once full).
 On the first sample stamped --stop-at-s or later it answers nothing more, writes one JSON
 object (commands sent, extras, answers) to --report and spins until SIGINT.
 """
@@ -29,8 +32,10 @@ from pathlib import Path
 
 import rclpy
 from builtin_interfaces.msg import Time
+from rclpy.duration import Duration
 from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
+from rclpy.qos import HistoryPolicy, QoSProfile
 from sensor_msgs.msg import JointState
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "examples"))
@@ -39,6 +44,7 @@ from lockstep_controller import LATEST_SAMPLE, speed_setpoint_rad_s
 PERIOD_NS = 10_000_000
 WRONG_STAMPS_NS = (-10**9, 10**18)
 EXTRAS_EVERY = 5
+KEPT_BURST = 2000
 
 
 def stamp(time_ns: int) -> Time:
@@ -52,7 +58,8 @@ class PlainController(Node):
         self.args = args
         self.sent = self.extras = self.answers = 0
         self.done = False
-        self.pub = self.create_publisher(JointState, "drill/cmd/top_drive", 10)
+        depth = QoSProfile(history=HistoryPolicy.KEEP_ALL) if args.depth == 0 else args.depth
+        self.pub = self.create_publisher(JointState, "drill/cmd/top_drive", depth)
         self.create_subscription(JointState, "drill/surface/measured", self.on_sample,
                                  LATEST_SAMPLE)
         self.held: JointState | None = None          # a sample to answer once sim_node listens
@@ -110,6 +117,9 @@ class PlainController(Node):
             return
         for i in range(self.args.flood):
             self.send(0.0, WRONG_STAMPS_NS[i % 2])
+            if self.args.depth == 0 and i % KEPT_BURST == KEPT_BURST - 1:
+                # a writer keeping all refuses a command once full: let the sim catch up
+                assert self.pub.wait_for_all_acked(Duration(seconds=30))
         self.extras = self.args.flood
         self.report()
 
@@ -129,6 +139,7 @@ def main() -> None:
     parser.add_argument("--die-at-s", type=float)
     parser.add_argument("--extras", action="store_true")
     parser.add_argument("--flood", type=int, default=0)
+    parser.add_argument("--depth", type=int, default=10)
     args = parser.parse_args()
     rclpy.init()
     node = PlainController(args)
