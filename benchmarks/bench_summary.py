@@ -48,6 +48,17 @@ def commit() -> str:
     return head + ("+" if dirty else "")
 
 
+def cpu_model() -> str:
+    """The processor's model name (/proc/cpuinfo), or '?': figures differ between VMs."""
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return "?"
+
+
 def header(title: str) -> str:
     now = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M:%S UTC")
     load = " ".join(f"{x:.2f}" for x in os.getloadavg())
@@ -55,8 +66,8 @@ def header(title: str) -> str:
 
 
 def main() -> int:
-    print(f"drill_sim_ros benchmarks in one run: commit {commit()}, {os.cpu_count()} cores, "
-          f"Python {sys.version.split()[0]}")
+    print(f"drill_sim_ros benchmarks in one run: commit {commit()}, {os.cpu_count()} cores "
+          f"({cpu_model()}), Python {sys.version.split()[0]}")
     failed = []
     for title, argv in RUNS:
         print(header(title), flush=True)
