@@ -85,7 +85,8 @@ def _modes_row(i: int, kind: str, d: dict[str, list[float | None]]) -> str:
         return f"{value:{width}.4f}" if value is not None else f"{'n/a':>{width}s}"
 
     found, analytic = d["identified_hz"], d["analytic_hz"][i]
-    error = f"{(found[i] - analytic) / analytic:+.2%}" if i < len(found) else "n/a"
+    hz = found[i] if i < len(found) else None
+    error = "n/a" if hz is None else f"{(hz - analytic) / analytic:+.2%}"
     return (f"{i + 1:4d}  {kind:10s}  {cell('identified_hz', 12)}  {cell('analytic_hz', 11)}"
             f"  {error:>7s}  {cell('identified_damping_ratio', 15)}  "
             f"{cell('analytic_damping_ratio', 13)}")

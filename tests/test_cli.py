@@ -156,6 +156,22 @@ def test_modes_reports_damping_ratios(tmp_path: Path) -> None:
         assert d["identified_damping_ratio"] == pytest.approx(expected, rel=0.10)
 
 
+def test_modes_on_a_walled_preset_names_no_peak_after_the_wrong_mode() -> None:
+    """``drill_sim modes`` on the deviated preset: the wall's note, and per kind one
+    identified frequency a mode (null where none was found), each within 10 % of its own
+    analytic mode: a listing of the lowest peaks found would name mode 2's peak mode 1."""
+    result = drill_sim("modes", "--params", "field_8p5in_deviated")
+    assert result.returncode == 0, result.stderr
+    assert "note: the string rings in its well, on the wall" in result.stdout
+    out = json.loads(result.stdout.splitlines()[-1])
+    for kind in ("torsional", "axial"):
+        found, analytic = out[kind]["identified_hz"], out[kind]["analytic_hz"]
+        assert len(found) == len(analytic) == 3, out[kind]
+        for hz, mode_hz in zip(found, analytic, strict=True):
+            assert hz is None or abs(hz / mode_hz - 1.0) < 0.1, out[kind]
+    assert None not in out["torsional"]["identified_hz"]    # the wall damps axial motion
+
+
 STARTUP_KEYS = {"breakaway_s", "breakaway_turns", "breakaway_torque_nm", "first_slip_s",
                 "peak_motor_torque_nm", "stick_slip", "period_s", "stick_fraction",
                 "bit_rpm_max", "motor_torque_nm", "twist_turns", "cutoff_hz"}

@@ -47,13 +47,14 @@ FILTER_DECAY = 1.5         # the decimation filter lasts at most 1.5 / (largest 
 
 @dataclass(frozen=True)
 class Modes:
-    """Natural frequencies, Hz, identified from the undamped ring-down and analytic; damping
-    ratios identified from the damped ring-down (None: no pole found near that mode) and
-    analytic (first order), mode by mode as the analytic frequencies."""
+    """Natural frequencies, Hz, identified from the undamped ring-down (None: no peak near
+    that mode) and analytic; damping ratios identified from the damped ring-down (None: no
+    pole found near that mode) and analytic (first order), mode by mode as the analytic
+    frequencies."""
 
-    torsional_identified_hz: list[float]
+    torsional_identified_hz: list[float | None]
     torsional_analytic_hz: list[float]
-    axial_identified_hz: list[float]
+    axial_identified_hz: list[float | None]
     axial_analytic_hz: list[float]
     torsional_identified_damping_ratio: list[float | None]
     torsional_analytic_damping_ratio: list[float]
@@ -206,10 +207,25 @@ def identify_modes(preset: Preset, count: int = 3, seconds: float = 400.0) -> Mo
     analytic = {axial: sg.analytic_modes_hz(spec, count, axial=axial) for axial in (False, True)}
     zeta = {axial: sg.analytic_damping_ratios(spec, analytic[axial], axial)
             for axial in (False, True)}
-    peaks = _undamped_peaks_hz(preset, count, seconds)
+    peaks = [peaks_by_mode(found, analytic[axial])
+             for axial, found in enumerate(_undamped_peaks_hz(preset, count, seconds))]
     identified = identified_damping_ratios(preset, analytic, zeta, seconds)
     return Modes(peaks[0], analytic[False], peaks[1], analytic[True],
                  identified[False], zeta[False], identified[True], zeta[True])
+
+
+def peaks_by_mode(peaks_hz: list[float], modes_hz: list[float], window: float = 0.1
+                  ) -> list[float | None]:
+    """For each mode at ``modes_hz``, the spectral peak nearest it within +-``window`` of its
+    frequency (the damping poles' window, :func:`poles.damping_ratio_near`), else None: on
+    a walled string the wall can damp a mode out of the ring-down, and the lowest peaks
+    found are then not modes 1, 2, 3 (listed in turn, they would be named after the wrong
+    modes)."""
+    out: list[float | None] = []
+    for f in modes_hz:
+        near = [p for p in peaks_hz if abs(p / f - 1.0) < window]
+        out.append(min(near, key=lambda p: abs(p - f)) if near else None)
+    return out
 
 
 def _undamped_peaks_hz(preset: Preset, count: int, seconds: float

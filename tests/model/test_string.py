@@ -280,6 +280,16 @@ def test_a_hook_loop_faster_than_the_axial_round_trip_is_refused() -> None:
         drill(steady, fast, 20.0)
 
 
+def test_peaks_are_named_after_the_mode_they_sit_near() -> None:
+    """On a walled string the wall can damp axial mode 1 out of the ring-down: the lowest
+    peaks found (1.19 and 2.14 Hz on the deviated preset's free axial modes 0.36, 1.20,
+    2.15) are modes 2 and 3, not 1 and 2; a peak 25 % off every mode names none."""
+    modes_hz = [0.3616, 1.1983, 2.1463]
+    assert si.peaks_by_mode([1.19, 2.14], modes_hz) == [None, 1.19, 2.14]
+    assert si.peaks_by_mode([0.36 * 1.25, 1.2, 1.21, 2.1463], modes_hz) == [None, 1.2, 2.1463]
+    assert si.peaks_by_mode([], modes_hz) == [None, None, None]
+
+
 def test_light_pipe_on_a_heavy_bha_approaches_the_lumped_model() -> None:
     """A pipe much lighter than its BHA: mode 1 tends to sqrt(C / I) / 2 pi of RGD07 eq. (1),
     both in the formula and in the simulated ring-down."""
