@@ -91,7 +91,10 @@ def matrix_pencil(record: np.ndarray, dt_s: float, orders: list[int]) -> list[Po
     return fits
 
 
-def damping_ratio_near(fits: list[PoleFit], omega_rad_s: float, window: float = 0.1,
+MODE_WINDOW = 0.1   # a pole or peak names a mode within +-10 % of its frequency
+
+
+def damping_ratio_near(fits: list[PoleFit], omega_rad_s: float, window: float = MODE_WINDOW,
                        floor: float = 0.01, present: float = 1e-3) -> float | None:
     """The damping ratio sigma / |s| of the pole nearest ``omega`` in |s| among those within
     +-``window`` of it whose amplitude is at least ``floor`` of the largest there and

@@ -214,8 +214,8 @@ def identify_modes(preset: Preset, count: int = 3, seconds: float = 400.0) -> Mo
                  identified[False], zeta[False], identified[True], zeta[True])
 
 
-def peaks_by_mode(peaks_hz: list[float], modes_hz: list[float], window: float = 0.1
-                  ) -> list[float | None]:
+def peaks_by_mode(peaks_hz: list[float], modes_hz: list[float],
+                  window: float = poles.MODE_WINDOW) -> list[float | None]:
     """For each mode at ``modes_hz``, the spectral peak nearest it within +-``window`` of its
     frequency (the damping poles' window, :func:`poles.damping_ratio_near`), else None: on
     a walled string the wall can damp a mode out of the ring-down, and the lowest peaks
