@@ -19,10 +19,15 @@ threshold dynamics) and the wall time; then the coverage counts (issue 51: withi
 >= 17 of 20).
 Other start-ups: ``--preset`` (a name, a YAML path, or ``tangent``: the Well B-like mapping
 of tests/model/fv_cases.py, whose cycle does not branch: docs/fit.md), ``--rpm``,
-``--ramp-s`` (default field_8p5in_deviated, 30 rpm in 10 s).
+``--ramp-s`` (default field_8p5in_deviated, 30 rpm in 10 s). Several start-ups, fitted
+jointly as ``drill_sim fit`` fits the start-ups of one log: ``--rpm 40,120 --ramp-s 2,6``
+(a start-up a speed, each 60 s from rest, the second's sensor noise seeded apart: the
+off-bottom torque at two speeds, which is what tells the string's viscous loss, growing
+with speed, from the wall's Coulomb friction: docs/fit.md).
 Usage: .venv/bin/python benchmarks/bench_fit.py [--seeds 1:20] [--workers 2]
        [--params a,b] [--start 0.8] [--substeps 54] [--dir /tmp/bench_fit]
-       [--preset field_8p5in_deviated] [--rpm 30] [--ramp-s 10] [--markdown]
+       [--preset field_8p5in_deviated] [--rpm 30[,R2...]] [--ramp-s 10[,S2...]]
+       [--markdown]
 (``--markdown``: each log as a row of docs/fit.md's coverage tables; run again with the same
 arguments, the finished logs are only read back.)
 """
@@ -60,20 +65,26 @@ def preset_data(name: str) -> dict:
     return read_preset_data(preset_path(name))
 
 
+SEED_APART = 10_000   # a log's k-th start-up has its sensor noise seeded seed + k x this
+
+
 def one_log(seed: int, data: dict, names: str, client: object, share: float, cache: Path,
-            startup: tuple[str, float, float] = (PRESET, 30.0, 10.0)) -> dict:
-    name, rpm, ramp_s = startup
+            startup: tuple[str, tuple[float, ...], tuple[float, ...]] = (PRESET, (30.0,),
+                                                                         (10.0,))) -> dict:
+    name, rpms, ramps_s = startup
     truth_preset = preset_from_dict(name, data)
-    log = synthetic.synthetic_log(truth_preset, rpm, ramp_s, 60.0,
-                                  synthetic.scenario_sensors(seed))
+    logs = [synthetic.synthetic_log(truth_preset, rpm, ramp_s, 60.0,
+                                    synthetic.scenario_sensors(seed + k * SEED_APART))
+            for k, (rpm, ramp_s) in enumerate(zip(rpms, ramps_s, strict=True))]
     paths = names.split(",")
     truth = np.array([float(get_path(data, p)) for p in paths])
     start = with_values(data, {p: share * v for p, v in zip(paths, truth, strict=True)})
-    target = objective.make_target(log, truth_preset)
+    targets = [objective.make_target(log, truth_preset) for log in logs]
+    log, target = logs[0], targets[0]     # the cycle reported: the first start-up's
 
     def progress(text: str) -> None:
         print(f"\rlog {seed}: {text}", end="", file=sys.stderr, flush=True)
-    evaluator = engine.Evaluator(start, parse_fit(names, start), [target], client, cache,
+    evaluator = engine.Evaluator(start, parse_fit(names, start), targets, client, cache,
                                  progress)
     t0, c0 = time.perf_counter(), time.process_time()
     result = engine.fit(evaluator)
@@ -142,8 +153,8 @@ def main() -> None:
     ap.add_argument("--dir", type=Path, default=Path("/tmp/bench_fit"))
     ap.add_argument("--preset", default=PRESET,
                     help="a preset name, a YAML path, or tangent (tests/model/fv_cases.py)")
-    ap.add_argument("--rpm", type=float, default=30.0)
-    ap.add_argument("--ramp-s", type=float, default=10.0)
+    ap.add_argument("--rpm", default="30", help="R[,R2...]: a start-up a speed")
+    ap.add_argument("--ramp-s", default="10", help="S[,S2...]: each start-up's ramp")
     ap.add_argument("--markdown", action="store_true",
                     help="print each log as a row of docs/fit.md's tables")
     args = ap.parse_args()
@@ -155,9 +166,15 @@ def main() -> None:
     args.dir.mkdir(parents=True, exist_ok=True)
     tag = (f"{len(paths)}p_{args.start:g}_{args.substeps or 'preset'}_r{engine.REPLAYS_PER_POINT}"
            "_profile")
-    startup = (args.preset, args.rpm, args.ramp_s)
-    if startup != (PRESET, 30.0, 10.0):
-        tag += f"_{Path(args.preset).stem}_{args.rpm:g}rpm_{args.ramp_s:g}s"
+    rpms = tuple(float(v) for v in args.rpm.split(","))
+    ramps_s = tuple(float(v) for v in args.ramp_s.split(","))
+    if len(rpms) != len(ramps_s):
+        sys.exit(f"--rpm names {len(rpms)} start-ups and --ramp-s {len(ramps_s)}: give one "
+                 "ramp a start-up")
+    startup = (args.preset, rpms, ramps_s)
+    if startup != (PRESET, (30.0,), (10.0,)):
+        tag += (f"_{Path(args.preset).stem}_{'+'.join(f'{r:g}' for r in rpms)}rpm_"
+                f"{'+'.join(f'{r:g}' for r in ramps_s)}s")
     done_path = args.dir / f"done_{tag}.jsonl"
     done = {}
     if done_path.exists():
