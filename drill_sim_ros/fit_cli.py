@@ -98,6 +98,10 @@ def cmd_fit(args: Any) -> int:
     log = _window(read_log(args.log, args.torque), args.window)
     segments = [log.part(a, b) for a, b in find_startups(log)]
     targets = [make_target(seg, preset) for seg in segments]
+    fitted_together = [[seg] for seg in segments] if args.each else [segments]
+    for warning in dict.fromkeys(w for group in fitted_together for w in
+                                 engine.one_speed_warning(params, [s.speed_rad_s for s in group])):
+        print(f"drill_sim fit: warning: {warning}", file=sys.stderr)
     cache = args.cache or (args.out.with_suffix(".fit-cache.jsonl") if args.out else None)
     with plot_into(args.plot, args.overwrite) as plot_tmp, \
             output_into(args.out, args.overwrite, "--out", (".yaml", ".yml")) as out_tmp:

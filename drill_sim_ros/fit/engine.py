@@ -80,6 +80,10 @@ LOCAL_STARTS = 3              # the first pass starts from the best this many po
 BRACKET_STEPS = (0.02, 0.04)  # in u: the points tried on either side of the optimum
 BRACKET_ROUNDS = 3            # at most this many restarts from a better one of them
 CORRELATED = 0.95             # |correlation| above this: the log cannot tell the two apart
+VISCOUS_PATH = "string.torsional_damping_per_s"   # a loss torque that grows with speed ...
+COULOMB_PATHS = ("well.side_friction.dynamic",)   # ... and friction torques that do not
+SPEED_SPREAD = 3.0            # start-ups' speeds at least this far apart tell the two apart
+#                               (the tangent: one at 3x told them apart, 2x hardly; fit.md)
 
 
 def simulate(data: dict[str, Any], values: dict[str, float], t_s: np.ndarray,
@@ -435,7 +439,8 @@ def fit(evaluator: Evaluator, seed: int = 0) -> FitResult:
         evaluator.misfit_sd(best.x))
     count[0] += bands.points
     stage("intervals")
-    warnings = _warnings(params, best, jacobian, bands.correlation)
+    warnings = [*one_speed_warning(params, [t.log.speed_rad_s for t in evaluator.targets]),
+                *_warnings(params, best, jacobian, bands.correlation)]
     return FitResult(tuple(params), best.x, x_of(bands.low), x_of(bands.high),
                      bands.correlation, before.misfit, best.misfit, count[0],
                      evaluator.computed, evaluator.reused,
@@ -461,6 +466,29 @@ def _step(u: np.ndarray, i: int) -> np.ndarray:
     h = np.zeros_like(u)
     h[i] = JACOBIAN_STEP if u[i] + JACOBIAN_STEP <= 1.0 else -JACOBIAN_STEP
     return h
+
+
+def one_speed_warning(params: Sequence[FitParameter], speeds_rad_s: Sequence[np.ndarray]
+                      ) -> list[str]:
+    """A warning when the string's viscous loss is fitted with a Coulomb friction on
+    start-ups that all turn at about one speed (their turning speeds, each the median of a
+    start-up's second half, less than ``SPEED_SPREAD`` apart). The viscous loss is a torque
+    rate x inertia x speed; the dynamic friction's does not depend on speed. At one speed a
+    little more of one and a little less of the other give nearly the same torque: on the
+    Well B-like tangent at 40 rpm the four fitted jointly put the damping 8.4 % high and the
+    dynamic coefficient 0.9 % low (docs/fit.md), a point a start-up at 120 rpm rejects."""
+    fitted = {p.path for p in params}
+    if VISCOUS_PATH not in fitted or not fitted.intersection(COULOMB_PATHS):
+        return []
+    turning = [float(np.median(s[s.size // 2:])) for s in speeds_rad_s if s.size]
+    if not turning or min(turning) <= 0.0 or max(turning) >= SPEED_SPREAD * min(turning):
+        return []
+    rpm = [v * 30.0 / math.pi for v in (min(turning), max(turning))]
+    at = f"{rpm[0]:.0f} rpm" if rpm[1] - rpm[0] < 0.5 else f"{rpm[0]:.0f} to {rpm[1]:.0f} rpm"
+    return [f"every start-up turns at {at}: at one speed the log can hardly tell "
+            f"{VISCOUS_PATH} (a loss growing with speed) from "
+            f"{' or '.join(fitted.intersection(COULOMB_PATHS))} (one that does not); add a "
+            f"start-up at {SPEED_SPREAD:g} times the speed or more (docs/fit.md)"]
 
 
 def _warnings(params: Sequence[FitParameter], best: Evaluation, jacobian: np.ndarray,

@@ -13,8 +13,9 @@ import pytest
 import yaml
 
 from drill_sim_ros import cli
-from drill_sim_ros.fit import objective, synthetic
+from drill_sim_ros.fit import engine, objective, synthetic
 from drill_sim_ros.fit.log import LogError, find_startups, read_log
+from drill_sim_ros.fit.params import parse_fit
 from drill_sim_ros.model.presets import load_preset, preset_from_dict, preset_path
 from drill_sim_ros.model.replay import replay_speed
 from drill_sim_ros.model.startup import RPM_PER_RAD_S, run_startup
@@ -120,6 +121,38 @@ def test_a_logged_hook_load_is_checked_against_the_hanging_weight() -> None:
             assert "+10 %" in warning[0] and "12.0 s" in warning[0]
     target = SimpleNamespace(log=SimpleNamespace(hook_load_n=None))
     assert fit_cli._hook_load(target, hanging_n) is None
+
+
+def _startup_speed(rpm: float) -> np.ndarray:
+    """A drive's logged speed: 1 s at rest, a 2 s ramp, then ``rpm``, 100 Hz, noisy."""
+    t_s = np.arange(0.0, 60.0, 0.01)
+    ramp = np.clip((t_s - 1.0) / 2.0, 0.0, 1.0)
+    noise = 0.02 * np.random.default_rng(1).standard_normal(t_s.size)
+    return ramp * rpm / RPM_PER_RAD_S + noise
+
+
+@pytest.mark.parametrize(("fitted", "rpms", "warned"), [
+    ("well.side_friction.dynamic,string.torsional_damping_per_s", (40,), True),
+    ("well.side_friction.dynamic,string.torsional_damping_per_s", (40, 40, 80), True),
+    ("well.side_friction.dynamic,string.torsional_damping_per_s", (40, 120), False),
+    ("well.side_friction.dynamic,string.torsional_damping_per_s", (120, 40), False),
+    ("well.side_friction.static,string.torsional_damping_per_s", (40,), False),
+    ("well.side_friction.dynamic", (40,), False),
+])
+def test_the_viscous_loss_and_the_dynamic_friction_at_one_speed_are_warned(
+        fitted: str, rpms: tuple[float, ...], warned: bool) -> None:
+    """A torque rate x inertia x speed and a torque that does not depend on speed cannot be
+    told apart at one speed: fitting both to start-ups less than three times apart in speed
+    is warned of, naming the speed and both paths."""
+    params = parse_fit(fitted, coarse_data())
+    warnings = engine.one_speed_warning(params, [_startup_speed(r) for r in rpms])
+    assert bool(warnings) is warned
+    if warned:
+        low, high = min(rpms), max(rpms)
+        at = f"{low:.0f} rpm" if low == high else f"{low:.0f} to {high:.0f} rpm"
+        assert f"every start-up turns at {at}:" in warnings[0]
+        assert "string.torsional_damping_per_s" in warnings[0]
+        assert "well.side_friction.dynamic" in warnings[0]
 
 
 def test_start_ups_are_found_from_rest_to_turning() -> None:
