@@ -110,7 +110,7 @@ def profile_intervals(evaluate: Callable[[Sequence[np.ndarray]], list[np.ndarray
         if c0[i, i] <= 0.0:
             continue                                  # not constrained: the bounds
         direction = c0[:, i] / c0[i, i]
-        ts, rs = _profile(evaluate, u_best, residuals, direction, rise)
+        ts, rs = _profile(evaluate, u_best, residuals, i, direction, rise)
         points += ts.size - 1
         misfits = np.array([float(r @ r) for r in rs])
         if scatter.shape[0] >= 2:
@@ -175,19 +175,24 @@ def jackknife_sd(statistic: Callable[[np.ndarray], float], samples: np.ndarray) 
 
 
 def _profile(evaluate: Callable[[Sequence[np.ndarray]], list[np.ndarray]],
-             u_best: np.ndarray, residuals: np.ndarray, direction: np.ndarray,
+             u_best: np.ndarray, residuals: np.ndarray, index: int, direction: np.ndarray,
              rise: float) -> tuple[np.ndarray, list[np.ndarray]]:
     """The profile's points t (the step along the parameter) and their residuals: the
     optimum, ``PROFILE_STEPS`` on either side, then the farthest step doubled while a side
-    does not rise by ``rise`` (at most ``PROFILE_EXTENSIONS`` times)."""
+    does not rise by ``rise`` (at most ``PROFILE_EXTENSIONS`` times). A point keeps
+    parameter ``index`` (``direction``'s entry 1) within its bounds; the others follow
+    ``direction`` up to their bounds and stay there (for two parameters and a misfit
+    quadratic in u, exactly their conditional optimum under the bounds; with more, near
+    it). Points whose others left the bounds used to be skipped: where the correlated line
+    left the box before the misfit rose, the interval read the parameter's bound (the
+    dynamic coefficient fitted with the damping on the tangent: "+669 %", docs/fit.md)."""
     ts, rs = [0.0], [residuals]
 
     def add(steps: Sequence[float]) -> None:
         wanted = []
         for t in steps:
-            u = u_best + t * direction
-            if np.all((u >= 0.0) & (u <= 1.0)):
-                wanted.append((t, u))
+            if 0.0 <= u_best[index] + t <= 1.0:
+                wanted.append((t, np.clip(u_best + t * direction, 0.0, 1.0)))
         ts.extend(t for t, _ in wanted)
         rs.extend(evaluate([u for _, u in wanted]))
     add([s * side for s in PROFILE_STEPS for side in (1.0, -1.0)])

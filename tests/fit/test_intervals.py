@@ -125,3 +125,36 @@ def test_the_jackknife_reads_the_spread_of_a_statistic_of_an_average() -> None:
     read = np.mean([jackknife_sd(statistic, rng.normal(0.3, 1.0, (12, 40)))
                     for _ in range(200)])
     assert spread <= read <= 1.3 * spread
+
+
+def test_a_profile_that_meets_another_parameters_bound_rises_there() -> None:
+    """Two nearly interchangeable parameters (columns correlated 0.995), the second's
+    optimum 0.05 above its lower bound: along the first's profile the second falls about
+    as fast as the first rises and meets its bound at t = 0.05, before the valley's misfit
+    has risen. Held at its bound, the misfit rises; the interval's upper end is where the
+    profile under the bound, computed here in closed form, has risen by the threshold
+    (it read the first parameter's own bound, 1.0, when such points were skipped)."""
+    from scipy.optimize import brentq
+    from scipy.stats import f as fisher
+    rng = np.random.default_rng(3)
+    x, y = rng.standard_normal((2, RESIDUALS))
+    a = 12.0 * np.column_stack((x, 0.995 * x + np.sqrt(1 - 0.995**2) * y))
+    u_best = np.array([0.5, 0.05])
+    noise = rng.standard_normal(RESIDUALS)
+    noise -= a @ np.linalg.lstsq(a, noise, rcond=None)[0]     # the optimum stays u_best
+    bands = profile_intervals(lambda us: [a @ (u - u_best) + noise for u in us], u_best,
+                              noise, a, np.zeros((0, RESIDUALS)), REPLAYS)
+    c0 = np.linalg.inv(a.T @ a)
+    slope = c0[1, 0] / c0[0, 0]                    # the second's conditional optimum
+
+    def risen(t: float) -> float:
+        second = max(0.0, u_best[1] + slope * t)   # convex in it: the bound is its optimum
+        r = a @ (np.array([u_best[0] + t, second]) - u_best) + noise
+        return float(r @ r - noise @ noise)
+    dof = RESIDUALS - 2
+    rise = noise @ noise / dof * fisher.ppf(0.95, 1, dof)
+    free = np.sqrt(rise * c0[0, 0])                # where the profile without bounds rises
+    bounded = brentq(lambda t: risen(t) - rise, 0.0, 1.0 - u_best[0])
+    assert -1.2 < slope < -0.8 and free > 0.08 > 0.05 / -slope   # the case is as described
+    assert bounded < 0.08
+    assert bands.high[0] - u_best[0] == pytest.approx(bounded, rel=0.15)
