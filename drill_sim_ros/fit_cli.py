@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import datetime as dt
 import json
+import math
 import sys
 from pathlib import Path
 from typing import Any
@@ -258,7 +259,7 @@ def _summary(report: dict[str, Any]) -> str:
             lines.append(f" start-up {i + 1}:")
         for path, v in fit["values"].items():
             lines.append(f"  {path:42s} {v['value']:.5g}  95% [{v['low95']:.5g}, "
-                         f"{v['high95']:.5g}]  (from {v['initial']:.5g})")
+                         f"{v['high95']:.5g}]  (from {v['initial']:.5g}){_open(v)}")
         lines.append(f"  misfit (rms of weighted residuals; 1 = within noise) "
                      f"{fit['misfit_before']:.4g} before, {fit['misfit_after']:.4g} after; "
                      f"{fit['replays']} replays ({fit['from_cache']} from the cache) in "
@@ -294,6 +295,16 @@ def _summary(report: dict[str, Any]) -> str:
     for path, s in report.get("spread", {}).items():
         lines.append(f"  spread over start-ups: {path} {s['mean']:.5g} +- {s['std']:.3g}")
     return "\n".join(lines)
+
+
+def _open(value: dict[str, Any]) -> str:
+    """A note where a 95 % limit is the parameter's bound: the misfit did not rise that
+    far, so the log does not limit it on that side."""
+    low, high = value["bounds"]
+    sides = [side for side, limit, bound in (("below", value["low95"], low),
+                                             ("above", value["high95"], high))
+             if math.isclose(limit, bound, rel_tol=1e-9, abs_tol=1e-12)]
+    return f"; not limited {' or '.join(sides)} by the log: the bound" if sides else ""
 
 
 def _write_preset(out: Path, data: dict[str, Any], report: dict[str, Any], args: Any

@@ -313,3 +313,18 @@ def test_a_las_log_is_read_by_mnemonic_and_unit(tmp_path) -> None:
     assert np.allclose(log.t_s, t)
     assert np.allclose(log.speed_rad_s, 30.0 / RPM_PER_RAD_S)
     assert np.allclose(log.torque_nm, 2500.0)
+
+
+@pytest.mark.parametrize(("low95", "high95", "note"), [
+    (0.19, 0.21, ""),
+    (0.19, 1.5, "; not limited above by the log: the bound"),
+    (0.05, 0.21, "; not limited below by the log: the bound"),
+    (0.05, 1.5, "; not limited below or above by the log: the bound"),
+])
+def test_a_95_percent_limit_at_the_bound_is_said_to_be_the_bound(low95: float, high95: float,
+                                                                  note: str) -> None:
+    """A limit the profile did not find a rise before is the parameter's bound, not a
+    limit the log sets: the summary says so."""
+    from drill_sim_ros.fit_cli import _open
+    value = {"value": 0.2, "low95": low95, "high95": high95, "bounds": [0.05, 1.5]}
+    assert _open(value) == note
