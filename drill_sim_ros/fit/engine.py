@@ -476,7 +476,8 @@ def one_speed_warning(params: Sequence[FitParameter], speeds_rad_s: Sequence[np.
     rate x inertia x speed; the dynamic friction's does not depend on speed. At one speed a
     little more of one and a little less of the other give nearly the same torque: on the
     Well B-like tangent at 40 rpm the four fitted jointly put the damping 8.4 % high and the
-    dynamic coefficient 0.9 % low (docs/fit.md), a point a start-up at 120 rpm rejects."""
+    dynamic coefficient 0.9 % low (docs/fit.md), a point a start-up at 120 rpm rejects;
+    fitted to both speeds, the damping's bias halved (+2.5 to +6.3 % on four logs)."""
     fitted = {p.path for p in params}
     if VISCOUS_PATH not in fitted or not fitted.intersection(COULOMB_PATHS):
         return []
