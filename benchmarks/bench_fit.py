@@ -27,7 +27,7 @@ with speed, from the wall's Coulomb friction: docs/fit.md).
 Usage: .venv/bin/python benchmarks/bench_fit.py [--seeds 1:20] [--workers 2]
        [--params a,b] [--start 0.8] [--substeps 54] [--dir /tmp/bench_fit]
        [--preset field_8p5in_deviated] [--rpm 30[,R2...]] [--ramp-s 10[,S2...]]
-       [--markdown]
+       [--follow speed|setpoint] [--markdown]
 (``--markdown``: each log as a row of docs/fit.md's coverage tables; run again with the same
 arguments, the finished logs are only read back.)
 """
@@ -70,7 +70,8 @@ SEED_APART = 10_000   # a log's k-th start-up has its sensor noise seeded seed +
 
 def one_log(seed: int, data: dict, names: str, client: object, share: float, cache: Path,
             startup: tuple[str, tuple[float, ...], tuple[float, ...]] = (PRESET, (30.0,),
-                                                                         (10.0,))) -> dict:
+                                                                         (10.0,)),
+            follow: str = "speed") -> dict:
     name, rpms, ramps_s = startup
     truth_preset = preset_from_dict(name, data)
     logs = [synthetic.synthetic_log(truth_preset, rpm, ramp_s, 60.0,
@@ -85,7 +86,7 @@ def one_log(seed: int, data: dict, names: str, client: object, share: float, cac
     def progress(text: str) -> None:
         print(f"\rlog {seed}: {text}", end="", file=sys.stderr, flush=True)
     evaluator = engine.Evaluator(start, parse_fit(names, start), targets, client, cache,
-                                 progress)
+                                 progress, follow=follow)
     t0, c0 = time.perf_counter(), time.process_time()
     result = engine.fit(evaluator)
     seconds, cpu_s = time.perf_counter() - t0, time.process_time() - c0
@@ -155,6 +156,8 @@ def main() -> None:
                     help="a preset name, a YAML path, or tangent (tests/model/fv_cases.py)")
     ap.add_argument("--rpm", default="30", help="R[,R2...]: a start-up a speed")
     ap.add_argument("--ramp-s", default="10", help="S[,S2...]: each start-up's ramp")
+    ap.add_argument("--follow", choices=("speed", "setpoint"), default="speed",
+                    help="what the replays' drive follows (drill_sim fit --follow)")
     ap.add_argument("--markdown", action="store_true",
                     help="print each log as a row of docs/fit.md's tables")
     args = ap.parse_args()
@@ -175,6 +178,8 @@ def main() -> None:
     if startup != (PRESET, (30.0,), (10.0,)):
         tag += (f"_{Path(args.preset).stem}_{'+'.join(f'{r:g}' for r in rpms)}rpm_"
                 f"{'+'.join(f'{r:g}' for r in ramps_s)}s")
+    if args.follow != "speed":
+        tag += f"_follow_{args.follow}"
     done_path = args.dir / f"done_{tag}.jsonl"
     done = {}
     if done_path.exists():
@@ -189,7 +194,7 @@ def main() -> None:
                 r = done[seed]
             else:
                 r = one_log(seed, data, args.params, client, args.start,
-                            args.dir / f"cache_{tag}_{seed}.jsonl", startup)
+                            args.dir / f"cache_{tag}_{seed}.jsonl", startup, args.follow)
                 r["params"] = args.params
                 with done_path.open("a") as f:
                     f.write(json.dumps(r) + "\n")

@@ -30,6 +30,7 @@ from drill_sim_ros.model.presets import (
     read_preset_data,
     submerged_string_weight_n,
 )
+from drill_sim_ros.model.replay import FOLLOW
 from drill_sim_ros.plot_file import (
     add_plot_arguments,
     commit_output,
@@ -73,6 +74,12 @@ def add_parser(sub: Any) -> None:
                    help=f"replays averaged per parameter vector, {REPLAYS_RANGE[0]}.."
                    f"{REPLAYS_RANGE[1]} (default {engine.REPLAYS_PER_POINT}: fewer are "
                    "faster and leave the misfit rougher, docs/fit.md)")
+    p.add_argument("--follow", choices=FOLLOW, default="speed",
+                   help="what the replays' drive follows: the logged speed (default), or "
+                   "the logged setpoint through the preset's own speed loop (needs a "
+                   "setpoint_rpm column and the rig's drive in the preset; no sensor noise "
+                   "in the replayed speed, so one replay a point: --replays is not used; "
+                   "docs/fit.md)")
     p.add_argument("--json", action="store_true", help="print only the JSON line")
     add_plot_arguments(p, "the recorded and fitted surface speed and torque", "--out")
 
@@ -99,6 +106,7 @@ def cmd_fit(args: Any) -> int:
     log = _window(read_log(args.log, args.torque), args.window)
     segments = [log.part(a, b) for a, b in find_startups(log)]
     targets = [make_target(seg, preset) for seg in segments]
+    engine.require_follow(args.follow, segments)
     fitted_together = [[seg] for seg in segments] if args.each else [segments]
     for warning in dict.fromkeys(w for group in fitted_together for w in
                                  engine.one_speed_warning(params, [s.speed_rad_s for s in group])):
@@ -110,7 +118,7 @@ def cmd_fit(args: Any) -> int:
         results = report.pop("_results")
         if plot_tmp is not None:
             from drill_sim_ros.fit.plot import plot_fit
-            plot_fit(plot_tmp, data, params, targets, results)
+            plot_fit(plot_tmp, data, params, targets, results, args.follow)
             commit_plot(plot_tmp, args.plot, args.overwrite)
             print(f"wrote {args.plot}", file=sys.stderr)
         if out_tmp is not None:
@@ -129,22 +137,23 @@ def _run(args: Any, data: dict[str, Any], params: list, targets: list[Target],
     groups = [[t] for t in targets] if args.each else [targets]
     try:
         if args.in_process:
-            results = [_fit(data, params, g, None, cache, line, args.replays)
+            results = [_fit(data, params, g, None, cache, line, args.replays, args.follow)
                        for g in groups]
         else:
             from drill_sim_ros.study.engine import connect
             with connect(args.scheduler, args.workers) as client:
-                results = [_fit(data, params, g, client, cache, line, args.replays)
-                           for g in groups]
+                results = [_fit(data, params, g, client, cache, line, args.replays,
+                                args.follow) for g in groups]
     finally:
         line.close()
     return _report(args, data, params, targets, groups, results)
 
 
 def _fit(data: dict[str, Any], params: list, group: list[Target], client: Any,
-         cache: Path | None, line: StatusLine, replays: int
+         cache: Path | None, line: StatusLine, replays: int, follow: str = "speed"
          ) -> tuple[engine.FitResult, list]:
-    evaluator = engine.Evaluator(data, params, group, client, cache, line.show, replays)
+    evaluator = engine.Evaluator(data, params, group, client, cache, line.show, replays,
+                                 follow)
     result = engine.fit(evaluator)
     values = evaluator.values_of(result.x)
     runs = evaluator.map_runs(values)
@@ -238,6 +247,7 @@ def _report(args: Any, data: dict[str, Any], params: list, targets: list[Target]
             "startups": cycles})
     report: dict[str, Any] = {"log": str(args.log), "preset": args.params,
                               "mode": "each" if args.each else "joint",
+                              "follow": args.follow,
                               "startups": len(targets), "fits": fits, "_results": results}
     if args.each and len(fits) > 1:
         report["spread"] = {p.path: {"mean": float(np.mean(v)), "std": float(np.std(v, ddof=1))}

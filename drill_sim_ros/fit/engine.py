@@ -59,12 +59,13 @@ from typing import Any
 import numpy as np
 
 from drill_sim_ros.fit.intervals import jackknife_sd, profile_intervals
+from drill_sim_ros.fit.log import SurfaceLog
 from drill_sim_ros.fit.objective import Target, noise_std
 from drill_sim_ros.fit.params import FitParameter, with_values
 from drill_sim_ros.model.analysis import lowpass
 from drill_sim_ros.model.errors import DrillSimError
 from drill_sim_ros.model.presets import preset_from_dict
-from drill_sim_ros.model.replay import replay_speed
+from drill_sim_ros.model.replay import FOLLOW, replay_speed
 
 STARTS_PER_PARAMETER = 16
 JACOBIAN_STEP = 0.01          # in u (a share of each parameter's bounds)
@@ -86,21 +87,35 @@ SPEED_SPREAD = 3.0            # start-ups' speeds at least this far apart tell t
 #                               (the tangent: one at 3x told them apart, 2x hardly; fit.md)
 
 
+def require_follow(follow: str, logs: Sequence[SurfaceLog]) -> None:
+    """DrillSimError, in one line, unless the replays can follow ``follow`` in every log."""
+    if follow not in FOLLOW:
+        raise DrillSimError(f"--follow {follow!r}: must be one of {', '.join(FOLLOW)}")
+    missing = [log.source for log in logs if log.setpoint_rad_s is None]
+    if follow == "setpoint" and missing:
+        raise DrillSimError(f"--follow setpoint: {missing[0]} has no setpoint column "
+                            "(setpoint_rpm or setpoint_rad_s)")
+
+
 def simulate(data: dict[str, Any], values: dict[str, float], t_s: np.ndarray,
              speed_rad_s: np.ndarray, speed_noise: tuple[int, float] | None = None,
-             cutoff_hz: float = math.inf) -> tuple[np.ndarray, np.ndarray] | str:
+             cutoff_hz: float = math.inf, follow: str = "speed"
+             ) -> tuple[np.ndarray, np.ndarray] | str:
     """One replay (a Dask task): the string torque at the top N m and the bit speed rad/s at
     the log's times, or the one-line reason the preset with ``values`` is refused.
     ``speed_noise`` (seed, std rad/s): white noise added to the speed it follows; the speed
-    is then low-passed at ``cutoff_hz`` (:func:`replayed_speed`)."""
-    if speed_noise is not None:
-        seed, std = speed_noise
-        speed_rad_s = speed_rad_s + std * np.random.default_rng(seed).standard_normal(
-            speed_rad_s.size)
-    speed_rad_s = replayed_speed(t_s, speed_rad_s, cutoff_hz)
+    is then low-passed at ``cutoff_hz`` (:func:`replayed_speed`). ``follow="setpoint"``:
+    ``speed_rad_s`` is the drive's logged setpoint, followed as it is through the preset's
+    speed loop (model/replay.py; no noise, no low-pass: a command has neither)."""
+    if follow == "speed":
+        if speed_noise is not None:
+            seed, std = speed_noise
+            speed_rad_s = speed_rad_s + std * np.random.default_rng(seed).standard_normal(
+                speed_rad_s.size)
+        speed_rad_s = replayed_speed(t_s, speed_rad_s, cutoff_hz)
     try:
         preset = preset_from_dict("fit", with_values(data, values))
-        run = replay_speed(preset, t_s, speed_rad_s)
+        run = replay_speed(preset, t_s, speed_rad_s, follow=follow)
     except DrillSimError as exc:
         return str(exc)
     return run.surface_torque_nm, run.bit_rpm * (math.pi / 30.0)
@@ -142,9 +157,12 @@ class Evaluator:
     def __init__(self, data: dict[str, Any], params: Sequence[FitParameter],
                  targets: Sequence[Target], client: Any = None, cache: Path | None = None,
                  progress: Callable[[str], None] | None = None,
-                 replays: int = REPLAYS_PER_POINT) -> None:
+                 replays: int = REPLAYS_PER_POINT, follow: str = "speed") -> None:
         self.data, self.params, self.targets = data, list(params), list(targets)
-        self.replays = replays                 # averaged per parameter vector
+        self.follow = follow                   # what the replays' drive follows
+        require_follow(follow, [t.log for t in self.targets])
+        # a replay of a setpoint has no noise to average over: one a point
+        self.replays = 1 if follow == "setpoint" else replays
         self.client, self.cache, self.progress = client, cache, progress
         self.done: dict[str, list[float] | str] = {}
         self.computed = self.reused = 0
@@ -167,6 +185,8 @@ class Evaluator:
             h.update(np.ascontiguousarray(array, dtype=np.float64).tobytes())
         h.update(",".join(p.path for p in self.params).encode())
         h.update(f"lowpass {target.cutoff_hz!r}".encode())
+        if self.follow != "speed":
+            h.update(f"follow {self.follow}".encode())
         return h.hexdigest()[:24]
 
     def _key(self, segment: int, x: np.ndarray) -> str:
@@ -208,10 +228,15 @@ class Evaluator:
               seed_offset: int = 0) -> tuple[Any, ...]:
         """:func:`simulate`'s arguments: start-up ``job[1]`` at ``xs[job[0]]``, the logged
         speed with noise of its own size seeded ``job[2] + seed_offset``."""
-        log = self.targets[job[1]].log
-        return (self.data, self.values_of(xs[job[0]]), log.t_s, log.speed_rad_s,
-                (job[2] + seed_offset, self.speed_noise[job[1]]),
-                self.targets[job[1]].cutoff_hz)
+        target = self.targets[job[1]]
+        return (self.data, self.values_of(xs[job[0]]), target.log.t_s, self._series(target),
+                (job[2] + seed_offset, self.speed_noise[job[1]]), target.cutoff_hz,
+                self.follow)
+
+    def _series(self, target: Target) -> np.ndarray:
+        """What the replays' drive follows: the logged speed, or the logged setpoint."""
+        log = target.log
+        return log.setpoint_rad_s if self.follow == "setpoint" else log.speed_rad_s
 
     def _take(self, key: str, segment: int, result: tuple[np.ndarray, np.ndarray] | str
               ) -> None:
@@ -261,7 +286,10 @@ class Evaluator:
         """Add to each compared value's uncertainty the scatter of ``SENSITIVITY_REPLAYS``
         replays at ``x`` that follow the logged speed with fresh noise of its own size
         (fit.objective's module doc); measured at several points, the largest holds (the
-        scatter depends on the parameters)."""
+        scatter depends on the parameters). Not when the replays follow a setpoint: they
+        carry no speed noise to be sensitive to."""
+        if self.follow == "setpoint":
+            return
         jobs = [(0, s, r) for s in range(len(self.targets)) for r in range(SENSITIVITY_REPLAYS)]
         keys = [f"{self._key(s, x)}:sensitivity{r}" for _, s, r in jobs]
         todo = [(key, job) for key, job in zip(keys, jobs, strict=True) if key not in self.done]
@@ -303,8 +331,8 @@ class Evaluator:
 
     def map_runs(self, values: dict[str, float]) -> list[tuple[np.ndarray, np.ndarray]]:
         """Each start-up replayed with ``values``: (string torque N m, bit speed rad/s)."""
-        runs = self._map([(self.data, values, t.log.t_s, t.log.speed_rad_s, None,
-                           t.cutoff_hz) for t in self.targets])
+        runs = self._map([(self.data, values, t.log.t_s, self._series(t), None,
+                           t.cutoff_hz, self.follow) for t in self.targets])
         for run in runs:
             if isinstance(run, str):
                 raise DrillSimError(f"the fitted values are refused: {run}")

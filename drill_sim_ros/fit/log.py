@@ -3,8 +3,9 @@ into start-ups.
 
 What a log holds (SI once read), each of shape (samples,): time s, the drive's surface
 speed rad/s and a surface torque N m, either the torque sub's string torque at the quill
-(``string``) or the drive's motor torque (``motor``); optionally the hook load N, the WOB N
-and a downhole bit speed rad/s.
+(``string``) or the drive's motor torque (``motor``); optionally the hook load N, the WOB N,
+a downhole bit speed rad/s and the drive's speed setpoint rad/s (``drill_sim fit --follow
+setpoint``).
 
 CSV and LAS columns are named by what they hold and end in their unit (case ignored):
 
@@ -15,7 +16,7 @@ CSV and LAS columns are named by what they hold and end in their unit (case igno
   ``motor_torque_nm`` / ``_knm``, ``surface_torque_nm`` / ``_knm``, ``torque_nm`` / ``_knm``
   (the drive's reading: motor torque); the string torque is taken when both are given;
 * optional: ``hook_load_n`` / ``_kn``, ``wob_n`` / ``_kn``, ``bit_rpm`` /
-  ``bit_speed_rad_s``.
+  ``bit_speed_rad_s``, ``setpoint_rpm`` / ``setpoint_rad_s``.
 
 A LAS file's curves are read by mnemonic and unit (``RPM`` in ``rpm``, ``TORQUE`` in
 ``kN.m``, ...: the mnemonic, an underscore and the unit with dots and slashes dropped);
@@ -58,7 +59,8 @@ MOTOR_TORQUE_NAMES = {"motor_torque_nm": 1.0, "motor_torque_knm": 1e3,
                       "torque_nm": 1.0, "torque_knm": 1e3}
 OPTIONAL_NAMES = {"hook_load_n": {"hook_load_n": 1.0, "hook_load_kn": 1e3},
                   "wob_n": {"wob_n": 1.0, "wob_kn": 1e3},
-                  "bit_speed_rad_s": {"bit_rpm": RAD_S_PER_RPM, "bit_speed_rad_s": 1.0}}
+                  "bit_speed_rad_s": {"bit_rpm": RAD_S_PER_RPM, "bit_speed_rad_s": 1.0},
+                  "setpoint_rad_s": {"setpoint_rpm": RAD_S_PER_RPM, "setpoint_rad_s": 1.0}}
 TORQUE_KINDS = ("string", "motor")
 
 
@@ -75,6 +77,7 @@ class SurfaceLog:
     hook_load_n: np.ndarray | None = None
     wob_n: np.ndarray | None = None
     bit_speed_rad_s: np.ndarray | None = None
+    setpoint_rad_s: np.ndarray | None = None    # the drive's commanded speed (--follow)
 
     @property
     def sample_s(self) -> float:

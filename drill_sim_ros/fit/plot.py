@@ -17,8 +17,9 @@ RPM_PER_RAD_S = 30.0 / np.pi
 
 
 def plot_fit(path: Path, data: dict[str, Any], params: list, targets: list[Target],
-             results: list) -> None:
-    """Draw the fit (``results``: per group, (FitResult, runs)) into ``path`` (PNG)."""
+             results: list, follow: str = "speed") -> None:
+    """Draw the fit (``results``: per group, (FitResult, runs)) into ``path`` (PNG); the
+    replay with the preset's values follows what the fit's did (``follow``)."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -30,7 +31,8 @@ def plot_fit(path: Path, data: dict[str, Any], params: list, targets: list[Targe
     for col, (target, run) in enumerate(fitted):
         log = target.log
         t = log.t_s - log.t_s[0]
-        before = simulate(data, {}, log.t_s, log.speed_rad_s, None, target.cutoff_hz)
+        series = log.setpoint_rad_s if follow == "setpoint" else log.speed_rad_s
+        before = simulate(data, {}, log.t_s, series, None, target.cutoff_hz, follow)
         ax = axes[0, col]
         ax.plot(t, log.speed_rad_s * RPM_PER_RAD_S, color="0.6", lw=0.6, label="drive, logged")
         ax.plot(t, run[1] * RPM_PER_RAD_S, color="C1", lw=0.8, label="bit, fitted replay")

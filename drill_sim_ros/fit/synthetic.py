@@ -37,7 +37,8 @@ def measured_log(run: StartupRun, sensors: RigSensors, rest_s: float, source: st
                  ) -> SurfaceLog:
     """The start-up ``run`` (from rest at t = 0) after ``rest_s`` at rest (the samples of
     t = 0 repeated: the string still, untwisted), its drive speed, motor, string torque
-    measured by ``sensors``; the torque of the log is the string torque (a torque sub)."""
+    measured by ``sensors``; the torque of the log is the string torque (a torque sub); the
+    drive's setpoint as commanded (a command, not a measurement: no noise)."""
     dt = float(np.median(np.diff(run.t_s)))
     lead = max(1, round(rest_s / dt))
     t_s = np.concatenate((np.arange(lead) * dt, run.t_s + lead * dt))
@@ -49,13 +50,16 @@ def measured_log(run: StartupRun, sensors: RigSensors, rest_s: float, source: st
                              rest_then(run.surface_torque_nm), np.zeros(t_s.size)))
     measured = sensors.measure(truth)
     return SurfaceLog(source=source, t_s=t_s, speed_rad_s=measured[:, 0],
-                      torque_nm=measured[:, 2], torque_kind="string")
+                      torque_nm=measured[:, 2], torque_kind="string",
+                      setpoint_rad_s=rest_then(run.setpoint_rpm / RPM_PER_RAD_S))
 
 
 def write_csv(log: SurfaceLog, path: str) -> None:
     """``log`` as a CSV that ``drill_sim fit --log`` reads: time_s, surface_rpm and
-    string_torque_knm (or motor_torque_knm)."""
-    torque = f"{log.torque_kind}_torque_knm"
-    table = np.column_stack((log.t_s, log.speed_rad_s * RPM_PER_RAD_S, log.torque_nm / 1e3))
-    np.savetxt(path, table, delimiter=",", header=f"time_s,surface_rpm,{torque}",
-               comments="", fmt="%.6g")
+    string_torque_knm (or motor_torque_knm), and setpoint_rpm where the log has it."""
+    columns = {"time_s": log.t_s, "surface_rpm": log.speed_rad_s * RPM_PER_RAD_S,
+               f"{log.torque_kind}_torque_knm": log.torque_nm / 1e3}
+    if log.setpoint_rad_s is not None:
+        columns["setpoint_rpm"] = log.setpoint_rad_s * RPM_PER_RAD_S
+    np.savetxt(path, np.column_stack(list(columns.values())), delimiter=",",
+               header=",".join(columns), comments="", fmt="%.6g")

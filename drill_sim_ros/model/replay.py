@@ -8,6 +8,11 @@ a time series: between two samples it goes linearly from one recorded speed to t
 :meth:`Simulator.set_speed_ramp`), so the string is turned exactly as the rig turned it and
 the motor torque is what that takes. The drive turns one way: a negative recorded speed (a
 speed sensor's noise about rest) is taken as 0.
+
+``follow="setpoint"``: the series is the drive's *setpoint* instead, followed through the
+preset's own speed loop (the drive in speed mode, as ``drill_sim startup`` runs it): the
+replayed speed then carries no sensor noise, whose integral would move the wind-up
+(docs/fit.md), but the preset's drive (its loop gains and inertia) must be the rig's.
 """
 
 from __future__ import annotations
@@ -24,12 +29,16 @@ from drill_sim_ros.model.simulator import Samples, SimConfig, Simulator
 from drill_sim_ros.model.startup import StartupRun, require_startup_preset, startup_series
 
 PROGRESS_EVERY = 1000      # samples between progress reports
+FOLLOW = ("speed", "setpoint")   # what a replay's drive follows (module doc)
 
 
-def replay_simulator(preset: Preset) -> Simulator:
-    """``preset``'s string at rest off bottom under a kinematic drive (module doc)."""
+def replay_simulator(preset: Preset, follow: str = "speed") -> Simulator:
+    """``preset``'s string at rest off bottom under a kinematic drive, or under its own
+    speed loop to follow a setpoint (module doc)."""
     require_startup_preset(preset)
-    drive = preset.top_drive.with_(mode="kinematic")
+    if follow not in FOLLOW:
+        raise ParameterError(f"follow {follow!r}: must be one of {', '.join(FOLLOW)}")
+    drive = preset.top_drive.with_(mode="kinematic" if follow == "speed" else "speed")
     sim = Simulator(preset.params, SimConfig(dtau=preset.dtau, n_nodes=64), top_drive=drive,
                     scales=preset.scales, string=preset.kernel_string, bit_law=preset.bit_law)
     sim.start_at_rest()
@@ -50,15 +59,17 @@ def sample_steps(preset: Preset, t_s: np.ndarray) -> np.ndarray:
 
 
 def replay_speed(preset: Preset, t_s: np.ndarray, speed_rad_s: np.ndarray,
-                 on_progress: Callable[[float], None] | None = None) -> StartupRun:
+                 on_progress: Callable[[float], None] | None = None,
+                 follow: str = "speed") -> StartupRun:
     """Turn ``preset``'s string from rest with the drive speed ``speed_rad_s`` (rad/s) at the
     times ``t_s`` (s, increasing), linear between them (module doc); the run sampled at
-    those times (t from 0)."""
+    those times (t from 0). ``follow="setpoint"``: ``speed_rad_s`` is the setpoint of the
+    preset's speed loop."""
     speed = np.maximum(np.asarray(speed_rad_s, dtype=float), 0.0)
     if speed.shape != np.shape(t_s) or not np.all(np.isfinite(speed)):
         raise ParameterError("the speeds must be finite, one per sample time")
     steps = sample_steps(preset, t_s)
-    sim = replay_simulator(preset)
+    sim = replay_simulator(preset, follow)
     target = speed * preset.scales.time_s            # kernel units: rad per t*
     rows = np.empty((steps.size, k.N_COLS))
     sim.set_inputs(omega_s=float(target[0]))
