@@ -109,8 +109,9 @@ def one_log(seed: int, data: dict, names: str, client: object, share: float, cac
 
 
 def _spread(cycles: np.ndarray | None) -> list[list[float]] | None:
-    """The mean and standard deviation of period, mean and std over a point's replays."""
-    if cycles is None:
+    """The mean and standard deviation of period, mean and std over a point's replays
+    (None for one replay: ``--follow setpoint`` replays once a point)."""
+    if cycles is None or len(cycles) < 2:
         return None
     return np.column_stack((cycles.mean(axis=0), cycles.std(axis=0, ddof=1))).tolist()
 
