@@ -12,7 +12,9 @@ misfit a smoother function of the parameters, which the optimiser's differences 
 (with 4 replays the misfit along the static coefficient of field_8p5in_deviated was rough
 on the scale of the Jacobian's step, 1.5 % of it, lowest 4 % below the truth; with
 12 it falls steadily to the truth, measured 2026-12-06, benchmarks/fit_replay_bias.py).
-The misfit is the weighted residuals of that average. The fit works
+With ``follow="setpoint"`` a replay follows the log's setpoint through the preset's own
+speed loop instead (:func:`simulate`): no noise to add, one replay a point, no sensitivity
+replays. The misfit is the weighted residuals of that average. The fit works
 in the parameters scaled to their bounds (u = (x - low) / (high - low), in [0, 1]):
 
 1. a global start: the preset's values and ``STARTS_PER_PARAMETER`` x n points of a
