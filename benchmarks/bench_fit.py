@@ -47,6 +47,7 @@ from drill_sim_ros.fit import engine, objective, synthetic
 from drill_sim_ros.fit.params import get_path, parse_fit, with_values
 from drill_sim_ros.model.analysis import lowpass
 from drill_sim_ros.model.presets import preset_from_dict, preset_path, read_preset_data
+from drill_sim_ros.model.replay import FOLLOW
 from drill_sim_ros.study.engine import connect
 from tests.model import fv_cases
 
@@ -157,7 +158,7 @@ def main() -> None:
                     help="a preset name, a YAML path, or tangent (tests/model/fv_cases.py)")
     ap.add_argument("--rpm", default="30", help="R[,R2...]: a start-up a speed")
     ap.add_argument("--ramp-s", default="10", help="S[,S2...]: each start-up's ramp")
-    ap.add_argument("--follow", choices=("speed", "setpoint"), default="speed",
+    ap.add_argument("--follow", choices=FOLLOW, default="speed",
                     help="what the replays' drive follows (drill_sim fit --follow)")
     ap.add_argument("--markdown", action="store_true",
                     help="print each log as a row of docs/fit.md's tables")

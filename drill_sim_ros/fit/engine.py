@@ -66,6 +66,7 @@ from drill_sim_ros.fit.objective import Target, noise_std
 from drill_sim_ros.fit.params import FitParameter, with_values
 from drill_sim_ros.model.analysis import lowpass
 from drill_sim_ros.model.errors import DrillSimError
+from drill_sim_ros.model.params import RPM_PER_RAD_S
 from drill_sim_ros.model.presets import preset_from_dict
 from drill_sim_ros.model.replay import FOLLOW, replay_speed
 
@@ -97,6 +98,11 @@ def require_follow(follow: str, logs: Sequence[SurfaceLog]) -> None:
     if follow == "setpoint" and missing:
         raise DrillSimError(f"--follow setpoint: {missing[0]} has no setpoint column "
                             "(setpoint_rpm or setpoint_rad_s)")
+
+
+def followed_series(log: SurfaceLog, follow: str) -> np.ndarray:
+    """What a replay's drive follows in ``log``: its speed, or its setpoint (rad/s)."""
+    return log.setpoint_rad_s if follow == "setpoint" else log.speed_rad_s
 
 
 def simulate(data: dict[str, Any], values: dict[str, float], t_s: np.ndarray,
@@ -236,9 +242,7 @@ class Evaluator:
                 self.follow)
 
     def _series(self, target: Target) -> np.ndarray:
-        """What the replays' drive follows: the logged speed, or the logged setpoint."""
-        log = target.log
-        return log.setpoint_rad_s if self.follow == "setpoint" else log.speed_rad_s
+        return followed_series(target.log, self.follow)
 
     def _take(self, key: str, segment: int, result: tuple[np.ndarray, np.ndarray] | str
               ) -> None:
@@ -514,7 +518,7 @@ def one_speed_warning(params: Sequence[FitParameter], speeds_rad_s: Sequence[np.
     turning = [float(np.median(s[s.size // 2:])) for s in speeds_rad_s if s.size]
     if not turning or min(turning) <= 0.0 or max(turning) >= SPEED_SPREAD * min(turning):
         return []
-    rpm = [v * 30.0 / math.pi for v in (min(turning), max(turning))]
+    rpm = [v * RPM_PER_RAD_S for v in (min(turning), max(turning))]
     at = f"{rpm[0]:.0f} rpm" if rpm[1] - rpm[0] < 0.5 else f"{rpm[0]:.0f} to {rpm[1]:.0f} rpm"
     return [f"every start-up turns at {at}: at one speed the log can hardly tell "
             f"{VISCOUS_PATH} (a loss growing with speed) from "

@@ -7,13 +7,10 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
-from drill_sim_ros.fit.engine import simulate
+from drill_sim_ros.fit.engine import followed_series, simulate
 from drill_sim_ros.fit.objective import Target
 from drill_sim_ros.model.analysis import lowpass
-
-RPM_PER_RAD_S = 30.0 / np.pi
+from drill_sim_ros.model.params import RPM_PER_RAD_S
 
 
 def plot_fit(path: Path, data: dict[str, Any], params: list, targets: list[Target],
@@ -31,8 +28,8 @@ def plot_fit(path: Path, data: dict[str, Any], params: list, targets: list[Targe
     for col, (target, run) in enumerate(fitted):
         log = target.log
         t = log.t_s - log.t_s[0]
-        series = log.setpoint_rad_s if follow == "setpoint" else log.speed_rad_s
-        before = simulate(data, {}, log.t_s, series, None, target.cutoff_hz, follow)
+        before = simulate(data, {}, log.t_s, followed_series(log, follow), None,
+                          target.cutoff_hz, follow)
         ax = axes[0, col]
         ax.plot(t, log.speed_rad_s * RPM_PER_RAD_S, color="0.6", lw=0.6, label="drive, logged")
         ax.plot(t, run[1] * RPM_PER_RAD_S, color="C1", lw=0.8, label="bit, fitted replay")
