@@ -111,7 +111,7 @@ def one_log(seed: int, data: dict, names: str, client: object, share: float, cac
 
 def _spread(cycles: np.ndarray | None) -> list[list[float]] | None:
     """The mean and standard deviation of period, mean and std over a point's replays
-    (None for one replay: ``--follow setpoint`` replays once a point)."""
+    (None for one replay)."""
     if cycles is None or len(cycles) < 2:
         return None
     return np.column_stack((cycles.mean(axis=0), cycles.std(axis=0, ddof=1))).tolist()
@@ -169,8 +169,8 @@ def main() -> None:
     paths = args.params.split(",")
     first, last = (int(v) for v in args.seeds.split(":"))
     args.dir.mkdir(parents=True, exist_ok=True)
-    tag = (f"{len(paths)}p_{args.start:g}_{args.substeps or 'preset'}_r{engine.REPLAYS_PER_POINT}"
-           "_profile")
+    replays = engine.SETPOINT_REPLAYS if args.follow == "setpoint" else engine.REPLAYS_PER_POINT
+    tag = f"{len(paths)}p_{args.start:g}_{args.substeps or 'preset'}_r{replays}_profile"
     rpms = tuple(float(v) for v in args.rpm.split(","))
     ramps_s = tuple(float(v) for v in args.ramp_s.split(","))
     if len(rpms) != len(ramps_s):

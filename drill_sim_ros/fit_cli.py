@@ -78,8 +78,9 @@ def add_parser(sub: Any) -> None:
                    help="what the replays' drive follows: the logged speed (default), or "
                    "the logged setpoint through the preset's own speed loop (needs a "
                    "setpoint_rpm column and the rig's drive in the preset; no sensor noise "
-                   "in the replayed speed, so one replay a point: --replays is not used; "
-                   "docs/fit.md)")
+                   "in the replayed speed: --replays is not used, each point averages "
+                   f"{engine.SETPOINT_REPLAYS} replays of the setpoint shifted by under half "
+                   "a sample; docs/fit.md)")
     p.add_argument("--json", action="store_true", help="print only the JSON line")
     add_plot_arguments(p, "the recorded and fitted surface speed and torque", "--out")
 

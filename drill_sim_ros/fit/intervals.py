@@ -106,10 +106,11 @@ def profile_intervals(evaluate: Callable[[Sequence[np.ndarray]], list[np.ndarray
     replay_half = np.zeros(n)
     points = 0
     q_replays = float(student.ppf(0.5 + LEVEL / 2, max(1, scatter.shape[0] - 1)))
+    directions = profile_directions(jacobian)
     for i in range(n):
         if c0[i, i] <= 0.0:
             continue                                  # not constrained: the bounds
-        direction = c0[:, i] / c0[i, i]
+        direction = directions[:, i]
         ts, rs = _profile(evaluate, u_best, residuals, i, direction, rise)
         points += ts.size - 1
         misfits = np.array([float(r @ r) for r in rs])
@@ -124,6 +125,21 @@ def profile_intervals(evaluate: Callable[[Sequence[np.ndarray]], list[np.ndarray
         if up is not None:
             high[i] = min(1.0, u_best[i] + np.hypot(up, replay_half[i]))
     return Intervals(low, high, correlation, np.full(n, rise), replay_half, points)
+
+
+def profile_directions(jacobian: np.ndarray) -> np.ndarray:
+    """Column i: d_i = C0[:, i] / C0[i, i], C0 = (J^T J)^-1 (module doc): the direction in u
+    along which parameter i moves by one and the others follow their least-squares optimum
+    under the Jacobian's linear model. Along a pair the log can hardly tell apart (the
+    damping and the dynamic coefficient at one speed) the misfit's valley runs diagonally,
+    and a step along one axis climbs its side (fit.engine's bracket steps along these). A
+    parameter the misfit does not move with keeps its axis."""
+    c0 = np.linalg.pinv(jacobian.T @ jacobian)
+    out = np.eye(jacobian.shape[1])
+    for i in range(out.shape[1]):
+        if c0[i, i] > 0.0:
+            out[:, i] = c0[:, i] / c0[i, i]
+    return out
 
 
 def base_level(ts: np.ndarray, misfits: np.ndarray) -> float:

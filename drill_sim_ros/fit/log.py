@@ -31,15 +31,15 @@ a run of NaN.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
 
 from drill_sim_ros.fit.errors import LogError
+from drill_sim_ros.model.params import RPM_PER_RAD_S
 
-RAD_S_PER_RPM = 2.0 * math.pi / 60.0
+RAD_S_PER_RPM = 1.0 / RPM_PER_RAD_S
 MAX_GAP_RATIO = 1.5          # a step longer than this times the median: a gap
 REST_RPM = 2.0               # the drive at rest below this (its smoothed speed)
 TURNING_RPM = 5.0            # the drive turning above this

@@ -39,6 +39,7 @@ from drill_sim_ros.model.analysis import MODE_COUNT, cutoff_of, lowpass
 from drill_sim_ros.model.checks import number_in
 from drill_sim_ros.model.defaults import MAX_SURFACE_RPM
 from drill_sim_ros.model.errors import ParameterError
+from drill_sim_ros.model.params import RPM_PER_RAD_S
 from drill_sim_ros.model.presets import Preset
 from drill_sim_ros.model.simulator import Samples, SimConfig, Simulator
 from drill_sim_ros.model.string import analytic_modes_hz
@@ -52,7 +53,6 @@ MAX_RAMP_S = 3600.0      # the longest ramp, s
 SAMPLE_HZ_RANGE = (1.0, 10_000.0)
 CHUNK_STEPS = 500_000    # steps between progress reports (rounded to whole samples)
 RAD_PER_TURN = 2.0 * math.pi
-RPM_PER_RAD_S = 60.0 / RAD_PER_TURN
 
 
 @dataclass(frozen=True)

@@ -357,7 +357,8 @@ def test_following_the_logged_setpoint_the_truth_scores_the_torque_noise_alone()
     preset's loop reproduce the true run at the true values, so the misfit there is the
     torque's noise alone: its square a chi-square over the residuals' count divided by it
     (within 4 standard deviations of 1), and lower than with the torsional damping 5 % off
-    or the dynamic coefficient 2 % off. One replay a point: nothing to average."""
+    or the dynamic coefficient 2 % off. The replays of a point follow the setpoint shifted
+    by under half a sample each (engine.shifted_setpoint), which leaves that so."""
     data = fv_cases.tangent()
     data["string"]["bit_substeps"] = COARSE_SUBSTEPS
     preset = preset_from_dict("tangent", data)
@@ -365,7 +366,7 @@ def test_following_the_logged_setpoint_the_truth_scores_the_torque_noise_alone()
     target = objective.make_target(log, preset)
     paths = "well.side_friction.dynamic,string.torsional_damping_per_s"
     evaluator = engine.Evaluator(data, parse_fit(paths, data), [target], follow="setpoint")
-    assert evaluator.replays == 1
+    assert evaluator.replays == engine.SETPOINT_REPLAYS
     truth = np.array([data["well"]["side_friction"]["dynamic"],
                       data["string"]["torsional_damping_per_s"]])
     at = evaluator.evaluate([truth, truth * [1.0, 1.05], truth * [1.0, 0.95],
@@ -373,6 +374,25 @@ def test_following_the_logged_setpoint_the_truth_scores_the_torque_noise_alone()
     n = at[0].residuals.size
     assert abs(at[0].misfit**2 - 1.0) < 4.0 * np.sqrt(2.0 / n)
     assert all(e.misfit > at[0].misfit for e in at[1:])
+
+
+def test_a_shifted_setpoint_is_the_log_moved_by_under_half_a_sample() -> None:
+    """The setpoints a point's replays follow (engine.shifted_setpoint): seed 0 the log's
+    own; the others the same ramp moved in time by one shift each, within half a sample
+    either way (read back from the ramp's straight part: its value over its slope), and
+    the shifts spread over that interval (a mutant that does not shift fails)."""
+    sample_s, slope = 0.01, 4.0                       # 100 Hz, rad/s per s
+    t_s = np.arange(0.0, 1.0, sample_s)
+    ramp = np.minimum(slope * t_s, 2.0)               # 0 to 2 rad/s in 0.5 s, then held
+    assert engine.shifted_setpoint(t_s, ramp, 0) is ramp
+    inside = (t_s > 0.05) & (t_s < 0.45)
+    shifts = []
+    for seed in range(1, 51):
+        lag_s = t_s[inside] - engine.shifted_setpoint(t_s, ramp, seed)[inside] / slope
+        assert np.ptp(lag_s) < 1e-12                  # one shift for the whole series
+        shifts.append(lag_s[0])
+    assert np.max(np.abs(shifts)) <= sample_s / 2
+    assert np.ptp(shifts) > 0.6 * sample_s
 
 
 def test_following_a_setpoint_the_log_does_not_have_is_refused_in_one_line(tmp_path,
