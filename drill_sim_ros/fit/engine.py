@@ -15,13 +15,18 @@ on the scale of the Jacobian's step, 1.5 % of it, lowest 4 % below the truth; wi
 With ``follow="setpoint"`` a replay follows the log's setpoint through the preset's own
 speed loop instead (:func:`simulate`): no sensor noise to add and no sensitivity replays;
 ``SETPOINT_REPLAYS`` replays a point, each following the setpoint shifted in time by a
-seeded draw within half a sample (:func:`shifted_setpoint`; seed 0 unshifted). One replay
-a point left the misfit rough on a scale of a fraction of a % of the parameters (the wall's
-junctions let go at thresholds; along a segment from a joint fit to the truth on the
-tangent it jumped by up to 15 % between points 0.3 % of the damping apart), and least
-squares stopped in its shoulders: four of 20 joint fits 6.5 to 13.8 % high in the damping,
-each scoring above the truth; averaged over four shifts, two of those re-fitted within
-4.4 % (docs/fit.md). The misfit is the weighted residuals of that average. The fit works
+seeded draw within half a sample (:func:`shifted_setpoint`; seed 0 unshifted); and every
+step of the search and of the profile ``SETPOINT_STEP_SHARE`` times its size below. Both
+answer to how sharp and rough that misfit is (the wind-up's weights carry no speed noise;
+measured on the tangent's two-speed logs, 2026-12-07, docs/fit.md): one replay a point
+left it rough on a scale of a fraction of a % of the parameters (the wall's junctions let
+go at thresholds: along a segment from a joint fit to the truth it rose by 0.17 in all on
+the way down 0.21, against 0.09 on the way down 0.62 with four shifted replays,
+benchmarks/fit_setpoint_roughness.py), and least squares stopped in its shoulders; with
+the four, the Jacobian's 1 % of the range (5 % of the tangent's static coefficient, whose
+basin is under 1 % wide) still stopped a fit at +6.9 % of the damping scoring 1.46 where
+the truth scores 0.95, and a fifth of the steps reached the truth's basin.
+The misfit is the weighted residuals of that average. The fit works
 in the parameters scaled to their bounds (u = (x - low) / (high - low), in [0, 1]):
 
 1. a global start: the preset's values and ``STARTS_PER_PARAMETER`` x n points of a
@@ -35,8 +40,9 @@ in the parameters scaled to their bounds (u = (x - low) / (high - low), in [0, 1
    squares again from the best point so far under those weights (``PASSES`` in all);
 3. a bracket: the points ``BRACKET_STEPS`` on either side of the optimum along each
    parameter (2 and 4 % of its range; 3.3 and 6.6 % of field_8p5in_deviated's static
-   coefficient), and least squares again from the best of them if it is better, up to
-   ``BRACKET_ROUNDS`` times: the misfit, an average
+   coefficient), the others following along the misfit's valley (fit.intervals'
+   profile directions; for one parameter, its axis), and least squares again from the
+   best of them if it is better, up to ``BRACKET_ROUNDS`` times: the misfit, an average
    of replays whose slips move with the smallest change, is rough on the scale of the
    Jacobian's differences, and least squares stopped in a shoulder of it 5 % below the
    static coefficient's truth, where the misfit at the truth was lower (measured
@@ -90,6 +96,8 @@ REPLAYS_PER_POINT = 12        # replays averaged per parameter vector (common se
 PASSES = 2                    # least-squares passes, the weights measured anew after each
 LOCAL_STARTS = 3              # the first pass starts from the best this many points
 BRACKET_STEPS = (0.02, 0.04)  # in u: the points tried on either side of the optimum
+SETPOINT_STEP_SHARE = 0.2     # following a setpoint, every step above (and the profile's)
+#                               times this: its misfit is sharper (module doc)
 BRACKET_ROUNDS = 3            # at most this many restarts from a better one of them
 CORRELATED = 0.95             # |correlation| above this: the log cannot tell the two apart
 VISCOUS_PATH = "string.torsional_damping_per_s"   # a loss torque that grows with speed ...
@@ -429,6 +437,7 @@ def fit(evaluator: Evaluator, seed: int = 0) -> FitResult:
     low = np.array([p.low for p in params])
     span = np.array([p.high for p in params]) - low
     x0 = np.array([p.initial for p in params])
+    share = SETPOINT_STEP_SHARE if evaluator.follow == "setpoint" else 1.0   # the steps'
 
     def x_of(u: np.ndarray) -> np.ndarray:
         return low + span * np.clip(u, 0.0, 1.0)
@@ -455,7 +464,7 @@ def fit(evaluator: Evaluator, seed: int = 0) -> FitResult:
         return evaluator.evaluate([x_of(u)])[0].residuals
 
     def jac(u: np.ndarray) -> np.ndarray:
-        steps = [_step(u, i) for i in range(u.size)]
+        steps = [_step(u, i, JACOBIAN_STEP * share) for i in range(u.size)]
         points = [x_of(u), *[x_of(u + h) for h in steps]]
         evals = evaluator.evaluate(points)
         count[0] += len(points) - 1
@@ -479,7 +488,7 @@ def fit(evaluator: Evaluator, seed: int = 0) -> FitResult:
     for _ in range(BRACKET_ROUNDS):
         u_now = (best.x - low) / span
         valleys = profile_directions(jac(u_now))
-        nearby = evaluator.evaluate([x_of(u) for u in _bracket(u_now, valleys)])
+        nearby = evaluator.evaluate([x_of(u) for u in _bracket(u_now, valleys, share)])
         count[0] += len(nearby)
         points += [e.x for e in nearby]
         better = min(nearby, key=lambda e: e.misfit)
@@ -497,7 +506,7 @@ def fit(evaluator: Evaluator, seed: int = 0) -> FitResult:
     bands = profile_intervals(
         lambda us: [e.residuals for e in evaluator.evaluate([x_of(u) for u in us])],
         u_best, best.residuals, jacobian, evaluator.sensitivity_scatter(), evaluator.replays,
-        evaluator.misfit_sd(best.x))
+        evaluator.misfit_sd(best.x), share)
     count[0] += bands.points
     stage("intervals")
     warnings = [*one_speed_warning(params, [t.log.speed_rad_s for t in evaluator.targets]),
@@ -509,22 +518,23 @@ def fit(evaluator: Evaluator, seed: int = 0) -> FitResult:
                      tuple(evaluator.replayed_cycles(best.x)))
 
 
-def _bracket(u: np.ndarray, directions: np.ndarray) -> list[np.ndarray]:
-    """The points ``BRACKET_STEPS`` (in u) on either side of ``u`` along each parameter's
-    valley (``directions[:, i]``, its entry i one: fit.intervals.profile_directions),
-    parameter i within its bounds, the others clipped to theirs (module doc, step 3)."""
+def _bracket(u: np.ndarray, directions: np.ndarray, share: float = 1.0) -> list[np.ndarray]:
+    """The points ``BRACKET_STEPS`` times ``share`` (in u) on either side of ``u`` along
+    each parameter's valley (``directions[:, i]``, its entry i one:
+    fit.intervals.profile_directions), parameter i within its bounds, the others clipped
+    to theirs (module doc, step 3)."""
     out = []
     for i in range(u.size):
-        for h in (*BRACKET_STEPS, *(-h for h in BRACKET_STEPS)):
+        for h in (share * b for b in (*BRACKET_STEPS, *(-b for b in BRACKET_STEPS))):
             if 0.0 <= u[i] + h <= 1.0:
                 out.append(np.clip(u + h * directions[:, i], 0.0, 1.0))
     return out
 
 
-def _step(u: np.ndarray, i: int) -> np.ndarray:
+def _step(u: np.ndarray, i: int, size: float) -> np.ndarray:
     """The forward step of parameter ``i`` (backward at the upper bound)."""
     h = np.zeros_like(u)
-    h[i] = JACOBIAN_STEP if u[i] + JACOBIAN_STEP <= 1.0 else -JACOBIAN_STEP
+    h[i] = size if u[i] + size <= 1.0 else -size
     return h
 
 

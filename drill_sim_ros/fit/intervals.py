@@ -82,14 +82,15 @@ def jacobian_covariance(jacobian: np.ndarray, residuals: np.ndarray, scatter: np
 
 def profile_intervals(evaluate: Callable[[Sequence[np.ndarray]], list[np.ndarray]],
                       u_best: np.ndarray, residuals: np.ndarray, jacobian: np.ndarray,
-                      scatter: np.ndarray, replays: int, misfit_sd: float = 0.0
-                      ) -> Intervals:
+                      scatter: np.ndarray, replays: int, misfit_sd: float = 0.0,
+                      step_share: float = 1.0) -> Intervals:
     """The intervals of each parameter (module doc). ``evaluate``: the weighted residual
     vectors of points in u (within [0, 1]); ``residuals`` and ``jacobian`` at ``u_best``;
     ``scatter`` (sensitivity replays, residuals): their weighted deviations from their
     mean (none: zero rows); ``replays`` averaged a point; ``misfit_sd``: the standard
     deviation of the misfit at the optimum over the draws of those replays
-    (:func:`jackknife_sd`)."""
+    (:func:`jackknife_sd`); ``step_share``: the profile's steps are ``PROFILE_STEPS`` times
+    this (fit.engine: smaller for the sharper misfit of replays that follow a setpoint)."""
     from scipy.stats import f as fisher
     from scipy.stats import norm
     from scipy.stats import t as student
@@ -111,7 +112,7 @@ def profile_intervals(evaluate: Callable[[Sequence[np.ndarray]], list[np.ndarray
         if c0[i, i] <= 0.0:
             continue                                  # not constrained: the bounds
         direction = directions[:, i]
-        ts, rs = _profile(evaluate, u_best, residuals, i, direction, rise)
+        ts, rs = _profile(evaluate, u_best, residuals, i, direction, rise, step_share)
         points += ts.size - 1
         misfits = np.array([float(r @ r) for r in rs])
         if scatter.shape[0] >= 2:
@@ -192,7 +193,7 @@ def jackknife_sd(statistic: Callable[[np.ndarray], float], samples: np.ndarray) 
 
 def _profile(evaluate: Callable[[Sequence[np.ndarray]], list[np.ndarray]],
              u_best: np.ndarray, residuals: np.ndarray, index: int, direction: np.ndarray,
-             rise: float) -> tuple[np.ndarray, list[np.ndarray]]:
+             rise: float, step_share: float = 1.0) -> tuple[np.ndarray, list[np.ndarray]]:
     """The profile's points t (the step along the parameter) and their residuals: the
     optimum, ``PROFILE_STEPS`` on either side, then the farthest step doubled while a side
     does not rise by ``rise`` (at most ``PROFILE_EXTENSIONS`` times). A point keeps
@@ -211,8 +212,8 @@ def _profile(evaluate: Callable[[Sequence[np.ndarray]], list[np.ndarray]],
                 wanted.append((t, np.clip(u_best + t * direction, 0.0, 1.0)))
         ts.extend(t for t, _ in wanted)
         rs.extend(evaluate([u for _, u in wanted]))
-    add([s * side for s in PROFILE_STEPS for side in (1.0, -1.0)])
-    step = max(PROFILE_STEPS)
+    add([step_share * s * side for s in PROFILE_STEPS for side in (1.0, -1.0)])
+    step = step_share * max(PROFILE_STEPS)
     for _ in range(PROFILE_EXTENSIONS):
         t_now, misfits = np.array(ts), np.array([float(r @ r) for r in rs])
         missing = [side for side in (1.0, -1.0)
