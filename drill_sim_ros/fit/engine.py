@@ -15,17 +15,20 @@ on the scale of the Jacobian's step, 1.5 % of it, lowest 4 % below the truth; wi
 With ``follow="setpoint"`` a replay follows the log's setpoint through the preset's own
 speed loop instead (:func:`simulate`): no sensor noise to add and no sensitivity replays;
 ``SETPOINT_REPLAYS`` replays a point, each following the setpoint shifted in time by a
-seeded draw within half a sample (:func:`shifted_setpoint`; seed 0 unshifted); and every
-step of the search and of the profile ``SETPOINT_STEP_SHARE`` times its size below. Both
-answer to how sharp and rough that misfit is (the wind-up's weights carry no speed noise;
-measured on the tangent's two-speed logs, 2026-12-07, docs/fit.md): one replay a point
-left it rough on a scale of a fraction of a % of the parameters (the wall's junctions let
-go at thresholds: along a segment from a joint fit to the truth it rose by 0.17 in all on
-the way down 0.21, against 0.09 on the way down 0.62 with four shifted replays,
-benchmarks/fit_setpoint_roughness.py), and least squares stopped in its shoulders; with
-the four, the Jacobian's 1 % of the range (5 % of the tangent's static coefficient, whose
-basin is under 1 % wide) still stopped a fit at +6.9 % of the damping scoring 1.46 where
-the truth scores 0.95, and a fifth of the steps reached the truth's basin.
+seeded draw within half a sample (:func:`shifted_setpoint`; seed 0 unshifted); and after
+the first least-squares pass, every step (the Jacobian's, the bracket's, the profile's)
+``SETPOINT_STEP_SHARE`` times its size below. Both answer to how sharp and rough that
+misfit is (the wind-up's weights carry no speed noise; measured on the tangent's two-speed
+logs, 2026-12-07, docs/fit.md): one replay a point left it rough on a scale of a fraction
+of a % of the parameters (the wall's junctions let go at thresholds: along a segment from
+a joint fit to the truth it rose by 0.17 in all on the way down 0.21, against 0.09 on the
+way down 0.62 with four shifted replays, benchmarks/fit_setpoint_roughness.py), and least
+squares stopped in its shoulders. With the four, the Jacobian's 1 % of the range (5 % of
+the tangent's static coefficient, whose basin is under 1 % wide) still stopped a fit at
++6.9 % of the damping scoring 1.46 where the truth scores 0.95; a fifth of it everywhere
+reached the truth's basin there, but stopped another fit from 15 % below at +27 % (misfit
+2.37 against 0.84) which the full step had brought to +2.7 %. So the first pass takes the
+full step (into the basin), the rest a fifth (down it).
 The misfit is the weighted residuals of that average. The fit works
 in the parameters scaled to their bounds (u = (x - low) / (high - low), in [0, 1]):
 
@@ -96,8 +99,8 @@ REPLAYS_PER_POINT = 12        # replays averaged per parameter vector (common se
 PASSES = 2                    # least-squares passes, the weights measured anew after each
 LOCAL_STARTS = 3              # the first pass starts from the best this many points
 BRACKET_STEPS = (0.02, 0.04)  # in u: the points tried on either side of the optimum
-SETPOINT_STEP_SHARE = 0.2     # following a setpoint, every step above (and the profile's)
-#                               times this: its misfit is sharper (module doc)
+SETPOINT_STEP_SHARE = 0.2     # following a setpoint, every step above after the first pass
+#                               (and the profile's) times this: a sharper misfit (module doc)
 BRACKET_ROUNDS = 3            # at most this many restarts from a better one of them
 CORRELATED = 0.95             # |correlation| above this: the log cannot tell the two apart
 VISCOUS_PATH = "string.torsional_damping_per_s"   # a loss torque that grows with speed ...
@@ -437,7 +440,8 @@ def fit(evaluator: Evaluator, seed: int = 0) -> FitResult:
     low = np.array([p.low for p in params])
     span = np.array([p.high for p in params]) - low
     x0 = np.array([p.initial for p in params])
-    share = SETPOINT_STEP_SHARE if evaluator.follow == "setpoint" else 1.0   # the steps'
+    share = SETPOINT_STEP_SHARE if evaluator.follow == "setpoint" else 1.0
+    jacobian_step = [JACOBIAN_STEP]       # the first pass's; then ``share`` times it
 
     def x_of(u: np.ndarray) -> np.ndarray:
         return low + span * np.clip(u, 0.0, 1.0)
@@ -464,7 +468,7 @@ def fit(evaluator: Evaluator, seed: int = 0) -> FitResult:
         return evaluator.evaluate([x_of(u)])[0].residuals
 
     def jac(u: np.ndarray) -> np.ndarray:
-        steps = [_step(u, i, JACOBIAN_STEP * share) for i in range(u.size)]
+        steps = [_step(u, i, jacobian_step[0]) for i in range(u.size)]
         points = [x_of(u), *[x_of(u + h) for h in steps]]
         evals = evaluator.evaluate(points)
         count[0] += len(points) - 1
@@ -472,7 +476,8 @@ def fit(evaluator: Evaluator, seed: int = 0) -> FitResult:
                    for e, h in zip(evals[1:], steps, strict=True)]
         return np.column_stack(columns)
 
-    for starts_now in (LOCAL_STARTS, *[1] * (PASSES - 1)):
+    for pass_index, starts_now in enumerate((LOCAL_STARTS, *[1] * (PASSES - 1))):
+        jacobian_step[0] = JACOBIAN_STEP * (1.0 if pass_index == 0 else share)
         tried = sorted(evaluator.evaluate(points), key=lambda e: e.misfit)  # weighted anew
         ends = []
         for start in tried[:starts_now]:

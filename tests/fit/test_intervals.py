@@ -158,3 +158,26 @@ def test_a_profile_that_meets_another_parameters_bound_rises_there() -> None:
     assert -1.2 < slope < -0.8 and free > 0.08 > 0.05 / -slope   # the case is as described
     assert bounded < 0.08
     assert bands.high[0] - u_best[0] == pytest.approx(bounded, rel=0.15)
+
+
+def test_a_profile_direction_moves_the_other_parameter_to_its_conditional_optimum() -> None:
+    """For two parameters, the profile's (and the bracket's) direction of parameter i moves
+    it by one and the other j by the least-squares optimum of |J_i + J_j d|^2 over d,
+    d = -(J_i . J_j) / (J_j . J_j) (the projection, computed here without the inverse the
+    code uses); the bracket's points lie on those lines, ``share`` times its steps out."""
+    from drill_sim_ros.fit import engine
+    from drill_sim_ros.fit.intervals import profile_directions
+    a = _design(np.random.default_rng(7))
+    directions = profile_directions(a)
+    for i, j in ((0, 1), (1, 0)):
+        assert directions[i, i] == pytest.approx(1.0)
+        assert directions[j, i] == pytest.approx(-(a[:, i] @ a[:, j]) / (a[:, j] @ a[:, j]))
+    assert abs(directions[1, 0]) > 0.3                # correlated: not the axis
+    u = np.array([0.5, 0.5])
+    points = engine._bracket(u, directions, 0.5)
+    steps = [0.5 * h for h in engine.BRACKET_STEPS]
+    expected = [u + s * side * directions[:, i] for i in (0, 1) for side in (1, -1)
+                for s in steps]
+    assert len(points) == len(expected)
+    for p in points:
+        assert min(np.max(np.abs(p - e)) for e in expected) < 1e-12
