@@ -4,6 +4,7 @@ examples/lockstep_controller.py, no helper of this package.
 
     python tests/ros/plain_controllers.py --report PATH [--kind a|b|c] [--kickoff-stamp
         now|zero] [--stop-at-s 30] [--die-at-s T] [--extras] [--flood N [--depth D]]
+        [--go-file PATH]
 
 - a: answers every sample of drill/surface/measured, stamped with the sample's stamp, once
   its publisher has matched (an answer sent before is lost: docs/control-loop.md);
@@ -17,6 +18,9 @@ examples/lockstep_controller.py, no helper of this package.
 - --depth D: its publisher keeps the last D commands (10, rclpy's usual; 0: all of them, so
   DDS delivers every one and none is lost; the flood then waits for the sim to acknowledge
   every KEPT_BURST commands, as a writer keeping all refuses more once full).
+- --go-file: answers nothing until PATH exists; once its publisher has matched and it holds
+  a sample (the sim's latest, kept for late joiners), it writes PATH.ready-<pid> (the test's
+  start signal, so that two controllers begin together);
 On the first sample stamped --stop-at-s or later it answers nothing more, writes one JSON
 object (commands sent, extras, answers) to --report and spins until SIGINT.
 """
@@ -86,13 +90,21 @@ class PlainController(Node):
 
     def answer_held(self) -> None:
         if self.held is not None and self.pub.get_subscription_count() > 0:
+            if not self.going():
+                return self.say_ready()
             sample, self.held = self.held, None
             self.on_sample(sample)
 
+    def going(self) -> bool:
+        return self.args.go_file is None or Path(self.args.go_file).exists()
+
+    def say_ready(self) -> None:
+        Path(f"{self.args.go_file}.ready-{os.getpid()}").touch()
+
     def on_sample(self, sample: JointState) -> None:
-        if self.pub.get_subscription_count() == 0:   # an answer now would be lost
-            self.held = sample                       # (docs/control-loop.md)
-            return
+        if self.pub.get_subscription_count() == 0 or not self.going():
+            self.held = sample                       # an answer now would be lost
+            return                                   # (docs/control-loop.md), or early
         time_ns = sample.header.stamp.sec * 10**9 + sample.header.stamp.nanosec
         if self.done:
             return
@@ -140,6 +152,7 @@ def main() -> None:
     parser.add_argument("--extras", action="store_true")
     parser.add_argument("--flood", type=int, default=0)
     parser.add_argument("--depth", type=int, default=10)
+    parser.add_argument("--go-file")
     args = parser.parse_args()
     rclpy.init()
     node = PlainController(args)

@@ -242,21 +242,28 @@ def test_a_controller_killed_mid_run_and_restarted_resumes_from_the_latest_sampl
 # ---- more commands than samples ---------------------------------------------------------
 def test_two_controllers_at_once_advance_the_sim_once_per_sample(tmp_path):
     reports = [tmp_path / "one.json", tmp_path / "two.json"]
+    go = tmp_path / "go"
     with ros_context() as ros, \
-            running(controller_command(reports[0]), tmp_path / "one.log") as one, \
-            running(controller_command(reports[1]), tmp_path / "two.log") as two:
+            running(controller_command(reports[0], "--go-file", str(go)),
+                    tmp_path / "one.log") as one, \
+            running(controller_command(reports[1], "--go-file", str(go)),
+                    tmp_path / "two.log") as two:
         watch = Watch(ros)
-        # both up before the sim: the one ready first would otherwise run all the periods
-        # while the other still starts (a loaded machine: [0, 3000] answers, 2026-12-06)
-        watch.subscribers(topics.SURFACE_MEASURED, 2)
         record, log, sim_cm = sim_and_watch(tmp_path, PATIENT_WARN_S)
         with sim_cm as sim:
+            # both matched and holding the t = 0 sample before either answers: the one ready
+            # first would otherwise run all the periods while DDS still matches the other
+            # (on a loaded machine: [0, 3000] answers, 2026-12-06 and in CI, 2026-12-07)
+            assert ros.spin_until(lambda: len(list(tmp_path.glob("go.ready-*"))) == 2,
+                                  RUN_TIMEOUT_S), "the two controllers never both matched"
+            go.touch()
             answered = [watch.report(r)["sent"] for r in reports]
             sent = sum(answered)
-            # both answer every sample they take; on a loaded machine a late one finds the
-            # next sample already (depth 1) and the two may take turns, so duplicates are
-            # likely but not certain: every answer beyond one per sample is stale
-            assert sent >= PERIODS and min(answered) > 0, answered
+            # both answer t = 0 (one of them stale) and every sample they take after; on a
+            # loaded machine a late one finds the next sample already (depth 1), so
+            # duplicates are likely but not certain: every answer beyond one per sample is
+            # stale
+            assert sent >= PERIODS + 1 and min(answered) > 0, answered
             last = watch.count("stale_commands", sent - PERIODS)
             rows = finish(sim, log, record, [one, two])
     assert last["command_publishers"] == "2" and last["lost_commands"] == "0"
