@@ -60,8 +60,7 @@ def main() -> None:
           f"{args.points} points")
     for replays in (1, args.replays):
         evaluator = engine.Evaluator(data, parse_fit(PARAMS, data), targets,
-                                     follow="setpoint")
-        evaluator.replays = replays
+                                     replays=replays, follow="setpoint")
         misfits = segment_misfits(evaluator, start, truth, args.points)
         steps = np.diff(misfits)
         print(f"{replays} replay(s) a point: " + " ".join(f"{m:.3f}" for m in misfits))

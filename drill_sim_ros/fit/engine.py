@@ -201,12 +201,13 @@ class Evaluator:
     def __init__(self, data: dict[str, Any], params: Sequence[FitParameter],
                  targets: Sequence[Target], client: Any = None, cache: Path | None = None,
                  progress: Callable[[str], None] | None = None,
-                 replays: int = REPLAYS_PER_POINT, follow: str = "speed") -> None:
+                 replays: int | None = None, follow: str = "speed") -> None:
         self.data, self.params, self.targets = data, list(params), list(targets)
         self.follow = follow                   # what the replays' drive follows
         require_follow(follow, [t.log for t in self.targets])
         # a replay of a setpoint has no noise to average over, but shifts of its timing
-        self.replays = SETPOINT_REPLAYS if follow == "setpoint" else replays
+        default = SETPOINT_REPLAYS if follow == "setpoint" else REPLAYS_PER_POINT
+        self.replays = default if replays is None else replays
         self.client, self.cache, self.progress = client, cache, progress
         self.done: dict[str, list[float] | str] = {}
         self.computed = self.reused = 0

@@ -72,7 +72,7 @@ def jacobian_covariance(jacobian: np.ndarray, residuals: np.ndarray, scatter: np
                         replays: int) -> np.ndarray:
     """The parameters' covariance in u from the Jacobian (module doc, last paragraph)."""
     s2, _ = noise_level(residuals, jacobian.shape[1])
-    cov = s2 * np.linalg.pinv(jacobian.T @ jacobian)
+    cov = s2 * unscaled_covariance(jacobian)
     if scatter.shape[0] >= 2:
         shifts = scatter @ np.linalg.pinv(jacobian).T
         n = jacobian.shape[1]
@@ -98,7 +98,7 @@ def profile_intervals(evaluate: Callable[[Sequence[np.ndarray]], list[np.ndarray
     s2, dof = noise_level(residuals, n)
     rise = s2 * float(fisher.ppf(LEVEL, 1, dof)) + \
         float(norm.ppf(LEVEL)) * np.sqrt(2.0) * misfit_sd
-    c0 = np.linalg.pinv(jacobian.T @ jacobian)
+    c0 = unscaled_covariance(jacobian)
     cov = jacobian_covariance(jacobian, residuals, scatter, replays)
     sd = np.sqrt(np.maximum(np.diag(cov), 0.0))
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -128,6 +128,11 @@ def profile_intervals(evaluate: Callable[[Sequence[np.ndarray]], list[np.ndarray
     return Intervals(low, high, correlation, np.full(n, rise), replay_half, points)
 
 
+def unscaled_covariance(jacobian: np.ndarray) -> np.ndarray:
+    """C0 = (J^T J)^-1 (pseudo-inverse: a parameter the misfit ignores gets a zero row)."""
+    return np.linalg.pinv(jacobian.T @ jacobian)
+
+
 def profile_directions(jacobian: np.ndarray) -> np.ndarray:
     """Column i: d_i = C0[:, i] / C0[i, i], C0 = (J^T J)^-1 (module doc): the direction in u
     along which parameter i moves by one and the others follow their least-squares optimum
@@ -135,7 +140,7 @@ def profile_directions(jacobian: np.ndarray) -> np.ndarray:
     damping and the dynamic coefficient at one speed) the misfit's valley runs diagonally,
     and a step along one axis climbs its side (fit.engine's bracket steps along these). A
     parameter the misfit does not move with keeps its axis."""
-    c0 = np.linalg.pinv(jacobian.T @ jacobian)
+    c0 = unscaled_covariance(jacobian)
     out = np.eye(jacobian.shape[1])
     for i in range(out.shape[1]):
         if c0[i, i] > 0.0:
