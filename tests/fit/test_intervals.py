@@ -181,3 +181,37 @@ def test_a_profile_direction_moves_the_other_parameter_to_its_conditional_optimu
     assert len(points) == len(expected)
     for p in points:
         assert min(np.max(np.abs(p - e)) for e in expected) < 1e-12
+
+
+def _parabola_bands(plateau: float | None, misfit_sd: float = 5.0):
+    """The interval of one parameter whose misfit is 100 + 1e5 (u - 0.5)^2, or below
+    u = 0.485 (between the profile's first and second steps down) ``plateau``: a misfit that
+    jumps there and stays, as when a replay's break-away moves by a sample."""
+    size = 100
+
+    def residuals(u: np.ndarray) -> np.ndarray:
+        t = float(u[0]) - 0.5
+        misfit = plateau if plateau is not None and t < -0.015 else 100.0 + 1e5 * t**2
+        return np.full(size, np.sqrt(misfit / size))
+    u_best = np.array([0.5])
+    return profile_intervals(lambda us: [residuals(u) for u in us], u_best,
+                             residuals(u_best), np.ones((size, 1)), np.zeros((0, size)),
+                             REPLAYS, misfit_sd)
+
+
+def test_a_cliff_on_one_side_does_not_move_the_other_sides_bound() -> None:
+    """On a parabola the interval's half-width is sqrt(rise / 1e5), rise = s^2 F(0.95; 1,
+    dof) + z(0.95) sqrt(2) sd. A cliff on one side (the misfit jumps to 50 times the
+    optimum's beyond the first step) puts that side's bound between the step below and the
+    cliff, and leaves the other side's as it is (a parabola fitted through the cliff's
+    points lifted the level the rise is counted from: that bound moved five times as far)."""
+    from scipy.stats import f as fisher
+    from scipy.stats import norm
+    dof = 100 - 1
+    rise = 100.0 / dof * fisher.ppf(0.95, 1, dof) + norm.ppf(0.95) * np.sqrt(2.0) * 5.0
+    half = np.sqrt(rise / 1e5)
+    smooth, cliffed = _parabola_bands(None), _parabola_bands(5e3)
+    assert smooth.low[0] == pytest.approx(0.5 - half, abs=1e-9)
+    assert smooth.high[0] == pytest.approx(0.5 + half, abs=1e-9)
+    assert cliffed.high[0] == pytest.approx(0.5 + half, abs=1e-9)
+    assert 0.48 <= cliffed.low[0] <= 0.49
