@@ -13,6 +13,7 @@ import pytest
 from drill_sim_ros import cli
 from drill_sim_ros.fit.log import read_log
 from drill_sim_ros.model.params import RPM_PER_RAD_S
+from drill_sim_ros.model.presets import DEFAULT_PRESET, load_preset
 from drill_sim_ros.model.telemetry import TELEMETRY_INDEX as F
 from drill_sim_ros.viz.mcap_telemetry import read_telemetry
 from tests.archive.helpers import BIN
@@ -45,6 +46,15 @@ def test_the_recordings_surface_signals_are_the_telemetrys(recording) -> None:
     np.testing.assert_allclose(log.hook_load_n, row[:, F["hook_load_n"]], rtol=1e-12)
     motor = read_log(recording, "motor")
     np.testing.assert_allclose(motor.torque_nm, row[:, F["motor_torque_nm"]], rtol=1e-12)
+
+
+def test_the_recordings_setpoint_is_the_presets_speed(recording) -> None:
+    """``--follow setpoint`` reads the drive's setpoint from the telemetry recorded beside:
+    the default run holds its preset's surface speed from the first sample."""
+    log = read_log(recording, "string")
+    rpm = load_preset(DEFAULT_PRESET).physical.surface_rpm
+    assert log.setpoint_rad_s is not None and log.setpoint_rad_s.size == log.t_s.size
+    np.testing.assert_allclose(log.setpoint_rad_s * RPM_PER_RAD_S, rpm, rtol=1e-9)
 
 
 def test_a_recording_without_a_start_up_is_refused_in_one_line(recording, capsys) -> None:
