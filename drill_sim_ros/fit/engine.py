@@ -310,6 +310,12 @@ class Evaluator:
         target = self.targets[segment]
         return (np.asarray(raw) - target.logged) / self.sigma[segment]
 
+    def _replays_at(self, segment: int, x: np.ndarray) -> np.ndarray | None:
+        """The compared values of each replay averaged at an evaluated ``x`` for start-up
+        ``segment``, shape (replays, values); None when one was refused."""
+        raws = [self.done[f"{self._key(segment, x)}:r{r}"] for r in range(self.replays)]
+        return None if any(isinstance(r, str) for r in raws) else np.array(raws)
+
     def replayed_cycles(self, x: np.ndarray) -> list[np.ndarray | None]:
         """Per start-up, the torque's cycle (period s, mean and standard deviation N m;
         :meth:`Target.cycle_of`) in each of the replays averaged at the evaluated ``x``,
@@ -319,9 +325,8 @@ class Evaluator:
         smallest change of the speed replayed, and of the parameters (docs/fit.md)."""
         cycles: list[np.ndarray | None] = []
         for s, target in enumerate(self.targets):
-            raws = [self.done[f"{self._key(s, x)}:r{r}"] for r in range(self.replays)]
-            ok = not any(isinstance(r, str) for r in raws)
-            rows = [target.cycle_of(np.asarray(r)) for r in raws] if ok else [None]
+            raws = self._replays_at(s, x)
+            rows = [None] if raws is None else [target.cycle_of(r) for r in raws]
             cycles.append(None if any(r is None for r in rows) else np.array(rows))
         return cycles
 
@@ -330,22 +335,43 @@ class Evaluator:
         replays at ``x`` that follow the logged speed with fresh noise of its own size
         (fit.objective's module doc); measured at several points, the largest holds (the
         scatter depends on the parameters). Not when the replays follow a setpoint: they
-        carry no speed noise to be sensitive to."""
+        carry no speed noise to be sensitive to (:meth:`measure_timing` instead)."""
         if self.follow == "setpoint":
             return
+        for s, raws in enumerate(self._sensitivity_replays(x)):
+            if raws is not None:
+                self.sensitivity[s] = raws
+                scatter = np.std(raws, axis=0, ddof=1)
+                self.sigma[s] = np.sqrt(np.maximum(self.sigma[s]**2,
+                                                   self.targets[s].noise_sigma**2 + scatter**2))
+
+    def measure_timing(self, x: np.ndarray) -> None:
+        """Following a setpoint: ``SENSITIVITY_REPLAYS`` replays at ``x``, each following the
+        setpoint shifted by a draw of its own (:func:`shifted_setpoint`, seeds from
+        ``SENSITIVITY_SEED``), draws of what the log cannot tell, the true drive's timing
+        between its samples: the intervals' scatter (:meth:`sensitivity_scatter`,
+        fit.intervals item 3). They do not join the weights, which stay the log's noise
+        (the shifts move a compared value by 0.1-0.3 of it, RMS, on the tangent's log,
+        tests/fit/test_fit.py). Not when the replays follow the logged speed."""
+        if self.follow != "setpoint":
+            return
+        self.sensitivity = self._sensitivity_replays(x)
+
+    def _sensitivity_replays(self, x: np.ndarray) -> list[np.ndarray | None]:
+        """Per start-up, the compared values of ``SENSITIVITY_REPLAYS`` replays at ``x``
+        seeded from ``SENSITIVITY_SEED`` (run where not cached), shape (replays, values);
+        None where fewer than two were not refused."""
         jobs = [(0, s, r) for s in range(len(self.targets)) for r in range(SENSITIVITY_REPLAYS)]
         keys = [f"{self._key(s, x)}:sensitivity{r}" for _, s, r in jobs]
         todo = [(key, job) for key, job in zip(keys, jobs, strict=True) if key not in self.done]
         self._map([self._args([x], job, SENSITIVITY_SEED) for _, job in todo],
                   lambda i, result: self._take(todo[i][0], todo[i][1][1], result))
-        for s, target in enumerate(self.targets):
+        replays = []
+        for s in range(len(self.targets)):
             raws = [self.done[key] for key, job in zip(keys, jobs, strict=True) if job[1] == s]
             raws = [r for r in raws if not isinstance(r, str)]
-            if len(raws) >= 2:
-                self.sensitivity[s] = np.array(raws)
-                scatter = np.std(np.array(raws), axis=0, ddof=1)
-                self.sigma[s] = np.sqrt(np.maximum(self.sigma[s]**2,
-                                                   target.noise_sigma**2 + scatter**2))
+            replays.append(np.array(raws) if len(raws) >= 2 else None)
+        return replays
 
     def misfit_sd(self, x: np.ndarray) -> float:
         """The standard deviation of the misfit (the sum of the squared residuals) at an
@@ -353,20 +379,21 @@ class Evaluator:
         fit.intervals): the misfit's roughness from averaging a finite number."""
         variance = 0.0
         for s, target in enumerate(self.targets):
-            raws = [self.done[f"{self._key(s, x)}:r{r}"] for r in range(self.replays)]
-            if any(isinstance(r, str) for r in raws):
+            raws = self._replays_at(s, x)
+            if raws is None:
                 return 0.0
             logged, sigma = target.logged, self.sigma[s]
             variance += jackknife_sd(
                 lambda mean, logged=logged, sigma=sigma: float(np.sum(((mean - logged) /
                                                                       sigma)**2)),
-                np.array(raws))**2
+                raws)**2
         return math.sqrt(variance)
 
     def sensitivity_scatter(self) -> np.ndarray:
         """The sensitivity replays' deviations from their mean over the weights, each row a
         replay, the start-ups' residuals side by side: how far the compared values of one
-        log stray from the replays' expectation (empty when not measured)."""
+        log stray from the replays' expectation (empty when not measured). Following a
+        setpoint, the replays of :meth:`measure_timing`."""
         if any(raws is None for raws in self.sensitivity):
             return np.zeros((0, 0))
         return np.hstack([(raws - raws.mean(axis=0)) / sigma
@@ -509,6 +536,7 @@ def fit(evaluator: Evaluator, seed: int = 0) -> FitResult:
     stage("bracket")
     u_best = (best.x - low) / span
     jacobian = jac(u_best)
+    evaluator.measure_timing(best.x)
     bands = profile_intervals(
         lambda us: [e.residuals for e in evaluator.evaluate([x_of(u) for u in us])],
         u_best, best.residuals, jacobian, evaluator.sensitivity_scatter(), evaluator.replays,

@@ -374,6 +374,18 @@ def test_following_the_logged_setpoint_the_truth_scores_the_torque_noise_alone()
     n = at[0].residuals.size
     assert abs(at[0].misfit**2 - 1.0) < 4.0 * np.sqrt(2.0 / n)
     assert all(e.misfit > at[0].misfit for e in at[1:])
+    # the intervals' draws of the log's own timing (Evaluator.measure_timing): replays
+    # with shifts of their own, their deviations from their mean each a whole replay (the
+    # residuals side by side), not zero (different shifts), smaller than the noise they are
+    # weighted by (the truth's misfit is the noise alone, above), the weights unchanged
+    sigma = [w.copy() for w in evaluator.sigma]
+    evaluator.measure_timing(truth)
+    scatter = evaluator.sensitivity_scatter()
+    assert all(np.array_equal(a, b) for a, b in zip(sigma, evaluator.sigma, strict=True))
+    assert scatter.shape == (engine.SENSITIVITY_REPLAYS, n)
+    np.testing.assert_allclose(scatter.sum(axis=0), 0.0, atol=1e-9)
+    rms = np.sqrt(np.mean(scatter**2, axis=1))
+    assert np.all(rms > 0.0) and np.all(rms < 1.0)
 
 
 def test_a_shifted_setpoint_is_the_log_moved_by_under_half_a_sample() -> None:
