@@ -13,8 +13,9 @@ misfit a smoother function of the parameters, which the optimiser's differences 
 on the scale of the Jacobian's step, 1.5 % of it, lowest 4 % below the truth; with
 12 it falls steadily to the truth, measured 2026-12-06, benchmarks/fit_replay_bias.py).
 With ``follow="setpoint"`` a replay follows the log's setpoint through the preset's own
-speed loop instead (:func:`simulate`): no sensor noise to add and no sensitivity replays;
-``SETPOINT_REPLAYS`` replays a point, each following the setpoint shifted in time by a
+speed loop instead (:func:`simulate`): no sensor noise to add and no sensitivity replays
+in the weights (the intervals' replays draw the setpoint's timing instead,
+:meth:`Evaluator.measure_timing`); ``SETPOINT_REPLAYS`` replays a point, each following the setpoint shifted in time by a
 seeded draw within half a sample (:func:`shifted_setpoint`; seed 0 unshifted); and after
 the first least-squares pass, every step (the Jacobian's, the bracket's, the profile's)
 ``SETPOINT_STEP_SHARE`` times its size below. Both answer to how sharp and rough that

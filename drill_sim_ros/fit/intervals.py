@@ -26,7 +26,8 @@ parabola through the optimum would), then widened:
    optimum's cannot be told from it.
 3. **the replays' shifts**: the residuals of one log are not independent; a replay's slips
    move many samples together, and the log is one such realisation. The sensitivity
-   replays (fresh noise on the speed they follow, fit.engine) measure it: each one's
+   replays (fresh noise on the speed they follow; following a setpoint, a shift of their
+   own of its timing: fit.engine) measure it: each one's
    deviation dr_k from their mean would move the optimum along the profile by
    dt_k = -g . dr_k / g . g, g the residuals' least-squares slope over the profile's
    points; the log's realisation and the mean of the R replays averaged at a point add the
