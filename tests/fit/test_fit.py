@@ -432,3 +432,23 @@ def test_a_logs_setpoint_is_written_and_read_back(tmp_path) -> None:
     ramp_share = (log.t_s[-1] - log.t_s[0] - 1.0) / 10.0       # 1 s at rest, then the ramp
     assert back.setpoint_rad_s[-1] == pytest.approx(ramp_share * 30.0 / RPM_PER_RAD_S,
                                                     rel=1e-3)
+
+
+def test_a_setpoint_fit_draws_the_logs_timing_for_its_interval() -> None:
+    """``fit`` following the logged setpoint (the tangent's 30 s start-up to 40 rpm, the
+    damping from 10 % below): within 5 % of the truth, its 95 % interval covering it, and
+    the interval built with the replays of the setpoint's timing measured at the optimum
+    (Evaluator.measure_timing: eight rows, one per shift)."""
+    data = fv_cases.tangent()
+    data["string"]["bit_substeps"] = COARSE_SUBSTEPS
+    log = synthetic.synthetic_log(preset_from_dict("tangent", data), 40.0, 2.0, 30.0,
+                                  synthetic.scenario_sensors(2))
+    truth = data["string"]["torsional_damping_per_s"]
+    data["string"]["torsional_damping_per_s"] = 0.9 * truth
+    target = objective.make_target(log, preset_from_dict("tangent", data))
+    evaluator = engine.Evaluator(data, parse_fit("string.torsional_damping_per_s", data),
+                                 [target], follow="setpoint")
+    result = engine.fit(evaluator)
+    assert abs(result.x[0] / truth - 1.0) < 0.05
+    assert result.low95[0] < truth < result.high95[0]
+    assert evaluator.sensitivity_scatter().shape[0] == engine.SENSITIVITY_REPLAYS
