@@ -15,10 +15,11 @@ on the scale of the Jacobian's step, 1.5 % of it, lowest 4 % below the truth; wi
 With ``follow="setpoint"`` a replay follows the log's setpoint through the preset's own
 speed loop instead (:func:`simulate`): no sensor noise to add and no sensitivity replays
 in the weights (the intervals' replays draw the setpoint's timing instead,
-:meth:`Evaluator.measure_timing`); ``SETPOINT_REPLAYS`` replays a point, each following the setpoint shifted in time by a
-seeded draw within half a sample (:func:`shifted_setpoint`; seed 0 unshifted); and after
-the first least-squares pass, every step (the Jacobian's, the bracket's, the profile's)
-``SETPOINT_STEP_SHARE`` times its size below. Both answer to how sharp and rough that
+:meth:`Evaluator.measure_timing`); ``SETPOINT_REPLAYS`` replays a point, each following
+the setpoint shifted in time by a seeded draw within half a sample
+(:func:`shifted_setpoint`; seed 0 unshifted); and after the first least-squares pass,
+every step (the Jacobian's, the bracket's, the profile's) ``SETPOINT_STEP_SHARE`` times
+its size below. Both answer to how sharp and rough that
 misfit is (the wind-up's weights carry no speed noise; measured on the tangent's two-speed
 logs, 2026-12-07, docs/fit.md): one replay a point left it rough on a scale of a fraction
 of a % of the parameters (the wall's junctions let go at thresholds: along a segment from
@@ -104,6 +105,7 @@ SETPOINT_STEP_SHARE = 0.2     # following a setpoint, every step above after the
 #                               (and the profile's) times this: a sharper misfit (module doc)
 BRACKET_ROUNDS = 3            # at most this many restarts from a better one of them
 CORRELATED = 0.95             # |correlation| above this: the log cannot tell the two apart
+MISFIT_LOST = 2.0             # the misfit at the fit above this: it missed the log (_warnings)
 VISCOUS_PATH = "string.torsional_damping_per_s"   # a loss torque that grows with speed ...
 COULOMB_PATHS = ("well.side_friction.dynamic",)   # ... and friction torques that do not
 SPEED_SPREAD = 3.0            # start-ups' speeds at least this far apart tell the two apart
@@ -600,8 +602,17 @@ def one_speed_warning(params: Sequence[FitParameter], speeds_rad_s: Sequence[np.
 def _warnings(params: Sequence[FitParameter], best: Evaluation, jacobian: np.ndarray,
               correlation: np.ndarray) -> list[str]:
     """A parameter the misfit does not move with, a pair the log cannot tell apart (their
-    |correlation| above ``CORRELATED``), fitted values the preset refused."""
+    |correlation| above ``CORRELATED``), fitted values the preset refused, and a fit that
+    missed the log: the weights are the log's noise, so a model that reproduces it scores
+    about 1 (the truth scored 0.76 to 1.31 in every study of docs/fit.md), and a misfit
+    above ``MISFIT_LOST`` means residuals that many times the noise (one fit of 60 from
+    15 % below stopped at 16.1, its damping +70 %, its intervals narrow around it)."""
     warnings = []
+    if best.misfit > MISFIT_LOST:
+        warnings.append(f"the fit missed the log: its misfit is {best.misfit:.3g} times the "
+                        f"log's noise (about 1 where the model reproduces the log), so its "
+                        "values and intervals are not to be trusted; start from other values "
+                        "(the preset's), narrow the bounds, or fit fewer parameters")
     for i, p in enumerate(params):
         if not np.any(jacobian[:, i]):
             warnings.append(f"the log does not constrain {p.path} (the misfit does not move "

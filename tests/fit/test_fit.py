@@ -452,3 +452,18 @@ def test_a_setpoint_fit_draws_the_logs_timing_for_its_interval() -> None:
     assert abs(result.x[0] / truth - 1.0) < 0.05
     assert result.low95[0] < truth < result.high95[0]
     assert evaluator.sensitivity_scatter().shape[0] == engine.SENSITIVITY_REPLAYS
+
+
+@pytest.mark.parametrize(("noise_times", "warned"), [(1.0, False), (3.0, True)])
+def test_a_fit_that_missed_the_log_is_warned(noise_times: float, warned: bool) -> None:
+    """The residuals are weighted by the log's noise: residuals of the noise's own size (a
+    model that reproduces the log) give no warning, three times it a warning that the fit
+    missed the log, naming its misfit."""
+    params = parse_fit("well.side_friction.static,well.side_friction.dynamic", coarse_data())
+    residuals = noise_times * np.random.default_rng(3).standard_normal(4000)
+    best = engine.Evaluation(np.array([0.3, 0.2]), residuals, None)
+    warnings = engine._warnings(params, best, np.eye(4000, 2), np.eye(2))
+    missed = [w for w in warnings if w.startswith("the fit missed the log")]
+    assert bool(missed) is warned
+    if warned:
+        assert f"its misfit is {best.misfit:.3g} times the log's noise" in missed[0]
