@@ -604,7 +604,7 @@ def _warnings(params: Sequence[FitParameter], best: Evaluation, jacobian: np.nda
     """A parameter the misfit does not move with, a pair the log cannot tell apart (their
     |correlation| above ``CORRELATED``), fitted values the preset refused, and a fit that
     missed the log: the weights are the log's noise, so a model that reproduces it scores
-    about 1 (the truth scored 0.76 to 1.31 in every study of docs/fit.md), and a misfit
+    about 1 (the truth scored 0.50 to 1.31 in every study of docs/fit.md), and a misfit
     above ``MISFIT_LOST`` means residuals that many times the noise (one fit of 60 from
     15 % below stopped at 16.1, its damping +70 %, its intervals narrow around it)."""
     warnings = []
