@@ -14,7 +14,6 @@ import numpy as np
 from drill_sim_ros import topics
 from drill_sim_ros.archive.reader import ArchiveReader
 from drill_sim_ros.fit.errors import LogError
-from drill_sim_ros.model.params import RPM_PER_RAD_S
 from drill_sim_ros.model.telemetry import TELEMETRY_INDEX
 from drill_sim_ros.viz.mcap_telemetry import NoTelemetryError, channel_decoder, read_telemetry
 
@@ -23,8 +22,8 @@ STAMP_TOLERANCE_S = 1e-6     # a telemetry sample and a measured one at the same
 
 def read_mcap_columns(path: Path) -> dict[str, np.ndarray]:
     """time_s, drive_speed_rad_s, motor_torque_nm, string_torque_nm and hook_load_n of the
-    recording's measured surface signals, and setpoint_rad_s where :func:`read_setpoint`
-    finds it; LogError when it has none."""
+    recording's measured surface signals, and setpoint_rpm where :func:`read_setpoint_rpm`
+    finds it (fit.log converts it, as a CSV's); LogError when it has none."""
     rows: list[tuple[float, ...]] = []
     decode = None
     try:
@@ -48,14 +47,14 @@ def read_mcap_columns(path: Path) -> dict[str, np.ndarray]:
     names = ("time_s", "drive_speed_rad_s", "motor_torque_nm", "string_torque_nm",
              "hook_load_n")
     columns = {name: table[:, i] for i, name in enumerate(names)}
-    setpoint = read_setpoint(path, columns["time_s"])
+    setpoint = read_setpoint_rpm(path, columns["time_s"])
     if setpoint is not None:
-        columns["setpoint_rad_s"] = setpoint
+        columns["setpoint_rpm"] = setpoint
     return columns
 
 
-def read_setpoint(path: Path, t_s: np.ndarray) -> np.ndarray | None:
-    """The telemetry's speed setpoint (rad/s) at the times ``t_s``; None when the recording
+def read_setpoint_rpm(path: Path, t_s: np.ndarray) -> np.ndarray | None:
+    """The telemetry's speed setpoint (rpm) at the times ``t_s``; None when the recording
     has no telemetry or no telemetry sample at one of those times."""
     try:
         rows = np.concatenate([batch.rows for batch in read_telemetry(path)])
@@ -65,4 +64,4 @@ def read_setpoint(path: Path, t_s: np.ndarray) -> np.ndarray | None:
     at = np.clip(np.searchsorted(stamps, t_s - STAMP_TOLERANCE_S), 0, stamps.size - 1)
     if np.any(np.abs(stamps[at] - t_s) > STAMP_TOLERANCE_S):
         return None
-    return rows[at, TELEMETRY_INDEX["speed_setpoint_rpm"]] / RPM_PER_RAD_S
+    return rows[at, TELEMETRY_INDEX["speed_setpoint_rpm"]]
