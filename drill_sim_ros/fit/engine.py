@@ -43,7 +43,16 @@ in the parameters scaled to their bounds (u = (x - low) / (high - low), in [0, 1
    u, evaluated in parallel; the sensitivity measured again at the best optimum (it
    depends on the parameters: the weights keep the largest scatter seen), and least
    squares again from the best point so far under those weights (``PASSES`` in all);
-3. a bracket: the points ``BRACKET_STEPS`` on either side of the optimum along each
+3. a rescue, only when the search is lost (its misfit above ``MISFIT_LOST``, twice the
+   log's noise where the truth scores about 1): least squares again, its Jacobian's step
+   ``RESCUE_STEP`` in u, from the given values and then the global start's best points
+   (``RESCUE_STARTS`` in all) until one is no longer lost. Following a setpoint, log 45
+   of the tangent's two-speed study went from the given values (15 % below) at the full
+   step into the valley where more viscous loss stands in for less wall friction (misfit
+   16.1, damping +69.5 %); from there at a fifth of the step it stayed (16.1), from the
+   given values at a fifth it reached the truth's basin (0.98, each within 1.6 %;
+   measured 2026-12-07, docs/fit.md);
+4. a bracket: the points ``BRACKET_STEPS`` on either side of the optimum along each
    parameter (2 and 4 % of its range; 3.3 and 6.6 % of field_8p5in_deviated's static
    coefficient), the others following along the misfit's valley (fit.intervals'
    profile directions; for one parameter, its axis), and least squares again from the
@@ -52,7 +61,7 @@ in the parameters scaled to their bounds (u = (x - low) / (high - low), in [0, 1
    Jacobian's differences, and least squares stopped in a shoulder of it 5 % below the
    static coefficient's truth, where the misfit at the truth was lower (measured
    2026-12-06, docs/fit.md);
-4. the 95 % intervals from the misfit's profile along each parameter (fit.intervals:
+5. the 95 % intervals from the misfit's profile along each parameter (fit.intervals:
    where it first rises, at points 1 to 4 % of the range on either side, by the F
    threshold times the residuals' noise level plus the misfit's own noise over the draws
    of its replays, widened by how far the sensitivity replays' scatter would move the
@@ -106,6 +115,8 @@ SETPOINT_STEP_SHARE = 0.2     # following a setpoint, every step above after the
 BRACKET_ROUNDS = 3            # at most this many restarts from a better one of them
 CORRELATED = 0.95             # |correlation| above this: the log cannot tell the two apart
 MISFIT_LOST = 2.0             # the misfit at the fit above this: it missed the log (_warnings)
+RESCUE_STARTS = 3             # a lost search's least squares again from this many points ...
+RESCUE_STEP = 0.002           # ... its Jacobian's step this (in u; module doc, step 3)
 VISCOUS_PATH = "string.torsional_damping_per_s"   # a loss torque that grows with speed ...
 COULOMB_PATHS = ("well.side_friction.dynamic",)   # ... and friction torques that do not
 SPEED_SPREAD = 3.0            # start-ups' speeds at least this far apart tell the two apart
@@ -491,6 +502,7 @@ def fit(evaluator: Evaluator, seed: int = 0) -> FitResult:
     points = [x0, *[x_of(u) for u in starts]]
     evaluator.measure_sensitivity(x0)
     evaluator.measure_sensitivity(min(evaluator.evaluate(points), key=lambda e: e.misfit).x)
+    global_points = list(points)
     count = [len(points)]
     stage("global")
 
@@ -507,20 +519,33 @@ def fit(evaluator: Evaluator, seed: int = 0) -> FitResult:
                    for e, h in zip(evals[1:], steps, strict=True)]
         return np.column_stack(columns)
 
+    def descend(x_start: np.ndarray) -> np.ndarray:
+        """Where least squares from ``x_start`` stops."""
+        result = least_squares(fun, (x_start - low) / span, jac=jac, bounds=(0.0, 1.0),
+                               method="trf", ftol=TOLERANCE, xtol=TOLERANCE,
+                               max_nfev=MAX_ITERATIONS)
+        return x_of(result.x)
+
     for pass_index, starts_now in enumerate((LOCAL_STARTS, *[1] * (PASSES - 1))):
         jacobian_step[0] = JACOBIAN_STEP * (1.0 if pass_index == 0 else share)
         tried = sorted(evaluator.evaluate(points), key=lambda e: e.misfit)  # weighted anew
         ends = []
         for start in tried[:starts_now]:
-            result = least_squares(fun, (start.x - low) / span, jac=jac, bounds=(0.0, 1.0),
-                                   method="trf", ftol=TOLERANCE, xtol=TOLERANCE,
-                                   max_nfev=MAX_ITERATIONS)
-            ends.append(evaluator.evaluate([x_of(result.x)])[0])
+            ends.append(evaluator.evaluate([descend(start.x)])[0])
         best = min([*ends, tried[0]], key=lambda e: e.misfit)
         evaluator.measure_sensitivity(best.x)
         points += [e.x for e in ends]
     best = min(evaluator.evaluate(points), key=lambda e: e.misfit)
     stage("least squares")
+    jacobian_step[0] = RESCUE_STEP
+    ranked = sorted(evaluator.evaluate(global_points), key=lambda e: e.misfit)
+    for start in _rescue_starts(x0, ranked):
+        if best.misfit <= MISFIT_LOST:
+            break
+        points.append(descend(start))
+        best = min(evaluator.evaluate(points), key=lambda e: e.misfit)
+    jacobian_step[0] = JACOBIAN_STEP * share
+    stage("rescue")
     for _ in range(BRACKET_ROUNDS):
         u_now = (best.x - low) / span
         valleys = profile_directions(jac(u_now))
@@ -530,10 +555,7 @@ def fit(evaluator: Evaluator, seed: int = 0) -> FitResult:
         better = min(nearby, key=lambda e: e.misfit)
         if better.misfit >= best.misfit:
             break
-        result = least_squares(fun, (better.x - low) / span, jac=jac, bounds=(0.0, 1.0),
-                               method="trf", ftol=TOLERANCE, xtol=TOLERANCE,
-                               max_nfev=MAX_ITERATIONS)
-        points.append(x_of(result.x))
+        points.append(descend(better.x))
         best = min(evaluator.evaluate(points), key=lambda e: e.misfit)
     before = evaluator.evaluate([x0])[0]
     stage("bracket")
@@ -555,11 +577,18 @@ def fit(evaluator: Evaluator, seed: int = 0) -> FitResult:
                      tuple(evaluator.replayed_cycles(best.x)))
 
 
+def _rescue_starts(x0: np.ndarray, ranked: Sequence[Evaluation]) -> list[np.ndarray]:
+    """Where a lost search starts again (module doc, step 3): the given values, then the
+    global start's best points, ``RESCUE_STARTS`` in all."""
+    others = [e.x for e in ranked if not np.array_equal(e.x, x0)]
+    return [x0, *others][:RESCUE_STARTS]
+
+
 def _bracket(u: np.ndarray, directions: np.ndarray, share: float = 1.0) -> list[np.ndarray]:
     """The points ``BRACKET_STEPS`` times ``share`` (in u) on either side of ``u`` along
     each parameter's valley (``directions[:, i]``, its entry i one:
     fit.intervals.profile_directions), parameter i within its bounds, the others clipped
-    to theirs (module doc, step 3)."""
+    to theirs (module doc, step 4)."""
     out = []
     for i in range(u.size):
         for h in (share * b for b in (*BRACKET_STEPS, *(-b for b in BRACKET_STEPS))):

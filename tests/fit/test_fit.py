@@ -467,3 +467,49 @@ def test_a_fit_that_missed_the_log_is_warned(noise_times: float, warned: bool) -
     assert bool(missed) is warned
     if warned:
         assert f"its misfit is {best.misfit:.3g} times the log's noise" in missed[0]
+
+
+class _StandIn:
+    """An evaluator whose residuals are a formula, not replays (``fit``'s search alone):
+    the parameters' offsets from ``truth`` in units of 1 % of their range, beside a floor of
+    ``floor`` that no parameter moves (a model that cannot reproduce the log)."""
+
+    follow, replays, computed, reused, targets = "speed", 1, 0, 0, ()
+
+    def __init__(self, params: list, truth: np.ndarray, floor: float) -> None:
+        self.params, self.truth, self.floor = params, truth, floor
+        self.span = np.array([p.high - p.low for p in params])
+        self.started, self.seen = 0.0, []
+
+    def evaluate(self, xs: list[np.ndarray]) -> list[engine.Evaluation]:
+        self.seen += [np.array(x) for x in xs]
+        return [engine.Evaluation(np.array(x), np.concatenate(
+            (100.0 * (x - self.truth) / self.span, np.full(8, self.floor)))) for x in xs]
+
+    def measure_sensitivity(self, x: np.ndarray) -> None:
+        pass
+
+    measure_timing = measure_sensitivity
+
+    def sensitivity_scatter(self) -> np.ndarray:
+        return np.zeros((0, 0))
+
+    def misfit_sd(self, x: np.ndarray) -> float:
+        return 0.0
+
+    def replayed_cycles(self, x: np.ndarray) -> list:
+        return []
+
+
+@pytest.mark.parametrize(("floor", "rescued"), [(1.0, False), (3.0, True)])
+def test_a_lost_search_starts_again_from_the_given_values(floor: float, rescued: bool) -> None:
+    """A search that ends above ``MISFIT_LOST`` runs least squares again from the given
+    values at ``RESCUE_STEP`` (its Jacobian's first point beside them, the step from them,
+    is evaluated); one that ends below does not (no other stage steps that little in the
+    speed mode)."""
+    params = parse_fit("well.side_friction.static,well.side_friction.dynamic", coarse_data())
+    x0 = np.array([p.initial for p in params])
+    stand_in = _StandIn(params, 1.2 * x0, floor)
+    engine.fit(stand_in)
+    beside = x0 + engine.RESCUE_STEP * stand_in.span * np.array([1.0, 0.0])
+    assert any(np.allclose(x, beside, rtol=0.0, atol=1e-12) for x in stand_in.seen) is rescued
