@@ -64,9 +64,12 @@ run: venv
 	$(BIN)/mcap_to_rerun $(RUN_DIR)/run.mcap -o $(RUN_DIR)/run.rrd && \
 	echo "[run] replay: $(BIN)/mcap_replay $(RUN_DIR)/run.mcap   view: $(BIN)/rerun $(RUN_DIR)/run.rrd"
 
+# The suite waits on wall time (ROS runs, live viewers) more than it computes: two workers,
+# each file on one of them (its module fixtures built once), each worker its own DDS domain.
+TEST_WORKERS ?= 2
 test: venv
 	$(BIN)/ruff check drill_sim_ros tests benchmarks docs
-	$(BIN)/pytest
+	$(BIN)/pytest -n $(TEST_WORKERS) --dist loadfile
 
 lint: venv
 	$(BIN)/ruff check drill_sim_ros tests benchmarks docs

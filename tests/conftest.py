@@ -12,8 +12,14 @@ import sys
 
 os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
 os.environ.pop("ROS_LOCALHOST_ONLY", None)
-# A domain per test session (pid-derived) unless the caller (the Makefile) chose one.
+# A domain per test session (pid-derived) unless the caller (the Makefile) chose one; each
+# pytest-xdist worker (gw0, gw1, ...) the next domains from it, so two workers' nodes and
+# topics never meet.
 os.environ.setdefault("ROS_DOMAIN_ID", str(1 + os.getpid() % 101))
+_worker = os.environ.get("PYTEST_XDIST_WORKER", "")
+if _worker.startswith("gw"):
+    os.environ["ROS_DOMAIN_ID"] = str(
+        1 + (int(os.environ["ROS_DOMAIN_ID"]) - 1 + int(_worker[2:])) % 101)
 _prefixes = [p for p in os.environ.get("AMENT_PREFIX_PATH", "").split(os.pathsep) if p]
 if sys.prefix not in _prefixes:
     os.environ["AMENT_PREFIX_PATH"] = os.pathsep.join([*_prefixes, sys.prefix])
