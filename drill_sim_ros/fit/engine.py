@@ -635,7 +635,8 @@ def _warnings(params: Sequence[FitParameter], best: Evaluation, jacobian: np.nda
     missed the log: the weights are the log's noise, so a model that reproduces it scores
     about 1 (the truth scored 0.50 to 1.31 in every study of docs/fit.md), and a misfit
     above ``MISFIT_LOST`` means residuals that many times the noise (one fit of 60 from
-    15 % below stopped at 16.1, its damping +70 %, its intervals narrow around it)."""
+    15 % below stopped at 16.1, its damping +70 %, its intervals narrow around it, before
+    the rescue of step 3 of the module doc: a fit still lost after it is warned)."""
     warnings = []
     if best.misfit > MISFIT_LOST:
         warnings.append(f"the fit missed the log: its misfit is {best.misfit:.3g} times the "
