@@ -22,7 +22,7 @@ import time
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, fields, replace
 from pathlib import Path
-from typing import Any, TextIO
+from typing import Any, NoReturn, TextIO
 
 from drill_sim_ros import (
     closed_loop_cli,
@@ -469,7 +469,21 @@ def main(argv: Sequence[str] | None = None) -> int:
     # SIGTERM and SIGHUP stop a command as Ctrl-C does (every ``finally`` runs); the outputs
     # under way (--plot's temporary file, the directories made for it) go at once
     with stop_on_signals(remove_unfinished, STOP_GRACE_S):
-        return _main(args)
+        code = _main(args)
+    if stop_requested():
+        _end_now(code)
+    return code
+
+
+def _end_now(code: int) -> NoReturn:
+    """End a command stopped by a signal without the interpreter's finalizers, once every
+    ``finally`` has run and the outputs under way are removed: a stop that tore numba's
+    compiler mid-work leaves LLVM objects that can crash in them (status -11 after
+    "interrupted", seen 2026-12-07 in tests/robust/test_gateway_and_leftovers.py under
+    `make test`'s two workers, a cold compile on a loaded machine)."""
+    sys.stdout.flush()
+    sys.stderr.flush()
+    os._exit(code)
 
 
 def _main(args: argparse.Namespace) -> int:
