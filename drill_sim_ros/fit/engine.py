@@ -537,14 +537,15 @@ def fit(evaluator: Evaluator, seed: int = 0) -> FitResult:
         points += [e.x for e in ends]
     best = min(evaluator.evaluate(points), key=lambda e: e.misfit)
     stage("least squares")
-    jacobian_step[0] = RESCUE_STEP
-    ranked = sorted(evaluator.evaluate(global_points), key=lambda e: e.misfit)
-    for start in _rescue_starts(x0, ranked):
-        if best.misfit <= MISFIT_LOST:
-            break
-        points.append(descend(start))
-        best = min(evaluator.evaluate(points), key=lambda e: e.misfit)
-    jacobian_step[0] = JACOBIAN_STEP * share
+    if best.misfit > MISFIT_LOST:         # lost: start again (module doc, step 3)
+        jacobian_step[0] = RESCUE_STEP
+        ranked = sorted(evaluator.evaluate(global_points), key=lambda e: e.misfit)
+        for start in _rescue_starts(x0, ranked):
+            points.append(descend(start))
+            best = min(evaluator.evaluate(points), key=lambda e: e.misfit)
+            if best.misfit <= MISFIT_LOST:
+                break
+        jacobian_step[0] = JACOBIAN_STEP * share
     stage("rescue")
     for _ in range(BRACKET_ROUNDS):
         u_now = (best.x - low) / span
