@@ -58,6 +58,7 @@ from tests.ros.test_opcua_gateway import (
 pytestmark = pytest.mark.ros
 STRING, INT32 = ua.VariantType.String, ua.VariantType.Int32
 SPEED, TORQUE = 0, 1                     # DriveModeEnum's values (docs/hil.md)
+RUNNING = 1                              # RigStatus.Running (docs/hil.md)
 ROS_TIMEOUT_S = 10.0
 
 
@@ -256,6 +257,19 @@ async def follow_at_runtime(url: str, sim: SimParameters) -> None:
         await wait_until(rig, "DriveMode", lambda mode: mode == SPEED)
         await asyncio.to_thread(sim.set, lockstep=False)
         await wait_until(rig, "Lockstep", lambda on: on is False)
+        # a heartbeat in free run: the settings above may outlast heartbeat_timeout_s (2 s),
+        # and an owner silent that long in lockstep just lets go (no safe stop to latch)
+        await rig.write(SpeedSetpoint=ua.Variant(5.0, DOUBLE))
+        await wait_until(rig, "Status", lambda status: status == RUNNING)
+    finally:
+        await client.disconnect()
+
+
+async def wait_status(url: str, status: int) -> None:
+    """A second client (it only reads) waits for the rig's ``status``."""
+    client, rig = await connect(url)
+    try:
+        await wait_until(rig, "Status", lambda now: now == status)
     finally:
         await client.disconnect()
 
@@ -283,6 +297,7 @@ def test_the_ranges_and_lockstep_follow_sim_node_at_runtime_and_across_a_restart
         tmp_path: Path) -> None:
     with sims_and_gateway(tmp_path, ("/",)) as (sims, gateway, url), ros_context() as ros:
         run(follow_at_runtime(url, SimParameters(ros)))
+        run(wait_status(url, HEARTBEAT_LOST))        # the owner closed in free run
         assert stop(sims["/"], signal.SIGINT) == 0
         with running([*sim_command(None), "-p", "limits.max_surface_rpm:=200.0"],
                      tmp_path / "sim_again.log") as sim:

@@ -4,7 +4,6 @@ reset, pause/step, numerical faults and wall-clock pacing (issue 3)."""
 from __future__ import annotations
 
 import math
-import time
 
 import numpy as np
 import pytest
@@ -322,35 +321,33 @@ def test_pause_stops_the_clock_and_step_advances_one_period(ros):
     assert physics.consecutive(rows[:, F["sim_time_s"]], PERIOD_S)
 
 
-def _quiet_for(probe, topic: str, seconds: float):
-    """A predicate: no new message on ``topic`` for ``seconds`` (monotonic clock)."""
-    last = {"count": -1, "since": time.monotonic()}
-
-    def quiet() -> bool:
-        count, now = probe.count(topic), time.monotonic()
-        if count != last["count"]:
-            last["count"], last["since"] = count, now
-        return now - last["since"] >= seconds
-    return quiet
+def _paused_sim_times(probe) -> list[float]:
+    """The sim times /diagnostics reported in state "paused" (3 decimals)."""
+    values = (diagnostic_values(m) for m in probe.messages(topics.DIAGNOSTICS))
+    return [float(v["sim_time_s"]) for v in values if v.get("state") == "paused"]
 
 
 def test_free_run_serves_pause_and_commands_while_the_ticker_runs_flat_out(ros):
     start_node(ros, real_time_factor=0.0)
-    probe = start_probe(ros, [topics.TELEMETRY])
+    probe = start_probe(ros, [topics.TELEMETRY, topics.DIAGNOSTICS])
     assert ros.spin_until(lambda: probe.count(topics.TELEMETRY) > 200, 20.0)
     publish_acked(ros, probe, topics.CMD_WOB, 50e3)
     assert ros.spin_until(lambda: probe.messages(topics.TELEMETRY)[-1].data[
         F["applied_wob_n"]] == pytest.approx(50e3), 10.0)
     assert ros.call(probe, SetBool, f"{NODE}/pause", SetBool.Request(data=True)).success
-    # Samples published before the pause may still be queued for this (slower) subscriber;
-    # a running free-run sim never goes quiet for 0.5 s, a paused one does.
-    assert ros.spin_until(_quiet_for(probe, topics.TELEMETRY, 0.5), 15.0)
+    # The clock stopped: two reports of /diagnostics (1 s apart) give one sim time, and no
+    # sample is later than it. Samples published before the pause may still arrive late (a
+    # starved subscriber's queue), so counting arrivals would not tell.
+    assert ros.spin_until(lambda: len(_paused_sim_times(probe)) >= 2, 10.0)
+    paused = _paused_sim_times(probe)
+    assert paused[-1] == paused[0]
+    rows = physics.telemetry_rows(probe.messages(topics.TELEMETRY))
+    assert rows[-1, F["sim_time_s"]] <= paused[0] + 5e-4
     seen = probe.count(topics.TELEMETRY)
-    ros.spin_for(0.3)
-    assert probe.count(topics.TELEMETRY) == seen
     assert ros.call(probe, SetBool, f"{NODE}/pause", SetBool.Request(data=False)).success
     assert ros.spin_until(lambda: probe.count(topics.TELEMETRY) > seen + 200, 10.0)
     rows = physics.telemetry_rows(probe.messages(topics.TELEMETRY))
+    assert rows[-1, F["sim_time_s"]] > paused[0] + 0.1                 # running again
     # In free run a subscriber slower than the sim may miss samples (keep-last 100; the
     # in-process recording is the lossless path), so check order and the period grid only.
     times = rows[:, F["sim_time_s"]]
