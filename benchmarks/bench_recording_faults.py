@@ -18,7 +18,6 @@ import signal
 import subprocess
 import sys
 import tempfile
-import threading
 import time
 from pathlib import Path
 
@@ -36,6 +35,7 @@ from std_msgs.msg import Float64MultiArray
 
 from drill_sim_ros import topics
 from drill_sim_ros.archive.reader import ArchiveReader
+from drill_sim_ros.ros.spinning import SpinThread
 
 BIN = Path(sys.prefix) / "bin"
 SIM_TIME = topics.TELEMETRY_INDEX["sim_time_s"]
@@ -55,13 +55,7 @@ class Listener:
         self.node.create_subscription(DiagnosticArray, topics.DIAGNOSTICS, self._on_diag, qos)
         self._executor = SingleThreadedExecutor(context=self.context)
         self._executor.add_node(self.node)
-        self._stop = threading.Event()
-        self._thread = threading.Thread(target=self._spin, daemon=True)
-        self._thread.start()
-
-    def _spin(self) -> None:
-        while not self._stop.is_set():
-            self._executor.spin_once(timeout_sec=0.05)
+        self._spinning = SpinThread(self._executor, self.context)
 
     def _on_row(self, msg: Float64MultiArray) -> None:
         self.last_sim_time_s = max(self.last_sim_time_s, msg.data[SIM_TIME])
@@ -73,9 +67,7 @@ class Listener:
                 self.rates.append((time.monotonic(), float(values["real_time_factor_achieved"])))
 
     def close(self) -> None:
-        self._stop.set()
-        self._thread.join(5)
-        self._executor.shutdown()
+        self._spinning.stop()
         self.node.destroy_node()
         rclpy.try_shutdown(context=self.context)
 

@@ -28,7 +28,6 @@ import functools
 import logging
 import signal
 import sys
-import threading
 import time
 from collections.abc import Awaitable, Callable
 from dataclasses import dataclass
@@ -54,6 +53,7 @@ from drill_sim_ros.model.errors import DrillSimError, ParameterError
 from drill_sim_ros.ros.messages import status
 from drill_sim_ros.ros.parameters import init_ros
 from drill_sim_ros.ros.sim_link import SIM_PARAMETERS, SimLink, sim_values
+from drill_sim_ros.ros.spinning import SpinThread
 
 NODE_NAME = "opcua_gateway"
 USAGE = """usage: opcua_gateway [--ros-args -p endpoint:=opc.tcp://127.0.0.1:4840/drill_sim/ ...]
@@ -246,11 +246,6 @@ class GatewayNode(Node):
                             f"{self.sim_wait_s:g} s")
 
 
-def _spin(executor: SingleThreadedExecutor) -> None:
-    with contextlib.suppress(ExternalShutdownException):
-        executor.spin()
-
-
 Event = Callable[[], Awaitable[None]]
 
 
@@ -293,9 +288,9 @@ async def serve(node: GatewayNode, settings: list[RigSettings]) -> None:
     await server.start()
     for link, rig in zip(node.links, rigs, strict=True):
         _connect(link, rig, loop, events)
-    executor = SingleThreadedExecutor()
+    executor = SingleThreadedExecutor(context=node.context)
     executor.add_node(node)
-    threading.Thread(target=_spin, args=(executor,), daemon=True).start()
+    spinning = SpinThread(executor, node.context, "gateway-ros")
     for link, rig in zip(node.links, rigs, strict=True):
         node.get_logger().info(f"serving {rig.name} ({link.sim_node}) at {node.endpoint} "
                                f"(lockstep {rig.settings.lockstep}, drive mode "
@@ -310,7 +305,7 @@ async def serve(node: GatewayNode, settings: list[RigSettings]) -> None:
     finally:
         for signum in STOP_SIGNALS:
             loop.remove_signal_handler(signum)
-        executor.shutdown(timeout_sec=1.0)
+        await asyncio.to_thread(spinning.stop)
         await server.stop()
 
 

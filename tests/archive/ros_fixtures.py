@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import threading
 from collections.abc import Iterator
 from contextlib import contextmanager
 
@@ -12,6 +11,7 @@ from rclpy.node import Node
 from std_srvs.srv import Trigger
 
 from drill_sim_ros import topics
+from drill_sim_ros.ros.spinning import SpinThread
 from tests.archive.helpers import wait_for
 
 
@@ -23,20 +23,11 @@ def ros_node(name: str) -> Iterator[Node]:
     node = rclpy.create_node(name, context=context)
     executor = SingleThreadedExecutor(context=context)
     executor.add_node(node)
-    stop = threading.Event()
-
-    def spin() -> None:
-        while not stop.is_set() and context.ok():
-            executor.spin_once(timeout_sec=0.05)
-
-    thread = threading.Thread(target=spin, daemon=True)
-    thread.start()
+    spinning = SpinThread(executor, context)
     try:
         yield node
     finally:
-        stop.set()
-        thread.join(5)
-        executor.shutdown()
+        spinning.stop()
         node.destroy_node()
         rclpy.try_shutdown(context=context)
 
