@@ -64,10 +64,10 @@ run: venv
 	$(BIN)/mcap_to_rerun $(RUN_DIR)/run.mcap -o $(RUN_DIR)/run.rrd && \
 	echo "[run] replay: $(BIN)/mcap_replay $(RUN_DIR)/run.mcap   view: $(BIN)/rerun $(RUN_DIR)/run.rrd"
 
-# The suite waits on wall time (ROS runs, live viewers) more than it computes. TEST_WORKERS=2
-# runs it on two pytest-xdist workers (each file on one, each worker its own DDS domain) in
-# about 13 min instead of 21, but one free-run test flaked there (docs/testing.md): 0, serial.
-TEST_WORKERS ?= 0
+# The suite waits on wall time (ROS runs, live viewers) more than it computes: two
+# pytest-xdist workers (each file on one, each worker its own DDS domain) run it in about
+# 13 min instead of 21 (docs/testing.md). TEST_WORKERS=0 runs it serially.
+TEST_WORKERS ?= 2
 test: venv
 	$(BIN)/ruff check drill_sim_ros tests benchmarks docs
 	$(BIN)/pytest -n $(TEST_WORKERS) --dist loadfile
