@@ -309,7 +309,7 @@ class Evaluator:
     def _evaluation(self, x: np.ndarray) -> Evaluation:
         parts, refused = [], None
         for s, target in enumerate(self.targets):
-            raws = [self.done[f"{self._key(s, x)}:r{r}"] for r in range(self.replays)]
+            raws = self._raws(s, x)
             bad = [r for r in raws if isinstance(r, str)]
             if bad:
                 refused = bad[0]
@@ -324,10 +324,15 @@ class Evaluator:
         target = self.targets[segment]
         return (np.asarray(raw) - target.logged) / self.sigma[segment]
 
+    def _raws(self, segment: int, x: np.ndarray) -> list[np.ndarray | str]:
+        """What each replay averaged at an evaluated ``x`` gave for start-up ``segment``:
+        its compared values, or why it was refused."""
+        return [self.done[f"{self._key(segment, x)}:r{r}"] for r in range(self.replays)]
+
     def _replays_at(self, segment: int, x: np.ndarray) -> np.ndarray | None:
         """The compared values of each replay averaged at an evaluated ``x`` for start-up
         ``segment``, shape (replays, values); None when one was refused."""
-        raws = [self.done[f"{self._key(segment, x)}:r{r}"] for r in range(self.replays)]
+        raws = self._raws(segment, x)
         return None if any(isinstance(r, str) for r in raws) else np.array(raws)
 
     def replayed_cycles(self, x: np.ndarray) -> list[np.ndarray | None]:
