@@ -2,7 +2,8 @@
 
 For each controller the closed-loop map of the default field preset over surface rpm x WOB
 (``drill_sim map ... --t-end 180 --enable-at 60``; its statistics window is the map's
-default, the second half of the run, 90-180 s), and on the same grid the prediction of
+default, the second half of the run, 90-180 s; ``--t-end`` runs longer maps, windowed the
+same way), and on the same grid the prediction of
 ``drill_sim stability`` (control/stability.py: the first mode's loop gain
 G = |r_bit| |r_top| |exp(-2 gamma L_pipe)|, grows when G > 1). Every point of the map is run
 again through the bench (the same scenario, so the same run) for the scorecard's own status
@@ -20,7 +21,7 @@ The maps are run (by the command printed) into --maps unless their files are the
 (a re-run resumes them).
 
 Usage: .venv/bin/python docs/stability_map.py [--maps DIR] [--plot docs/img/stability_map.png]
-       [--ensemble N]
+       [--ensemble N] [--t-end SECONDS]
        (the three maps: about 5 min on 2 cores; the prediction: about 20 s; the 168 re-runs:
        about 3 min on 2 cores; the ensemble of 6 at the 4 stalled points: about 3 min)
 """
@@ -45,14 +46,15 @@ RPM = (20, 35, 50, 65, 80, 100, 140, 180)
 WOB_N = (40000, 60000, 80000, 100000, 120000, 140000, 160000)
 ENSEMBLE = 6        # members per controller at each point where a re-run stalled
 WORKERS = 2
+T_END_S = 180.0     # the map's runs (--t-end); the switch-on at 60 s, the window the second half
 
 
-def map_command(controller: str, out: Path) -> list[str]:
+def map_command(controller: str, out: Path, t_end_s: float = T_END_S) -> list[str]:
     return [sys.executable, "-m", "drill_sim_ros.cli", "map", "--params", PRESET,
             "--controller", controller, "--enable-at", "60",
             "--vary", "surface_rpm=" + ",".join(str(r) for r in RPM),
             "--vary", "wob_n=" + ",".join(str(w) for w in WOB_N),
-            "--t-end", "180", "--out", str(out)]
+            "--t-end", f"{t_end_s:g}", "--out", str(out)]
 
 
 def stuck_share(path: Path) -> np.ndarray:
@@ -62,13 +64,13 @@ def stuck_share(path: Path) -> np.ndarray:
         return ds.sel(surface_rpm=list(RPM), wob_n=list(WOB_N)).stick_fraction.values
 
 
-def _point_card(job: tuple[str, float, float]) -> dict[str, object]:
+def _point_card(job: tuple[str, float, float, int, float]) -> dict[str, object]:
     return rerun(*job)
 
 
-def scored(controller: str) -> list[list[dict[str, object]]]:
+def scored(controller: str, t_end_s: float = T_END_S) -> list[list[dict[str, object]]]:
     """The scorecard of every map point of ``controller`` (rerun), indexed [rpm][WOB]."""
-    jobs = [(controller, float(r), float(w)) for r in RPM for w in WOB_N]
+    jobs = [(controller, float(r), float(w), 0, t_end_s) for r in RPM for w in WOB_N]
     with ProcessPoolExecutor(WORKERS) as pool:
         cards = list(pool.map(_point_card, jobs))
     return [cards[i * len(WOB_N):(i + 1) * len(WOB_N)] for i in range(len(RPM))]
@@ -85,17 +87,18 @@ def predicted(tops: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
     return out
 
 
-def rerun(controller: str, rpm: float, wob_n: float, member: int = 0) -> dict[str, object]:
+def rerun(controller: str, rpm: float, wob_n: float, member: int = 0,
+          t_end_s: float = T_END_S) -> dict[str, object]:
     """The map's point again through the bench (``member`` of its ensemble; 0: the map's
-    own run), scored over the map's window (90-180 s): the scorecard (whose status tells a
+    own run), scored over the map's window (its second half): the scorecard (whose status tells a
     stall from stick-slip) and, for a stall, ``stall_depth_m``, the depth of cut per
     revolution the bit stuck at for good (None otherwise)."""
     from drill_sim_ros.control.bench import run_in_process
-    scenario = Scenario(preset=PRESET, duration_s=180.0, control_rate_hz=100.0,
+    scenario = Scenario(preset=PRESET, duration_s=t_end_s, control_rate_hz=100.0,
                         controller=controller, enable_at_s=60.0,
                         schedule=({"t_s": 0.0, "rpm": rpm, "wob_n": wob_n},))
     run = run_in_process(seeded(scenario, member))
-    card = run.score(90.0)
+    card = run.score(t_end_s / 2)
     return {**card, "stall_depth_m": stall_depth_m(run.rows, card["stall_time_s"])}
 
 
@@ -156,12 +159,13 @@ def report(controller: str, gain: np.ndarray, cards: list[list[dict[str, object]
     return stalled
 
 
-def _member_status(job: tuple[str, float, float, int]) -> tuple[str, float | None]:
+def _member_status(job: tuple[str, float, float, int, float]) -> tuple[str, float | None]:
     card = rerun(*job)
     return str(card["status"]), card["stall_depth_m"]
 
 
-def stall_ensemble(points: list[tuple[int, int]], members: int) -> None:
+def stall_ensemble(points: list[tuple[int, int]], members: int,
+                   t_end_s: float = T_END_S) -> None:
     """At each point, ``members`` runs per controller: how many stall, stick-slip or are
     ok, and the depths of cut the stalled ones stuck at (each run on its own process,
     ``WORKERS`` at a time)."""
@@ -169,7 +173,7 @@ def stall_ensemble(points: list[tuple[int, int]], members: int) -> None:
           "stalled / stick-slip / ok, per controller")
     print("| rpm | WOB kN | " + " | ".join(st.CONTROLLERS) + " |")
     print("|---|---|" + "---|" * len(st.CONTROLLERS))
-    jobs = [(c, float(RPM[i]), float(WOB_N[j]), k) for i, j in points
+    jobs = [(c, float(RPM[i]), float(WOB_N[j]), k, t_end_s) for i, j in points
             for c in st.CONTROLLERS for k in range(members)]
     with ProcessPoolExecutor(WORKERS) as pool:
         results = iter(pool.map(_member_status, jobs))
@@ -194,7 +198,8 @@ def stall_ensemble(points: list[tuple[int, int]], members: int) -> None:
 
 
 def plot(path: Path, gains: dict[str, np.ndarray], stuck: dict[str, np.ndarray],
-         fails: dict[str, np.ndarray], stalled: dict[str, list[tuple[int, int]]]) -> None:
+         fails: dict[str, np.ndarray], stalled: dict[str, list[tuple[int, int]]],
+         t_end_s: float = T_END_S) -> None:
     """One panel per controller: the simulated stick fraction (colour; a ring: the status
     not ok), the predicted G = 1 contour, the points where they disagree and the ones that
     stalled (a square)."""
@@ -229,7 +234,7 @@ def plot(path: Path, gains: dict[str, np.ndarray], stuck: dict[str, np.ndarray],
         ax.minorticks_off()
     np.atleast_1d(axes)[0].set_ylabel("applied WOB, kN")
     np.atleast_1d(axes)[0].legend(fontsize=8, loc="lower right")
-    fig.colorbar(mesh, ax=axes, label="stuck share, 90-180 s (simulated)")
+    fig.colorbar(mesh, ax=axes, label=f"stuck share, {t_end_s / 2:g}-{t_end_s:g} s (simulated)")
     fig.suptitle(f"{PRESET}: first-mode growth predicted (G > 1, left of/above the blue "
                  "line) against the closed-loop map", fontsize=10)
     fig.savefig(path, dpi=110, bbox_inches="tight")
@@ -266,12 +271,19 @@ def main() -> int:
     parser.add_argument("--plot", type=Path, default=None, help="PNG to write")
     parser.add_argument("--ensemble", type=int, default=ENSEMBLE,
                         help="members per controller at each stalled point (0: none)")
+    parser.add_argument("--t-end", type=float, default=T_END_S,
+                        help="each run's seconds (the switch-on at 60 s, the window the "
+                             "second half; default %(default)g)")
     args = parser.parse_args()
+    if args.t_end < 120.0:
+        parser.error(f"--t-end {args.t_end:g}: at least 120 s (the switch-on is at 60 s "
+                     "and the window is the second half)")
     args.maps.mkdir(parents=True, exist_ok=True)
     stuck = {}
     for c in st.CONTROLLERS:
-        out = args.maps / f"map_{c}.nc"
-        cmd = map_command(c, out)
+        out = args.maps / (f"map_{c}.nc" if args.t_end == T_END_S
+                           else f"map_{c}_{args.t_end:g}s.nc")
+        cmd = map_command(c, out, args.t_end)
         print("$ drill_sim " + " ".join(cmd[3:]))
         if not out.exists():
             subprocess.run(cmd, check=True)
@@ -286,16 +298,16 @@ def main() -> int:
     print(f"the bit unstable by itself (G infinite): {alone.sum()} points, at "
           + ", ".join(f"{RPM[i]} rpm {WOB_N[j] / 1e3:.0f} kN" for i, j in zip(*np.nonzero(alone),
                                                                      strict=True)))
-    cards = {c: scored(c) for c in st.CONTROLLERS}
+    cards = {c: scored(c, args.t_end) for c in st.CONTROLLERS}
     stalled = {c: report(c, gains[c], cards[c]) for c in st.CONTROLLERS}
     fails = {c: np.array([[str(x["status"]) != "ok" for x in row] for row in cards[c]])
              for c in st.CONTROLLERS}
     bit_check()
     points = sorted(set().union(*stalled.values()))
     if args.ensemble > 0 and points:
-        stall_ensemble(points, args.ensemble)
+        stall_ensemble(points, args.ensemble, args.t_end)
     if args.plot is not None:
-        plot(args.plot, gains, stuck, fails, stalled)
+        plot(args.plot, gains, stuck, fails, stalled, args.t_end)
         print(f"wrote {args.plot}", file=sys.stderr)
     return 0
 
