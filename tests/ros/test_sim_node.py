@@ -303,28 +303,36 @@ def test_reset_returns_the_model_to_its_initial_state_and_setpoints(ros):
     np.testing.assert_array_equal(after[0, F["bit_angle_rad"]:], fresh[F["bit_angle_rad"]:])
 
 
-def test_pause_stops_the_clock_and_step_advances_one_period(ros):
-    start_node(ros, real_time_factor=1.0)
-    probe = start_probe(ros, [topics.TELEMETRY])
-    assert ros.spin_until(lambda: probe.count(topics.TELEMETRY) > 5, 20.0)
-    assert not ros.call(probe, Trigger, f"{NODE}/step", Trigger.Request()).success
-    assert ros.call(probe, SetBool, f"{NODE}/pause", SetBool.Request(data=True)).success
-    ros.spin_for(0.3)
-    seen = probe.count(topics.TELEMETRY)
-    ros.spin_for(0.3)
-    assert probe.count(topics.TELEMETRY) == seen
-    assert ros.call(probe, Trigger, f"{NODE}/step", Trigger.Request()).success
-    assert ros.spin_until(lambda: probe.count(topics.TELEMETRY) == seen + 1, 5.0)
-    assert ros.call(probe, SetBool, f"{NODE}/pause", SetBool.Request(data=False)).success
-    assert ros.spin_until(lambda: probe.count(topics.TELEMETRY) > seen + 20, 5.0)
-    rows = physics.telemetry_rows(probe.messages(topics.TELEMETRY))
-    assert physics.consecutive(rows[:, F["sim_time_s"]], PERIOD_S)
-
-
 def _paused_sim_times(probe) -> list[float]:
     """The sim times /diagnostics reported in state "paused" (3 decimals)."""
     values = (diagnostic_values(m) for m in probe.messages(topics.DIAGNOSTICS))
     return [float(v["sim_time_s"]) for v in values if v.get("state") == "paused"]
+
+
+def _newest_sim_time(probe) -> float:
+    return probe.messages(topics.TELEMETRY)[-1].data[F["sim_time_s"]]
+
+
+def test_pause_stops_the_clock_and_step_advances_one_period(ros):
+    start_node(ros, real_time_factor=1.0)
+    probe = start_probe(ros, [topics.TELEMETRY, topics.DIAGNOSTICS])
+    assert ros.spin_until(lambda: probe.count(topics.TELEMETRY) > 5, 20.0)
+    assert not ros.call(probe, Trigger, f"{NODE}/step", Trigger.Request()).success
+    assert ros.call(probe, SetBool, f"{NODE}/pause", SetBool.Request(data=True)).success
+    # paused: /diagnostics reports one sim time (1 s apart), and every sample reaches it
+    assert ros.spin_until(lambda: len(_paused_sim_times(probe)) >= 2, 10.0)
+    paused = _paused_sim_times(probe)
+    assert paused[-1] == paused[0]
+    assert ros.spin_until(lambda: _newest_sim_time(probe) >= paused[0] - 5e-4, 5.0)
+    seen = probe.count(topics.TELEMETRY)
+    assert _newest_sim_time(probe) == pytest.approx(paused[0], abs=5e-4)
+    assert ros.call(probe, Trigger, f"{NODE}/step", Trigger.Request()).success
+    assert ros.spin_until(lambda: probe.count(topics.TELEMETRY) == seen + 1, 5.0)
+    assert _newest_sim_time(probe) == pytest.approx(paused[0] + PERIOD_S, abs=5e-4)
+    assert ros.call(probe, SetBool, f"{NODE}/pause", SetBool.Request(data=False)).success
+    assert ros.spin_until(lambda: probe.count(topics.TELEMETRY) > seen + 20, 5.0)
+    rows = physics.telemetry_rows(probe.messages(topics.TELEMETRY))
+    assert physics.consecutive(rows[:, F["sim_time_s"]], PERIOD_S)
 
 
 def test_free_run_serves_pause_and_commands_while_the_ticker_runs_flat_out(ros):
