@@ -65,6 +65,9 @@ async def first_session_owns(url: str) -> tuple[Client, Rig]:
     await wait_sample(rig, 1)
     assert await rig.value("Status") == RUNNING
     other, other_rig = await connect(url)
+    # the owner beats once more: a slow connect may outlast heartbeat_timeout_s (1 s here),
+    # after which a silent owner in lockstep lets go and the other session's writes would pass
+    await rig.write(Heartbeat=ua.Variant(1, UINT32))
     try:
         with pytest.raises(ua.uaerrors.BadUserAccessDenied):
             await other_rig.write(SpeedSetpoint=ua.Variant(5.0, DOUBLE),
