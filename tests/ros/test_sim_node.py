@@ -373,10 +373,18 @@ def test_numerical_fault_gives_an_error_diagnostic_and_reset_recovers(ros):
     def levels() -> list[bytes]:
         return [s.level for d in probe.messages(topics.DIAGNOSTICS) for s in d.status]
 
+    def error_sim_times() -> list[float]:
+        return [float(diagnostic_values(d)["sim_time_s"])
+                for d in probe.messages(topics.DIAGNOSTICS)
+                if any(s.level == DiagnosticStatus.ERROR for s in d.status)]
+
     assert ros.spin_until(lambda: DiagnosticStatus.ERROR in levels(), 5.0)
-    seen = probe.count(topics.TELEMETRY)
-    ros.spin_for(0.2)
-    assert seen <= probe.count(topics.TELEMETRY) <= seen + 1    # halted (one may be in flight)
+    # halted: two ERROR reports (1 s apart) give one sim time, and no sample is later than it
+    # (counting arrivals would not tell: samples published before the fault may come late)
+    assert ros.spin_until(lambda: len(error_sim_times()) >= 2, 5.0)
+    halted = error_sim_times()
+    assert halted[-1] == halted[0]
+    assert _newest_sim_time(probe) <= halted[0] + 5e-4
     assert not ros.call(probe, Trigger, f"{NODE}/step", Trigger.Request()).success
     assert ros.call(probe, Trigger, f"{NODE}/reset", Trigger.Request()).success
     seen = probe.count(topics.TELEMETRY)
