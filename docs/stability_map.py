@@ -87,6 +87,16 @@ def predicted(tops: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
     return out
 
 
+def point_scenario(controller: str, rpm: float, wob_n: float, member: int = 0,
+                   t_end_s: float = T_END_S) -> Scenario:
+    """The map's point as a bench scenario (the switch-on at 60 s), ``member`` of its
+    ensemble (0: the map's own run)."""
+    scenario = Scenario(preset=PRESET, duration_s=t_end_s, control_rate_hz=100.0,
+                        controller=controller, enable_at_s=60.0,
+                        schedule=({"t_s": 0.0, "rpm": rpm, "wob_n": wob_n},))
+    return seeded(scenario, member)
+
+
 def rerun(controller: str, rpm: float, wob_n: float, member: int = 0,
           t_end_s: float = T_END_S) -> dict[str, object]:
     """The map's point again through the bench (``member`` of its ensemble; 0: the map's
@@ -94,10 +104,7 @@ def rerun(controller: str, rpm: float, wob_n: float, member: int = 0,
     stall from stick-slip) and, for a stall, ``stall_depth_m``, the depth of cut per
     revolution the bit stuck at for good (None otherwise)."""
     from drill_sim_ros.control.bench import run_in_process
-    scenario = Scenario(preset=PRESET, duration_s=t_end_s, control_rate_hz=100.0,
-                        controller=controller, enable_at_s=60.0,
-                        schedule=({"t_s": 0.0, "rpm": rpm, "wob_n": wob_n},))
-    run = run_in_process(seeded(scenario, member))
+    run = run_in_process(point_scenario(controller, rpm, wob_n, member, t_end_s))
     card = run.score(t_end_s / 2)
     return {**card, "stall_depth_m": stall_depth_m(run.rows, card["stall_time_s"])}
 

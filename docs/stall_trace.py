@@ -19,10 +19,10 @@ import sys
 from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
-from stability_map import PRESET, WORKERS, static_torque_nm
+from stability_map import PRESET, T_END_S, WORKERS, point_scenario, static_torque_nm
 
+from drill_sim_ros.control import stability as st
 from drill_sim_ros.control.bench import run_in_process
-from drill_sim_ros.control.scenario import Scenario, seeded
 from drill_sim_ros.model.bit_rock import MODE_STUCK
 from drill_sim_ros.model.telemetry import TELEMETRY_INDEX as F
 
@@ -30,16 +30,17 @@ RPM = 140.0
 WOB_N = (100e3, 140e3)
 MEMBERS = 6
 DRIVES = ("stiff", "soft_torque")
-ENABLE_AT_S = 60.0
+ENABLE_AT_S = 60.0            # the map's switch-on (stability_map.point_scenario)
 LONG_S = 5.0                  # a stick this long was not ended by the bounce's own torque
-MOTOR_LIMIT_NM = 50e3         # the preset's top_drive.max_torque_nm
 
 
 def freed_depth_mm() -> float:
-    """The deepest cut (mm per revolution) whose stick a torque of ``MOTOR_LIMIT_NM`` ends
-    (RGD07 eq. 30 at rest, :func:`static_torque_nm` is linear in the depth)."""
+    """The deepest cut (mm per revolution) whose stick the motor's torque limit (the
+    preset's top_drive.max_torque_nm) ends (RGD07 eq. 30 at rest, :func:`static_torque_nm`
+    is linear in the depth)."""
+    limit_nm = st.checked_preset(PRESET).drive.max_torque_nm
     slope = static_torque_nm(1.0) - static_torque_nm(0.0)
-    return 1e3 * (MOTOR_LIMIT_NM - static_torque_nm(0.0)) / slope
+    return 1e3 * (limit_nm - static_torque_nm(0.0)) / slope
 
 
 def sticks(rows: np.ndarray) -> list[dict[str, float | bool]]:
@@ -66,19 +67,17 @@ def sticks(rows: np.ndarray) -> list[dict[str, float | bool]]:
 def run(job: tuple[str, float, int]) -> tuple[str, list[dict[str, float | bool]]]:
     """The scorecard's status and the sticks of one run."""
     drive, wob_n, member = job
-    scenario = Scenario(preset=PRESET, duration_s=180.0, control_rate_hz=100.0,
-                        controller=drive, enable_at_s=ENABLE_AT_S,
-                        schedule=({"t_s": 0.0, "rpm": RPM, "wob_n": wob_n},))
-    result = run_in_process(seeded(scenario, member))
-    return str(result.score(90.0)["status"]), sticks(result.rows)
+    result = run_in_process(point_scenario(drive, RPM, wob_n, member))
+    return str(result.score(T_END_S / 2)["status"]), sticks(result.rows)
 
 
 def report(drive: str, runs: list[tuple[str, list[dict[str, float | bool]]]]) -> None:
-    deep = [s for _, found in runs for s in found if s["depth_mm"] > freed_depth_mm()]
+    freed_mm = freed_depth_mm()
+    deep = [s for _, found in runs for s in found if s["depth_mm"] > freed_mm]
     stalled = sum(status == "stalled" for status, _ in runs)
     speeds = [s["drive_rpm"] for s in deep]
     print(f"\n{drive}: stalled in {stalled} of {len(runs)} runs; {len(deep)} sticks deeper "
-          f"than {freed_depth_mm():.1f} mm, the drive at {min(speeds):.0f}-{max(speeds):.0f} "
+          f"than {freed_mm:.1f} mm, the drive at {min(speeds):.0f}-{max(speeds):.0f} "
           "rpm over the second before")
     print(f"sticks that lasted more than {LONG_S:g} s:")
     print("| depth mm | lasted s | ended | quill peak kN m | bit peak kN m | holds kN m |")

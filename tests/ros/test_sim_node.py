@@ -303,10 +303,11 @@ def test_reset_returns_the_model_to_its_initial_state_and_setpoints(ros):
     np.testing.assert_array_equal(after[0, F["bit_angle_rad"]:], fresh[F["bit_angle_rad"]:])
 
 
-def _paused_sim_times(probe) -> list[float]:
-    """The sim times /diagnostics reported in state "paused" (3 decimals)."""
+def _sim_times_in_state(probe, state: str) -> list[float]:
+    """The sim times /diagnostics reported in ``state`` ("paused", "fault"; 3 decimals)."""
     values = (diagnostic_values(m) for m in probe.messages(topics.DIAGNOSTICS))
-    return [float(v["sim_time_s"]) for v in values if v.get("state") == "paused"]
+    return [float(v["sim_time_s"]) for v in values if v.get("state") == state]
+
 
 
 def _newest_sim_time(probe) -> float:
@@ -320,8 +321,8 @@ def test_pause_stops_the_clock_and_step_advances_one_period(ros):
     assert not ros.call(probe, Trigger, f"{NODE}/step", Trigger.Request()).success
     assert ros.call(probe, SetBool, f"{NODE}/pause", SetBool.Request(data=True)).success
     # paused: /diagnostics reports one sim time (1 s apart), and every sample reaches it
-    assert ros.spin_until(lambda: len(_paused_sim_times(probe)) >= 2, 10.0)
-    paused = _paused_sim_times(probe)
+    assert ros.spin_until(lambda: len(_sim_times_in_state(probe, "paused")) >= 2, 10.0)
+    paused = _sim_times_in_state(probe, "paused")
     assert paused[-1] == paused[0]
     assert ros.spin_until(lambda: _newest_sim_time(probe) >= paused[0] - 5e-4, 5.0)
     seen = probe.count(topics.TELEMETRY)
@@ -346,8 +347,8 @@ def test_free_run_serves_pause_and_commands_while_the_ticker_runs_flat_out(ros):
     # The clock stopped: two reports of /diagnostics (1 s apart) give one sim time, and no
     # sample is later than it. Samples published before the pause may still arrive late (a
     # starved subscriber's queue), so counting arrivals would not tell.
-    assert ros.spin_until(lambda: len(_paused_sim_times(probe)) >= 2, 10.0)
-    paused = _paused_sim_times(probe)
+    assert ros.spin_until(lambda: len(_sim_times_in_state(probe, "paused")) >= 2, 10.0)
+    paused = _sim_times_in_state(probe, "paused")
     assert paused[-1] == paused[0]
     rows = physics.telemetry_rows(probe.messages(topics.TELEMETRY))
     assert rows[-1, F["sim_time_s"]] <= paused[0] + 5e-4
@@ -373,16 +374,11 @@ def test_numerical_fault_gives_an_error_diagnostic_and_reset_recovers(ros):
     def levels() -> list[bytes]:
         return [s.level for d in probe.messages(topics.DIAGNOSTICS) for s in d.status]
 
-    def error_sim_times() -> list[float]:
-        return [float(diagnostic_values(d)["sim_time_s"])
-                for d in probe.messages(topics.DIAGNOSTICS)
-                if any(s.level == DiagnosticStatus.ERROR for s in d.status)]
-
     assert ros.spin_until(lambda: DiagnosticStatus.ERROR in levels(), 5.0)
     # halted: two ERROR reports (1 s apart) give one sim time, and no sample is later than it
     # (counting arrivals would not tell: samples published before the fault may come late)
-    assert ros.spin_until(lambda: len(error_sim_times()) >= 2, 5.0)
-    halted = error_sim_times()
+    assert ros.spin_until(lambda: len(_sim_times_in_state(probe, "fault")) >= 2, 5.0)
+    halted = _sim_times_in_state(probe, "fault")
     assert halted[-1] == halted[0]
     assert _newest_sim_time(probe) <= halted[0] + 5e-4
     assert not ros.call(probe, Trigger, f"{NODE}/step", Trigger.Request()).success

@@ -2,14 +2,14 @@
 
 from __future__ import annotations
 
-import threading
-
 import numpy as np
 import rclpy
 from rclpy.context import Context
-from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
+from rclpy.executors import SingleThreadedExecutor
 from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
 from std_msgs.msg import Float64MultiArray
+
+from drill_sim_ros.ros.spinning import SpinThread
 
 
 class TelemetryListener:
@@ -25,22 +25,14 @@ class TelemetryListener:
         self.node.create_subscription(Float64MultiArray, topic, self._on_msg, qos)
         self.executor = SingleThreadedExecutor(context=self.context)
         self.executor.add_node(self.node)
-        self._thread = threading.Thread(target=self._spin, daemon=True)
-        self._thread.start()
+        self._spinning = SpinThread(self.executor, self.context, "viz-test-listener")
 
     def _on_msg(self, msg: Float64MultiArray) -> None:
         self.rows.append(np.array(msg.data, dtype=np.float64))
 
-    def _spin(self) -> None:
-        try:
-            while self.context.ok():
-                self.executor.spin_once(timeout_sec=0.1)
-        except ExternalShutdownException:
-            pass
-
     def close(self) -> np.ndarray:
         """Stop spinning; return the rows received, shape (n, fields)."""
-        rclpy.try_shutdown(context=self.context)
-        self._thread.join(timeout=5)
+        self._spinning.stop()
         self.node.destroy_node()
+        rclpy.try_shutdown(context=self.context)
         return np.stack(self.rows) if self.rows else np.empty((0, 0))
