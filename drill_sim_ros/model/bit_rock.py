@@ -172,17 +172,31 @@ def bit_response(v0: float, kick_v: float, f_ext: float, omega0: float, kick_w: 
     Returns ``(v_new, omega_new, w_f, wob, tob, mode, stuck_new)``.
     """
     if stuck and doc >= 0.0:
-        # Stick (eq. 32): the bit is immobile and the rock reacts the string torque and
-        # force, until the string torque exceeds the cutting + friction torque
-        # delta_k + beta lam (eqs. 14, 33 in the form valid for any top-drive speed).
-        # The wearflat is in full contact as the paper assumes and carries f_ext - delta_k
-        # (eq. 31, last line), so W = delta_k + W_f (eq. 29) and <U''> = 0 give eq. 44.
-        # A limiter in contact carries the rest, and its friction adds to the hold.
-        w_f = stuck_wearflat(f_ext, doc, lam)
-        w_l = max(f_ext - doc - lam, 0.0) if limited else 0.0
-        static = doc + beta * lam + beta_limit * w_l if limited else doc + beta * lam
-        if t_ext <= static:
-            return 0.0, 0.0, w_f, doc + w_f + w_l, t_ext, MODE_STUCK, True
+        v_up = v0 + kick_v * f_ext             # the bit's speed with no axial reaction
+        if v_up < 0.0:
+            # The string pulls the stuck bit up. The rock pushes and cannot pull (the
+            # unilateral contact of eq. 31), so the bit rises with W = 0 and the wearflat
+            # unloaded, held in rotation by its blades' step alone (delta_k: eq. 14 with
+            # W_f = 0), a step that shrinks as the bit rises (eq. 8). A torque above it
+            # slips the bit (the law below, in lost contact). RGD07's own runs never get
+            # here: their f_ext is W_APP > 0 on a bit at rest (v0 = 0). As in RGD07, the
+            # contact is read from the bit's speed, not from a gap: a bit that stops
+            # rising is back on the rock.
+            if t_ext <= doc:
+                return v_up, 0.0, 0.0, 0.0, t_ext, MODE_STUCK, True
+        else:
+            # Stick (eq. 32): the bit is immobile and the rock reacts the string torque
+            # and force, until the string torque exceeds the cutting + friction torque
+            # delta_k + beta lam (eqs. 14, 33 in the form valid for any top-drive speed).
+            # The wearflat is in full contact as the paper assumes and carries
+            # f_ext - delta_k (eq. 31, last line), so W = delta_k + W_f (eq. 29) and
+            # <U''> = 0 give eq. 44. A limiter in contact carries the rest, and its
+            # friction adds to the hold.
+            w_f = stuck_wearflat(f_ext, doc, lam)
+            w_l = max(f_ext - doc - lam, 0.0) if limited else 0.0
+            static = doc + beta * lam + beta_limit * w_l if limited else doc + beta * lam
+            if t_ext <= static:
+                return 0.0, 0.0, w_f, doc + w_f + w_l, t_ext, MODE_STUCK, True
     if doc >= 0.0:
         v_new, w_f = wearflat_contact(v0, f_ext, doc, lam, kick_v)
         wob = doc + w_f                       # eq. (29): W = delta + W_f

@@ -165,6 +165,29 @@ def test_the_stuck_bit_holds_rgd07s_static_torque() -> None:
         assert slip[4] == static
 
 
+def test_a_stuck_bit_pulled_up_rises_held_only_by_its_step() -> None:
+    """Stuck, a bit that the string would pull up (v0 + kick f_ext < 0) rises at that speed:
+    the rock cannot pull, so W = W_f = 0, and with the wearflat unloaded only the blades'
+    step delta holds the torque (eq. 14 with W_f = 0). Above delta it slips, in lost contact
+    (W = delta, T = delta: eqs. 29-31 with W_f = 0). Pushed down (f_ext >= 0) the stick is
+    RGD07's, held up to delta + beta lambda."""
+    doc, beta, lam, kick_v, kick_w = 2.0, 0.3, 5.0, 1e-3, 1e-3
+    for law in range(len(br.LAWS)):
+        def respond(v0: float, f_ext: float, t_ext: float, law: int = law) -> tuple:
+            return br.bit_response(v0, kick_v, f_ext, 0.0, kick_w, t_ext, doc, True, beta,
+                                   lam, law, 0.0, 0.3, 0.5, False, 0.0)
+        v_new, omega_new, w_f, wob, tob, mode, stuck = respond(-0.01, -3.0, doc * 0.999)
+        assert v_new == pytest.approx(-0.01 - kick_v * 3.0, rel=1e-12)
+        assert (omega_new, w_f, wob, tob, mode, stuck) == (0.0, 0.0, 0.0, doc * 0.999,
+                                                           br.MODE_STUCK, True)
+        v_new, omega_new, w_f, wob, tob, mode, stuck = respond(-0.01, -3.0, doc * 1.001)
+        assert not stuck and omega_new > 0.0 and mode == br.MODE_LOST_CONTACT
+        assert (w_f, wob, tob) == (0.0, doc, doc)
+        assert v_new == pytest.approx(-0.01 - kick_v * (3.0 + doc), rel=1e-12)
+        held = respond(0.0, doc + 1.0, doc + beta * lam * 0.999)   # pushed down: W_f = 1
+        assert held[:2] == (0.0, 0.0) and held[5] == br.MODE_STUCK and held[6]
+
+
 def test_the_option_is_checked_one_line() -> None:
     """floor_ratio in (0, 1], speed_rad_s in (0, 1e4], applies_to friction | bit, no
     unknown key: one ParameterError line naming the key and the range."""

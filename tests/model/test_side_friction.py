@@ -697,6 +697,47 @@ def test_off_bottom_and_tagging_bottom_again() -> None:
     assert rest.column(k.C_V)[late].mean() > 0.0
 
 
+def test_a_stuck_bit_comes_off_bottom_when_picked_up() -> None:
+    """A driller picks up a bit that is stuck (the drive stopped) on a vertical string.
+
+    The rock pushes and cannot pull: once the hook's pull has taken out the string's
+    compression, the string pulls the bit up, it rises with WOB exactly 0 while its blades'
+    step still holds it in rotation, and it leaves the rock within the same bounds as a
+    turning bit (the pull reaches it after one travel time L / c_a; the compression
+    W sum L / (E A) at the pick-up speed, give or take a round trip; no wall to drag). It then
+    hangs off bottom with WOB 0. (RGD07's stick alone would hold it for good: measured
+    before the fix, still stuck 5 s after the pick-up. Measured after: the bit rose stuck
+    for 0.14 s and left the rock 1.08 s after the pick-up, 2026-12-07.)"""
+    data = preset_data(drive=SPEED_DRIVE, substeps=4,
+                       physical={"surface_rpm": 120.0, "applied_wob_n": APPLIED_N},
+                       string={"off_bottom_clearance_m": CLEARANCE_M,
+                               "hook_pickup_m_s": PICKUP_M_S, "hook_tag_m_s": TAG_M_S,
+                               "hook_wob_time_s": 1.0})
+    del data["well"]
+    p, sim = simulator(data)
+    sc = p.scales
+    sim.advance(steps(p, 10.0), every=steps(p, 0.01))
+    sim.set_inputs(omega_s=0.0)                      # the drive stops: the bit sticks
+    stopped = sim.advance(steps(p, 5.0), every=steps(p, 0.01))
+    assert np.all(stopped.column(k.C_MODE)[-100:] == k.MODE_STUCK)
+    wob_n = stopped.column(k.C_WOB)[-1] * sc.force_n
+
+    sim.set_off_bottom(True)
+    up = sim.advance(steps(p, 5.0), every=1)
+    mode, t_s = up.column(k.C_MODE), up.column(k.C_TAU) * sc.time_s
+    off = np.flatnonzero(mode == k.MODE_OFF_BOTTOM)
+    assert off.size, "the stuck bit never left the rock"
+    lift_s = t_s[off[0]] - t_s[0]
+    compression_m_per_n = sum(length / (YOUNG_PA * area(r_o, r_i))
+                              for r_o, r_i, length in SECTIONS)
+    travel_s = LENGTH_M / C_A
+    assert travel_s <= lift_s <= wob_n * compression_m_per_n / PICKUP_M_S + 2.0 * travel_s
+    rising = (mode == k.MODE_STUCK) & (up.column(k.C_V) < 0.0)
+    assert rising.any() and np.all(up.column(k.C_WOB)[rising] == 0.0)
+    held = up.data[-steps(p, 1.0):]
+    assert np.all(held[:, k.C_MODE] == k.MODE_OFF_BOTTOM) and np.all(held[:, k.C_WOB] == 0.0)
+
+
 def test_off_bottom_needs_the_distributed_string() -> None:
     sim = Simulator(FIG8A)
     with pytest.raises(ParameterError, match="off bottom needs the distributed string"):
