@@ -1,4 +1,9 @@
-"""Why the soft drives stall more often than stiff (docs/string.md, the stalls): the sticks.
+"""The sticks where the map's bit bounces (docs/string.md, the stalls): whether any lasts.
+
+Until 2026-12-07 the bit stalled for good at these points (stiff 5, soft_torque 9 of these
+12 runs each): the stick held a bit a bounce had landed deep against the string's pull too.
+Since the stick lets the string lift the bit (model.md, the kernel's stick), this script
+shows that none stalls, how deep the bit still lands, and that no stick lasts.
 
 Runs the map's point (the default field preset, 180 s, switch-on at 60 s) at 140 rpm with
 100 and 140 kN, members 0-5 of its ensemble (``scenario.seeded``), under stiff and
@@ -10,7 +15,7 @@ torque while it lasted. Printed per drive: the runs the scorecard calls stalled,
 sticks deeper than what the motor's limit holds quasi-statically (:func:`freed_depth_mm`),
 and every stick that lasted longer than ``LONG_S`` (those the wind-up alone can end).
 
-Usage: .venv/bin/python docs/stall_trace.py      (24 runs: about 1 min on 2 cores)
+Usage: .venv/bin/python docs/stall_trace.py      (24 runs: about 10 s on 2 cores)
 """
 
 from __future__ import annotations
