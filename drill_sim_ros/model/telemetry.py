@@ -90,8 +90,10 @@ def si_rows(samples: np.ndarray, offsets: tuple[float, float], factors: np.ndarr
 
     Each value is ``(column + rebasing offset) * factor``; ``offsets`` = (depth, angle) as
     :attr:`Simulator.offsets` gives them; ``factors`` from :func:`field_scales`; the hook
-    load is ``submerged_weight_n`` less the applied WOB; ``command_stamp_s`` is the stamp of
-    the command in force over these samples.
+    load is ``submerged_weight_n`` less the string's force at the top (``kernel.C_F_TOP``,
+    in the applied WOB's unit: the applied WOB on RGD07's lumped string, what the string
+    leans on the hook's loop on the distributed one, 0 hanging off bottom);
+    ``command_stamp_s`` is the stamp of the command in force over these samples.
     """
     out = np.empty((samples.shape[0], N_FIELDS))
     _fill_si(samples, float(offsets[0]), float(offsets[1]), factors,
@@ -102,6 +104,7 @@ def si_rows(samples: np.ndarray, offsets: tuple[float, float], factors: np.ndarr
 
 _TIME, _HOOK, _COMMAND = F["sim_time_s"], F["hook_load_n"], F["command_stamp_s"]
 _APPLIED_WOB = F["applied_wob_n"]
+_F_TOP = k.C_F_TOP          # the string's force at the hook above its hanging weight
 _SURFACE_RPM, _MOTOR, _STRING = F["surface_rpm"], F["motor_torque_nm"], F["surface_torque_nm"]
 _MEASURED = np.array(MEASURED, dtype=np.int64)
 MEASURED_COLUMNS = _MEASURED    # for RigSensors.measure_into, SIGNALS order
@@ -125,7 +128,9 @@ def _fill_si(samples: np.ndarray, depth_offset: float, angle_offset: float,
         for j in range(row.size):
             row[j] = row[j] * factors[j]
         row[_TIME] = sim_times_s[i]
-        row[_HOOK] = submerged_weight_n - row[_APPLIED_WOB]
+        # the hook carries the weight less what the string leans on below: the string's
+        # force at the top (the applied WOB only once the hook's loop has settled)
+        row[_HOOK] = submerged_weight_n - samples[i, _F_TOP] * factors[_APPLIED_WOB]
         row[_COMMAND] = command_stamp_s
         # perfect sensors (see model.measurement), as surface_truth gives them
         row[_MEASURED[0]] = row[_SURFACE_RPM] / RPM_PER_RAD_S

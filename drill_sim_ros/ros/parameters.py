@@ -145,7 +145,9 @@ SPECS: tuple[ParamSpec, ...] = (
               "Dimensionless axial-velocity perturbation added at t = 0 (seeds the "
               "instability).", -1e3, 1e3, read_only=True, unit="1"),
     ParamSpec("model.submerged_string_weight_n", DOUBLE, submerged_string_weight_n,
-              "Buoyed weight of drill pipe + BHA [N]; hook load = this - applied WOB. "
+              "Buoyed weight of drill pipe + BHA [N]; hook load = this - the string's "
+              "force at the top (the applied WOB once the hook's loop has settled; this "
+              "whole weight off bottom). "
               "Default: steel mass x g x (1 - 1200 kg/m3 mud / steel density); in a "
               "preset's well, the buoyed weight along the hole's axis in its own mud (what "
               "the string hangs with when nothing drags); 0 for dimensionless presets.",

@@ -46,7 +46,7 @@ def test_si_rows_match_the_scales_field_by_field():
         assert r[F["bit_angle_rad"]] == pytest.approx(d[k.C_PHI] + offsets[1], rel=1e-14)
         assert r[F["surface_angle_rad"]] == pytest.approx(d[k.C_PHI_S] + offsets[1],
                                                           rel=1e-14)
-        assert r[F["hook_load_n"]] == pytest.approx(weight_n - sc.wob_n(d[k.C_W_APP]),
+        assert r[F["hook_load_n"]] == pytest.approx(weight_n - sc.wob_n(d[k.C_F_TOP]),
                                                     rel=1e-14)
         assert MODE_NAMES[int(r[F["mode"]])] == MODE_NAMES[int(d[k.C_MODE])]
 
@@ -68,7 +68,7 @@ def test_compiled_si_rows_equal_the_vectorised_reference_bit_for_bit():
     ref[:, [F["bit_angle_rad"], F["surface_angle_rad"]]] += offsets[1]
     ref[:, [F[n] for n in source]] *= factors[[F[n] for n in source]]
     ref[:, F["sim_time_s"]] = times_s
-    ref[:, F["hook_load_n"]] = weight_n - ref[:, F["applied_wob_n"]]
+    ref[:, F["hook_load_n"]] = weight_n - data[:, k.C_F_TOP] * factors[F["applied_wob_n"]]
     ref[:, F["command_stamp_s"]] = stamp_s
     ref[:, F["drive_speed_measured_rad_s"]] = ref[:, F["surface_rpm"]] / RPM_PER_RAD_S
     ref[:, F["motor_torque_measured_nm"]] = ref[:, F["motor_torque_nm"]]

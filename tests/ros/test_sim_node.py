@@ -142,7 +142,9 @@ def test_every_topic_published_with_its_type_and_one_stamp_per_sample(ros):
     np.testing.assert_allclose(rows[:, F["applied_wob_n"]], wob0)
     weight = node.get_parameter("model.submerged_string_weight_n").value
     assert weight == pytest.approx(submerged_string_weight_n(preset))
-    np.testing.assert_allclose(rows[:, F["hook_load_n"]], weight - wob0)
+    # the hook carries the weight less the string's force at the top: the applied WOB, give
+    # or take the string's axial vibration (a few kN, measured 0.3 kN RMS at the start)
+    np.testing.assert_allclose(rows[:, F["hook_load_n"]], weight - wob0, rtol=5e-3)
     assert np.all(rows[:, F["bit_rpm"]] >= 0.0)            # eq. (32): the bit never backs up
     assert np.all(rows[:, F["wob_n"]] >= 0.0)              # contact forces push
     assert set(np.unique(rows[:, F["mode"]])) <= {0.0, 1.0, 2.0, 3.0}

@@ -54,15 +54,15 @@ def telemetry_rows(preset: Preset, seconds: float, rate_hz: float = 100.0) -> np
         "surface_rpm": sc.rpm(col(k.C_OMEGA_S)),
         "surface_torque_nm": sc.tob_nm(col(k.C_T_PIPE)),
         "applied_wob_n": sc.wob_n(col(k.C_W_APP)),
-        "hook_load_n": -sc.wob_n(col(k.C_W_APP)),
+        "hook_load_n": -sc.wob_n(col(k.C_F_TOP)),      # no weight: minus the string's force
         "motor_torque_nm": sc.tob_nm(col(k.C_MOTOR_TORQUE)),
         "speed_setpoint_rpm": sc.rpm(col(k.C_OMEGA_REF)),
         "drive_speed_measured_rad_s": col(k.C_OMEGA_S) / sc.time_s,
         "motor_torque_measured_nm": sc.tob_nm(col(k.C_MOTOR_TORQUE)),
         "string_torque_measured_nm": sc.tob_nm(col(k.C_T_PIPE)),
         "command_stamp_s": np.full(len(samples), -1.0),
-        "hook_load_measured_n": -sc.wob_n(col(k.C_W_APP)),
-        "applied_wob_estimate_n": sc.wob_n(col(k.C_W_APP)),
+        "hook_load_measured_n": -sc.wob_n(col(k.C_F_TOP)),
+        "applied_wob_estimate_n": sc.wob_n(col(k.C_F_TOP)),
         "bha_rpm": sc.rpm(col(k.C_OMEGA_BHA)),
     }
     return np.column_stack([fields[name] for name in topics.TELEMETRY_FIELDS])
