@@ -47,6 +47,7 @@ WOB_N = (40000, 60000, 80000, 100000, 120000, 140000, 160000)
 ENSEMBLE = 6        # members per controller at each point where a re-run stalled
 WORKERS = 2
 T_END_S = 180.0     # the map's runs (--t-end); the switch-on at 60 s, the window the second half
+BOUNCE_SHARE = 0.05  # a point bounces: its bit off the rock more than this share of the window
 
 
 def map_command(controller: str, out: Path, t_end_s: float = T_END_S) -> list[str]:
@@ -206,10 +207,11 @@ def stall_ensemble(points: list[tuple[int, int]], members: int,
 
 def plot(path: Path, gains: dict[str, np.ndarray], stuck: dict[str, np.ndarray],
          fails: dict[str, np.ndarray], stalled: dict[str, list[tuple[int, int]]],
-         t_end_s: float = T_END_S) -> None:
+         bouncing: dict[str, np.ndarray], t_end_s: float = T_END_S) -> None:
     """One panel per controller: the simulated stick fraction (colour; a ring: the status
-    not ok), the predicted G = 1 contour, the points where they disagree and the ones that
-    stalled (a square)."""
+    not ok), the predicted G = 1 contour, the points where they disagree, the ones where
+    the bit bounces (off the rock more than BOUNCE_SHARE of the window: a dot) and the
+    ones that stalled (a square, drawn only where there are any)."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -225,11 +227,14 @@ def plot(path: Path, gains: dict[str, np.ndarray], stuck: dict[str, np.ndarray],
         wrong = (gain > 1.0) != sticks
         ax.scatter(xx[wrong], yy[wrong], marker="x", s=60, c="tab:blue",
                    label="prediction disagrees")
+        ax.scatter(xx[bouncing[name]], yy[bouncing[name]], marker=".", s=30, c="tab:green",
+                   label=f"bit off the rock > {BOUNCE_SHARE:.0%} of the window")
         held = np.zeros(gain.shape, dtype=bool)
         for i, j in stalled[name]:
             held[i, j] = True
-        ax.scatter(xx[held], yy[held], marker="s", s=150, facecolors="none",
-                   edgecolors="tab:purple", linewidths=1.5, label="stalled")
+        if held.any():
+            ax.scatter(xx[held], yy[held], marker="s", s=150, facecolors="none",
+                       edgecolors="tab:purple", linewidths=1.5, label="stalled")
         finite = np.minimum(gain, 10.0)       # a bit unstable by itself: G infinite
         levels = ax.contour(x, y, finite.T, levels=[1.0], colors="tab:blue", linewidths=2)
         ax.clabel(levels, fmt="G = 1", fontsize=8)
@@ -309,12 +314,14 @@ def main() -> int:
     stalled = {c: report(c, gains[c], cards[c]) for c in st.CONTROLLERS}
     fails = {c: np.array([[str(x["status"]) != "ok" for x in row] for row in cards[c]])
              for c in st.CONTROLLERS}
+    bouncing = {c: np.array([[float(x["off_bottom_fraction"]) > BOUNCE_SHARE for x in row]
+                             for row in cards[c]]) for c in st.CONTROLLERS}
     bit_check()
     points = sorted(set().union(*stalled.values()))
     if args.ensemble > 0 and points:
         stall_ensemble(points, args.ensemble, args.t_end)
     if args.plot is not None:
-        plot(args.plot, gains, stuck, fails, stalled, args.t_end)
+        plot(args.plot, gains, stuck, fails, stalled, bouncing, args.t_end)
         print(f"wrote {args.plot}", file=sys.stderr)
     return 0
 
