@@ -24,7 +24,8 @@ The bit law has a seam like the top drive's modes: a law index (``LAW_*``, kerne
 ``P_BIT_LAW``) and one small function per law giving the sliding torque from the depth of
 cut, the wearflat force and the bit's speed, with two parameters ``a`` and ``b`` (slots
 ``P_BIT_LAW_A``, ``P_BIT_LAW_B``). Whatever the law, the stick is RGD07's: the bit stuck holds
-any string torque up to the static torque delta + beta lambda (eqs. 14, 32-33), and a law's
+any string torque up to the static torque delta + beta lambda (eqs. 14, 32-33; a bit that the
+string pulls up rises and holds delta alone, :func:`bit_response`), and a law's
 torque at omega = 0 is that static level (f(0) = 1 below), so the torque is continuous at
 the slip. A new law is one function here, its index, its branch in :func:`sliding_torque`
 and its :class:`BitLaw` parameters.
