@@ -620,6 +620,16 @@ def test_a_well_without_a_survey_and_a_bad_file_are_named(tmp_path: Path) -> Non
 PICKUP_M_S, TAG_M_S, CLEARANCE_M, APPLIED_N = 0.05, 0.05, 0.05, 40_000.0
 
 
+def hook_data() -> dict[str, Any]:
+    """The test string drilling at 120 rpm on 40 kN under the speed drive, with the hook's
+    pick-up, tag speed and clearance of this section (the wave step 4 dtau)."""
+    return preset_data(drive=SPEED_DRIVE, substeps=4,
+                       physical={"surface_rpm": 120.0, "applied_wob_n": APPLIED_N},
+                       string={"off_bottom_clearance_m": CLEARANCE_M,
+                               "hook_pickup_m_s": PICKUP_M_S, "hook_tag_m_s": TAG_M_S,
+                               "hook_wob_time_s": 1.0})
+
+
 def test_off_bottom_and_tagging_bottom_again() -> None:
     """Drilling at 120 rpm on 40 kN in the well, then picked up and put down again.
 
@@ -643,11 +653,7 @@ def test_off_bottom_and_tagging_bottom_again() -> None:
     above the rock; first contact 10 991 N = the law's bound; the largest later step
     10.9 kN; WOB 39.8 kN.) The wave step is 4 dtau (0.3 ms): at 16 (1.2 ms) the bit hangs
     up to 24 mm above the clearance, past the ringing's 22 mm (measured 2026-12-06)."""
-    data = preset_data(drive=SPEED_DRIVE, substeps=4,
-                       physical={"surface_rpm": 120.0, "applied_wob_n": APPLIED_N},
-                       string={"off_bottom_clearance_m": CLEARANCE_M,
-                               "hook_pickup_m_s": PICKUP_M_S, "hook_tag_m_s": TAG_M_S,
-                               "hook_wob_time_s": 1.0})
+    data = hook_data()
     p, sim = simulator(data)
     sc = p.scales
     every = steps(p, 0.01)
@@ -708,11 +714,7 @@ def test_a_stuck_bit_comes_off_bottom_when_picked_up() -> None:
     hangs off bottom with WOB 0. (RGD07's stick alone would hold it for good: measured
     before the fix, still stuck 5 s after the pick-up. Measured after: the bit rose stuck
     for 0.14 s and left the rock 1.08 s after the pick-up, 2026-12-07.)"""
-    data = preset_data(drive=SPEED_DRIVE, substeps=4,
-                       physical={"surface_rpm": 120.0, "applied_wob_n": APPLIED_N},
-                       string={"off_bottom_clearance_m": CLEARANCE_M,
-                               "hook_pickup_m_s": PICKUP_M_S, "hook_tag_m_s": TAG_M_S,
-                               "hook_wob_time_s": 1.0})
+    data = hook_data()
     del data["well"]
     p, sim = simulator(data)
     sc = p.scales

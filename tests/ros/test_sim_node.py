@@ -311,7 +311,6 @@ def _sim_times_in_state(probe, state: str) -> list[float]:
     return [float(v["sim_time_s"]) for v in values if v.get("state") == state]
 
 
-
 def _newest_sim_time(probe) -> float:
     return probe.messages(topics.TELEMETRY)[-1].data[F["sim_time_s"]]
 
